@@ -1,0 +1,57 @@
+//! Rendering interpreter errors for people: file, line and column, the line, a caret.
+//!
+//! The library's errors carry a `Span`; here they become `miette` reports with the source.
+
+use std::path::Path;
+
+use miette::{miette, LabeledSpan, NamedSource, Report};
+use tezgah_gcode::{Canon, CanonSink, Config, GcodeError, Interpreter, Origin};
+
+/// A report naming `file:line:col` and underlining the place in the source.
+pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
+    let name = path.display().to_string();
+    let span = e.span;
+    let label = LabeledSpan::at_offset(span.offset.min(text.len()), "here");
+    miette!(
+        labels = vec![label],
+        "{name}:{}:{}: {}",
+        span.line,
+        span.column,
+        e.kind
+    )
+    .with_source_code(NamedSource::new(name, text.to_string()))
+}
+
+/// Counts of what a program does, for `check`'s summary line.
+#[derive(Default)]
+struct Counts {
+    lines: u32,
+    rapids: usize,
+    feeds: usize,
+    arcs: usize,
+    dwells: usize,
+}
+
+impl CanonSink for Counts {
+    fn call(&mut self, origin: Origin, call: Canon) {
+        self.lines = self.lines.max(origin.line);
+        match call {
+            Canon::StraightTraverse(_) => self.rapids += 1,
+            Canon::StraightFeed(_) => self.feeds += 1,
+            Canon::ArcFeed { .. } => self.arcs += 1,
+            Canon::Dwell(_) => self.dwells += 1,
+            _ => {}
+        }
+    }
+}
+
+/// One line saying what the (already checked) program does.
+pub fn summarize(text: &str, config: Config) -> String {
+    let mut counts = Counts::default();
+    let mut interp = Interpreter::new(config);
+    let _ = interp.run(text, &mut counts);
+    format!(
+        "{} lines, {} rapid, {} feed, {} arc moves, {} dwells",
+        counts.lines, counts.rapids, counts.feeds, counts.arcs, counts.dwells
+    )
+}

@@ -1,0 +1,138 @@
+//! The `tezgah` command line: wires the library stages to files and the terminal.
+//!
+//! Every command is a thin shell over a library call; see the README for the commands.
+
+mod diagnostics;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use miette::{IntoDiagnostic, Result, WrapErr};
+use tezgah_gcode::{Canon, Config, Interpreter, Origin, ToolTable};
+
+#[derive(Parser)]
+#[command(name = "tezgah", version, about = "CNC motion control and CAM")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the canonical machining calls of a program, as LinuxCNC's `rs274` prints them.
+    Canon {
+        /// The G-code program.
+        program: PathBuf,
+        /// A tool table in LinuxCNC's format.
+        #[arg(long)]
+        tool_table: Option<PathBuf>,
+    },
+    /// Pre-flight: check a whole program and report every error, or a short summary.
+    Check {
+        /// The G-code program.
+        program: PathBuf,
+        /// A tool table in LinuxCNC's format.
+        #[arg(long)]
+        tool_table: Option<PathBuf>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Canon {
+            program,
+            tool_table,
+        } => canon(&program, tool_table.as_deref()),
+        Command::Check {
+            program,
+            tool_table,
+        } => check(&program, tool_table.as_deref()),
+    };
+    match result {
+        Ok(code) => code,
+        Err(report) => {
+            eprintln!("{report:?}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn read_text(path: &Path) -> Result<String> {
+    std::fs::read(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))
+        .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
+}
+
+fn load_config(tool_table: Option<&Path>) -> Result<Config> {
+    let table = match tool_table {
+        Some(path) => ToolTable::parse(&read_text(path)?)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("in {}", path.display()))?,
+        None => ToolTable::default(),
+    };
+    Ok(Config::linuxcnc(table))
+}
+
+/// `tezgah canon`: one call per line; on error the calls made so far, then the error.
+fn canon(program: &Path, tool_table: Option<&Path>) -> Result<ExitCode> {
+    let text = read_text(program)?;
+    let mut interp = Interpreter::new(load_config(tool_table)?);
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    let mut sink = Printer { out: &mut out };
+    let result = interp.run(&text, &mut sink);
+    // rs274's driver resets the interpreter twice when it stops, whatever the outcome.
+    sink.call(Origin::default(), Canon::OnReset);
+    sink.call(Origin::default(), Canon::OnReset);
+    drop(sink);
+    use std::io::Write;
+    out.flush().into_diagnostic()?;
+    match result {
+        Ok(()) => Ok(ExitCode::SUCCESS),
+        Err(e) => {
+            eprintln!("{:?}", diagnostics::report(program, &text, &e));
+            Ok(ExitCode::FAILURE)
+        }
+    }
+}
+
+struct Printer<'a, W: std::io::Write> {
+    out: &'a mut W,
+}
+
+impl<W: std::io::Write> Printer<'_, W> {
+    fn call(&mut self, _origin: Origin, call: Canon) {
+        // A closed pipe (`| head`) is not an error worth reporting.
+        let _ = writeln!(self.out, "{call}");
+    }
+}
+
+impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
+    fn call(&mut self, origin: Origin, call: Canon) {
+        Printer::call(self, origin, call);
+    }
+}
+
+/// `tezgah check`: every error with its place, or a summary of the program.
+fn check(program: &Path, tool_table: Option<&Path>) -> Result<ExitCode> {
+    let text = read_text(program)?;
+    let config = load_config(tool_table)?;
+    let errors = tezgah_gcode::check(&text, config.clone());
+    if errors.is_empty() {
+        let summary = diagnostics::summarize(&text, config);
+        println!("{}: OK, {summary}", program.display());
+        return Ok(ExitCode::SUCCESS);
+    }
+    for e in &errors {
+        eprintln!("{:?}", diagnostics::report(program, &text, e));
+    }
+    eprintln!(
+        "{}: {} error{}",
+        program.display(),
+        errors.len(),
+        if errors.len() == 1 { "" } else { "s" }
+    );
+    Ok(ExitCode::FAILURE)
+}

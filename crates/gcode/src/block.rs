@@ -1,0 +1,288 @@
+//! The block: one line of G-code read into its words, as LinuxCNC's `read_items` reads it.
+//!
+//! Reading checks what can be checked word by word (repeated letters, unknown codes, two codes
+//! of one modal group, negative feeds, …); the rules that tie words together are the
+//! interpreter's. Every word keeps the byte offset of its letter in the source line.
+
+use crate::codes::{g_group, ggroup, m_group, mgroup};
+use crate::error::ErrorKind;
+use crate::lexer::{NormLine, COMMENT_MARK};
+use crate::params::Params;
+use crate::reader::{integer_of, ParamRef, ReadResult, Reader};
+
+/// A word's value and where its letter stands in the source line (byte offset).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Word {
+    pub value: f64,
+    pub at: u32,
+}
+
+/// A G or M code of a block: the code (G codes ×10) and where it stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Code {
+    pub code: u32,
+    pub at: u32,
+}
+
+/// A `#…=value` assignment, applied after the whole line has been read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assignment {
+    pub target: ParamRef,
+    pub value: f64,
+    pub at: u32,
+}
+
+/// One block. Letters other than G, M, N and O are kept by their position in the alphabet.
+#[derive(Debug, Clone, Default)]
+pub struct Block {
+    /// The N word's number (its integer part), if any.
+    pub n: Option<i64>,
+    pub words: [Option<Word>; 26],
+    pub g: [Option<Code>; ggroup::COUNT],
+    pub m: [Option<Code>; mgroup::COUNT],
+    pub m_count: usize,
+    /// Index into the line's comments of the comment that counts (the last one, as LinuxCNC).
+    pub comment: Option<usize>,
+    pub assignments: Vec<Assignment>,
+}
+
+/// Letters that are words of their own (everything but G, M, N, O).
+const fn is_value_letter(c: u8) -> bool {
+    matches!(
+        c,
+        b'a' | b'b'
+            | b'c'
+            | b'd'
+            | b'e'
+            | b'f'
+            | b'h'
+            | b'i'
+            | b'j'
+            | b'k'
+            | b'l'
+            | b'p'
+            | b'q'
+            | b'r'
+            | b's'
+            | b't'
+            | b'x'
+            | b'y'
+            | b'z'
+    )
+}
+
+impl Block {
+    /// The word of letter `c` (lower case), if the block has one.
+    #[inline]
+    pub fn word(&self, c: u8) -> Option<Word> {
+        self.words[(c - b'a') as usize]
+    }
+
+    /// The value of letter `c`, if present.
+    #[inline]
+    pub fn get(&self, c: u8) -> Option<f64> {
+        self.word(c).map(|w| w.value)
+    }
+
+    #[inline]
+    pub fn has(&self, c: u8) -> bool {
+        self.word(c).is_some()
+    }
+
+    /// The G code of a modal group, if the block has one.
+    #[inline]
+    pub fn g(&self, group: usize) -> Option<u32> {
+        self.g[group].map(|c| c.code)
+    }
+
+    #[inline]
+    pub fn m(&self, group: usize) -> Option<u32> {
+        self.m[group].map(|c| c.code)
+    }
+
+    /// Whether any axis word (X Y Z A B C) is present.
+    pub fn has_axis_words(&self) -> bool {
+        [b'x', b'y', b'z', b'a', b'b', b'c']
+            .iter()
+            .any(|&c| self.has(c))
+    }
+
+    fn clear(&mut self) {
+        self.n = None;
+        self.words = [None; 26];
+        self.g = [None; ggroup::COUNT];
+        self.m = [None; mgroup::COUNT];
+        self.m_count = 0;
+        self.comment = None;
+        self.assignments.clear();
+    }
+
+    /// Read the normalised line `line` into `self`. `Ok(false)` means the line is deleted by
+    /// `/` and holds nothing to execute. On error, the index into `line.text` is returned.
+    pub fn read(&mut self, line: &NormLine, params: &Params) -> ReadResult<bool> {
+        self.clear();
+        let text = &line.text[..];
+        let mut r = Reader::new(text, 0, params);
+        if text.first() == Some(&b'/') {
+            return Ok(false);
+        }
+        if text.first() == Some(&b'n') {
+            r.pos = 1;
+            let v = r.number()?;
+            if v < 0.0 {
+                return Err((ErrorKind::BadLineNumber, 1));
+            }
+            self.n = Some(v.trunc() as i64);
+        }
+        let mut comment_index = 0;
+        while r.pos < text.len() {
+            let c = text[r.pos];
+            let at = line.at[r.pos];
+            match c {
+                COMMENT_MARK => {
+                    self.comment = Some(comment_index);
+                    comment_index += 1;
+                    r.pos += 1;
+                }
+                b'#' => self.read_assignment(&mut r, at)?,
+                b'g' => self.read_g(&mut r, at)?,
+                b'm' => self.read_m(&mut r, at)?,
+                c if is_value_letter(c) => self.read_letter(&mut r, c, at)?,
+                _ => return Err((ErrorKind::BadCharacter(c as char), r.pos)),
+            }
+        }
+        Ok(true)
+    }
+
+    fn read_assignment(&mut self, r: &mut Reader, at: u32) -> ReadResult<()> {
+        let target = r.parameter_ref()?;
+        if r.text.get(r.pos) != Some(&b'=') {
+            return Err((ErrorKind::EqualSignMissing, r.pos));
+        }
+        r.pos += 1;
+        let value = r.real_value()?;
+        self.assignments.push(Assignment { target, value, at });
+        Ok(())
+    }
+
+    fn read_g(&mut self, r: &mut Reader, at: u32) -> ReadResult<()> {
+        let start = r.pos;
+        r.pos += 1;
+        let value = r.real_value()?;
+        // LinuxCNC keeps G codes as ten times their number and allows 0.001 of slack.
+        let tenfold = 10.0 * value;
+        let mut code = tenfold.floor();
+        if tenfold - code > 0.999 {
+            code = tenfold.ceil();
+        } else if tenfold - code > 0.001 {
+            return Err((ErrorKind::GCodeOutOfRange, start));
+        }
+        if code > 999.0 {
+            return Err((ErrorKind::GCodeOutOfRange, start));
+        }
+        if code < 0.0 {
+            return Err((ErrorKind::NegativeGCode, start));
+        }
+        let code = code as u32;
+        let group = g_group(code).ok_or((ErrorKind::UnknownGCode, start))?;
+        if self.g[group].is_some() {
+            return Err((ErrorKind::TwoGCodesSameGroup, start));
+        }
+        self.g[group] = Some(Code { code, at });
+        Ok(())
+    }
+
+    fn read_m(&mut self, r: &mut Reader, at: u32) -> ReadResult<()> {
+        let start = r.pos;
+        r.pos += 1;
+        let value = r.integer_value()?;
+        if value < 0 {
+            return Err((ErrorKind::NegativeMCode, start));
+        }
+        if value > 199 {
+            return Err((ErrorKind::MCodeTooBig(value), start));
+        }
+        let group = m_group(value).ok_or((ErrorKind::UnknownMCode(value), start))?;
+        if self.m[group].is_some() {
+            return Err((ErrorKind::TwoMCodesSameGroup, start));
+        }
+        self.m[group] = Some(Code {
+            code: value as u32,
+            at,
+        });
+        self.m_count += 1;
+        Ok(())
+    }
+
+    fn read_letter(&mut self, r: &mut Reader, c: u8, at: u32) -> ReadResult<()> {
+        let start = r.pos;
+        let slot = (c - b'a') as usize;
+        if self.words[slot].is_some() {
+            return Err((ErrorKind::MultipleWords(c as char), start));
+        }
+        r.pos += 1;
+        let value = match c {
+            // Words whose value must be an integer.
+            b'h' | b'l' | b't' => r.integer_value()? as f64,
+            _ => r.real_value()?,
+        };
+        let negative = value < 0.0;
+        let kind = match c {
+            b'f' if negative => Some(ErrorKind::NegativeFeed),
+            b's' if negative => Some(ErrorKind::NegativeSpindleSpeed),
+            b't' if negative => Some(ErrorKind::NegativeTool),
+            b'l' if negative => Some(ErrorKind::NegativeL),
+            b'd' if negative => Some(ErrorKind::NegativeD),
+            _ => None,
+        };
+        if let Some(kind) = kind {
+            return Err((kind, start));
+        }
+        self.words[slot] = Some(Word { value, at });
+        Ok(())
+    }
+}
+
+/// Whether `v` is an integer within LinuxCNC's slack.
+pub fn is_integer(v: f64) -> bool {
+    integer_of(v).is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(s: &str) -> ReadResult<Block> {
+        let mut l = NormLine::default();
+        l.lex(s).unwrap();
+        let p = Params::default();
+        let mut b = Block::default();
+        b.read(&l, &p)?;
+        Ok(b)
+    }
+
+    #[test]
+    fn words_and_codes() {
+        let b = read("N10 G1 X1.5 Y-2 F100 M3 S1000").unwrap();
+        assert_eq!(b.n, Some(10));
+        assert_eq!(b.g(ggroup::MOTION), Some(10));
+        assert_eq!(b.get(b'x'), Some(1.5));
+        assert_eq!(b.word(b'y').unwrap().at, 12);
+        assert_eq!(b.m(mgroup::SPINDLE), Some(3));
+    }
+
+    #[test]
+    fn word_errors() {
+        assert_eq!(read("g0x1x2").unwrap_err().0, ErrorKind::MultipleWords('x'));
+        assert_eq!(read("g0g1").unwrap_err().0, ErrorKind::TwoGCodesSameGroup);
+        assert_eq!(read("g12").unwrap_err().0, ErrorKind::UnknownGCode);
+        assert_eq!(read("g1.25").unwrap_err().0, ErrorKind::GCodeOutOfRange);
+        assert_eq!(read("g0x1n2").unwrap_err().0, ErrorKind::BadCharacter('n'));
+        assert_eq!(read("g1f-1").unwrap_err().0, ErrorKind::NegativeFeed);
+    }
+
+    #[test]
+    fn fractional_line_number() {
+        assert_eq!(read("N4567.789 S1200").unwrap().n, Some(4567));
+    }
+}

@@ -1,0 +1,287 @@
+//! Canonical machining calls: what the interpreter tells the machine, in LinuxCNC's vocabulary.
+//!
+//! Positions are in the program's current length units and in program coordinates (the active
+//! work offsets are announced by their own calls), exactly as LinuxCNC's canonical interface
+//! receives them. `Display` prints a call the way LinuxCNC's standalone `rs274` prints it, so
+//! the `canon` command can be diffed against it; [`crate::moves`] turns the calls into moves.
+
+use std::fmt;
+
+use tezgah_geom::{Plane, Pose};
+
+/// Length units of the program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Units {
+    Inches,
+    #[default]
+    Millimeters,
+}
+
+impl Units {
+    /// Millimetres per unit.
+    pub fn mm(self) -> f64 {
+        match self {
+            Units::Inches => 25.4,
+            Units::Millimeters => 1.0,
+        }
+    }
+}
+
+/// `SET_MOTION_CONTROL_MODE` argument.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ControlMode {
+    ExactStop,
+    ExactPath,
+    Continuous(f64),
+}
+
+/// Sense of spindle rotation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpindleDir {
+    Clockwise,
+    CounterClockwise,
+}
+
+/// One canonical call.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Canon {
+    UseLengthUnits(Units),
+    SetG5xOffset {
+        index: u8,
+        offset: Pose,
+    },
+    SetG92Offset(Pose),
+    SetXyRotation(f64),
+    SetFeedReference,
+    OnReset,
+    /// `None` for the planes of the U V W axes (G17.1 …), which tezgah does not drive.
+    SelectPlane(Option<Plane>),
+    SetMotionControlMode(ControlMode),
+    SetNaivecamTolerance(f64),
+    /// G93 = 1, G94 = 0, G95 = 2 (LinuxCNC's `SET_FEED_MODE(spindle, mode)`).
+    SetFeedMode(i32),
+    SetFeedRate(f64),
+    SetSpindleSpeed(f64),
+    StartSpindle(SpindleDir),
+    StopSpindle,
+    SetSpindleMode(f64),
+    StraightTraverse(Pose),
+    StraightFeed(Pose),
+    ArcFeed {
+        first_end: f64,
+        second_end: f64,
+        first_axis: f64,
+        second_axis: f64,
+        rotation: i32,
+        axis_end: f64,
+        abc: [f64; 3],
+    },
+    Dwell(f64),
+    Comment(String),
+    Message(String),
+    SelectTool(i64),
+    StartChange,
+    /// Load the tool of the given pocket (LinuxCNC's pocket = 1-based row of the tool table).
+    ChangeTool(usize),
+    /// M61: tell the machine which pocket's tool is in the spindle without a change.
+    ChangeToolNumber(usize),
+    /// X Y Z A B C offsets (U V W are always zero here).
+    UseToolLengthOffset(Pose),
+    FloodOn,
+    FloodOff,
+    MistOn,
+    MistOff,
+    EnableFeedOverride,
+    DisableFeedOverride,
+    EnableSpeedOverride,
+    DisableSpeedOverride,
+    ProgramStop,
+    OptionalProgramStop,
+    PalletShuttle,
+    ProgramEnd,
+    Finish,
+}
+
+/// `%.4f` of a pose's six values joined by ", ".
+struct Six<'a>(&'a Pose);
+
+impl fmt::Display for Six<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let p = &self.0 .0;
+        write!(
+            f,
+            "{:.4}, {:.4}, {:.4}, {:.4}, {:.4}, {:.4}",
+            p[0], p[1], p[2], p[3], p[4], p[5]
+        )
+    }
+}
+
+impl fmt::Display for Canon {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        use Canon::*;
+        match self {
+            UseLengthUnits(u) => write!(
+                f,
+                "USE_LENGTH_UNITS({})",
+                match u {
+                    Units::Inches => "CANON_UNITS_INCHES",
+                    Units::Millimeters => "CANON_UNITS_MM",
+                }
+            ),
+            SetG5xOffset { index, offset } => {
+                write!(f, "SET_G5X_OFFSET({index}, {})", Six(offset))
+            }
+            SetG92Offset(p) => write!(f, "SET_G92_OFFSET({})", Six(p)),
+            SetXyRotation(r) => write!(f, "SET_XY_ROTATION({r:.4})"),
+            SetFeedReference => f.write_str("SET_FEED_REFERENCE(CANON_XYZ)"),
+            OnReset => f.write_str("ON_RESET()"),
+            SelectPlane(p) => write!(
+                f,
+                "SELECT_PLANE({})",
+                match p {
+                    Some(Plane::XY) => "CANON_PLANE_XY",
+                    Some(Plane::ZX) => "CANON_PLANE_XZ",
+                    Some(Plane::YZ) => "CANON_PLANE_YZ",
+                    None => "CANON_PLANE_UNKNOWN",
+                }
+            ),
+            SetMotionControlMode(m) => match m {
+                ControlMode::ExactStop => f.write_str("SET_MOTION_CONTROL_MODE(CANON_EXACT_STOP)"),
+                ControlMode::ExactPath => f.write_str("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)"),
+                ControlMode::Continuous(t) => {
+                    write!(f, "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, {t:.6})")
+                }
+            },
+            SetNaivecamTolerance(t) => write!(f, "SET_NAIVECAM_TOLERANCE({t:.4})"),
+            SetFeedMode(m) => write!(f, "SET_FEED_MODE(0, {m})"),
+            SetFeedRate(v) => write!(f, "SET_FEED_RATE({v:.4})"),
+            SetSpindleSpeed(s) => write!(f, "SET_SPINDLE_SPEED(0, {s:.4})"),
+            StartSpindle(SpindleDir::Clockwise) => f.write_str("START_SPINDLE_CLOCKWISE(0)"),
+            StartSpindle(SpindleDir::CounterClockwise) => {
+                f.write_str("START_SPINDLE_COUNTERCLOCKWISE(0)")
+            }
+            StopSpindle => f.write_str("STOP_SPINDLE_TURNING(0)"),
+            SetSpindleMode(v) => write!(f, "SET_SPINDLE_MODE(0 {v:.4})"),
+            StraightTraverse(p) => write!(f, "STRAIGHT_TRAVERSE({})", Six(p)),
+            StraightFeed(p) => write!(f, "STRAIGHT_FEED({})", Six(p)),
+            ArcFeed {
+                first_end,
+                second_end,
+                first_axis,
+                second_axis,
+                rotation,
+                axis_end,
+                abc,
+            } => write!(
+                f,
+                "ARC_FEED({first_end:.4}, {second_end:.4}, {first_axis:.4}, {second_axis:.4}, {rotation}, {axis_end:.4}, {:.4}, {:.4}, {:.4})",
+                abc[0], abc[1], abc[2]
+            ),
+            Dwell(s) => write!(f, "DWELL({s:.4})"),
+            Comment(s) => write!(f, "COMMENT(\"{s}\")"),
+            Message(s) => write!(f, "MESSAGE(\"{s}\")"),
+            SelectTool(t) => write!(f, "SELECT_TOOL({t})"),
+            StartChange => f.write_str("START_CHANGE()"),
+            ChangeTool(p) => write!(f, "CHANGE_TOOL({p})"),
+            ChangeToolNumber(p) => write!(f, "CHANGE_TOOL_NUMBER({p})"),
+            UseToolLengthOffset(p) => {
+                let o = &p.0;
+                write!(
+                    f,
+                    "USE_TOOL_LENGTH_OFFSET({:.4} {:.4} {:.4}, {:.4} {:.4} {:.4}, 0.0000 0.0000 0.0000)",
+                    o[0], o[1], o[2], o[3], o[4], o[5]
+                )
+            }
+            FloodOn => f.write_str("FLOOD_ON()"),
+            FloodOff => f.write_str("FLOOD_OFF()"),
+            MistOn => f.write_str("MIST_ON()"),
+            MistOff => f.write_str("MIST_OFF()"),
+            EnableFeedOverride => f.write_str("ENABLE_FEED_OVERRIDE()"),
+            DisableFeedOverride => f.write_str("DISABLE_FEED_OVERRIDE()"),
+            EnableSpeedOverride => f.write_str("ENABLE_SPEED_OVERRIDE(0)"),
+            DisableSpeedOverride => f.write_str("DISABLE_SPEED_OVERRIDE(0)"),
+            ProgramStop => f.write_str("PROGRAM_STOP()"),
+            OptionalProgramStop => f.write_str("OPTIONAL_PROGRAM_STOP()"),
+            PalletShuttle => f.write_str("PALLET_SHUTTLE()"),
+            ProgramEnd => f.write_str("PROGRAM_END()"),
+            Finish => f.write_str("FINISH()"),
+        }
+    }
+}
+
+impl Canon {
+    /// Whether this call moves the machine or sets the feed in force: the calls that the
+    /// differential tests compare numerically.
+    pub fn is_motion(&self) -> bool {
+        matches!(
+            self,
+            Canon::StraightTraverse(_)
+                | Canon::StraightFeed(_)
+                | Canon::ArcFeed { .. }
+                | Canon::Dwell(_)
+                | Canon::SetFeedRate(_)
+        )
+    }
+}
+
+/// Where a canonical call came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Origin {
+    /// 1-based source line; 0 for the calls made before the first line and after the last.
+    pub line: u32,
+    /// The block's N word, if any.
+    pub n: Option<i64>,
+}
+
+/// Receiver of canonical calls.
+pub trait CanonSink {
+    fn call(&mut self, origin: Origin, call: Canon);
+}
+
+impl CanonSink for Vec<(Origin, Canon)> {
+    fn call(&mut self, origin: Origin, call: Canon) {
+        self.push((origin, call));
+    }
+}
+
+/// A sink that drops every call (for pre-flight checks and benchmarks).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Discard;
+
+impl CanonSink for Discard {
+    fn call(&mut self, _: Origin, _: Canon) {}
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_match_rs274() {
+        let arc = Canon::ArcFeed {
+            first_end: 50.0,
+            second_end: 0.0,
+            first_axis: 24.986,
+            second_axis: 0.0,
+            rotation: -1,
+            axis_end: 0.0,
+            abc: [0.0; 3],
+        };
+        assert_eq!(
+            arc.to_string(),
+            "ARC_FEED(50.0000, 0.0000, 24.9860, 0.0000, -1, 0.0000, 0.0000, 0.0000, 0.0000)"
+        );
+        assert_eq!(
+            Canon::SetMotionControlMode(ControlMode::Continuous(1.0)).to_string(),
+            "SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, 1.000000)"
+        );
+        assert_eq!(
+            Canon::SetSpindleMode(0.0).to_string(),
+            "SET_SPINDLE_MODE(0 0.0000)"
+        );
+        assert_eq!(
+            Canon::UseToolLengthOffset(Pose::new(0.0, 0.0, 2.54, 0.0, 0.0, 0.0)).to_string(),
+            "USE_TOOL_LENGTH_OFFSET(0.0000 0.0000 2.5400, 0.0000 0.0000 0.0000, 0.0000 0.0000 0.0000)"
+        );
+    }
+}

@@ -1,0 +1,286 @@
+//! Errors of the lexer, parser and interpreter, worded as LinuxCNC words them.
+//!
+//! The text of each kind is LinuxCNC's message where LinuxCNC has one, so that a programmer who
+//! knows LinuxCNC recognises it and the `bad/` tests of LinuxCNC's suite can be compared word
+//! for word. The [`Span`] says where in the program the error was found.
+
+use crate::span::Span;
+
+/// An error with the place in the program where it was found.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{kind}")]
+pub struct GcodeError {
+    pub kind: ErrorKind,
+    pub span: Span,
+}
+
+impl GcodeError {
+    pub fn new(kind: ErrorKind, span: Span) -> Self {
+        GcodeError { kind, span }
+    }
+}
+
+/// Details of a centre-format arc whose end is not on the circle through its start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcMismatch {
+    /// Letters of the two in-plane axes, e.g. ('X', 'Y').
+    pub letters: (char, char),
+    pub start: [f64; 2],
+    pub center: [f64; 2],
+    pub end: [f64; 2],
+    pub r1: f64,
+    pub r2: f64,
+    pub abs_err: f64,
+    pub rel_err: f64,
+}
+
+impl std::fmt::Display for ArcMismatch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (a, b) = self.letters;
+        write!(
+            f,
+            "start=({a}{:.4},{b}{:.4}) center=({a}{:.4},{b}{:.4}) end=({a}{:.4},{b}{:.4}) r1={:.4} r2={:.4}",
+            self.start[0],
+            self.start[1],
+            self.center[0],
+            self.center[1],
+            self.end[0],
+            self.end[1],
+            self.r1,
+            self.r2
+        )
+    }
+}
+
+/// C's `%.4g`: four significant digits, trailing zeros removed, exponent form outside 1e-5..1e4.
+pub fn format_g4(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let exp = v.abs().log10().floor() as i32;
+    if !(-5..4).contains(&exp) {
+        let s = format!("{v:.3e}");
+        // Rust prints `2.857e-6`; C prints `2.857e-06`.
+        let (mantissa, e) = s.split_once('e').unwrap_or((&s, "0"));
+        let mantissa = trim_zeros(mantissa);
+        let e: i32 = e.parse().unwrap_or(0);
+        let sign = if e < 0 { '-' } else { '+' };
+        return format!("{mantissa}e{sign}{:02}", e.abs());
+    }
+    let decimals = (3 - exp).max(0) as usize;
+    trim_zeros(&format!("{v:.decimals$}")).to_string()
+}
+
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
+}
+
+/// What went wrong. The display text is LinuxCNC's wording.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ErrorKind {
+    // --- lexical ---
+    #[error("Unclosed comment found")]
+    UnclosedComment,
+    #[error("Nested comment found")]
+    NestedComment,
+    #[error("Bad character '{0}' used")]
+    BadCharacter(char),
+    #[error("bad number format (conversion failed) parsing '{0}'")]
+    BadNumberFormat(String),
+    #[error("No characters found in reading real value")]
+    NoCharactersInRealValue,
+    #[error("Non integer value for integer")]
+    NonIntegerValue,
+    #[error("Multiple {0} words on one line")]
+    MultipleWords(char),
+    #[error("Unknown word starting with {0}")]
+    UnknownWord(char),
+    #[error("E word with no G70, G76, M66, M67 or M68 to use it")]
+    EWordUnused,
+    #[error("Bad format unsigned integer")]
+    BadLineNumber,
+    #[error("File ended with no percent sign")]
+    NoClosingPercent,
+    #[error("File ended with no percent sign or program end")]
+    NoProgramEnd,
+    #[error("bad number format (trailing characters) parsing '{0}'")]
+    TrailingCharacters(String),
+
+    // --- words ---
+    #[error("G-code out of range")]
+    GCodeOutOfRange,
+    #[error("Negative g code used")]
+    NegativeGCode,
+    #[error("Unknown g code used")]
+    UnknownGCode,
+    #[error("Two g codes used from same modal group")]
+    TwoGCodesSameGroup,
+    #[error("Negative m code used")]
+    NegativeMCode,
+    #[error("Unknown m code used: M{0}")]
+    UnknownMCode(i64),
+    #[error("M-code greater than 199: M{0}")]
+    MCodeTooBig(i64),
+    #[error("Two m codes used from same modal group")]
+    TwoMCodesSameGroup,
+    #[error("Too many m codes on line")]
+    TooManyMCodes,
+    #[error("Negative f word used")]
+    NegativeFeed,
+    #[error("Negative spindle speed used")]
+    NegativeSpindleSpeed,
+    #[error("Negative tool id (tool not found)")]
+    NegativeTool,
+    #[error("Negative P word used")]
+    NegativeP,
+    #[error("Negative l word used")]
+    NegativeL,
+    #[error("Negative h word used")]
+    NegativeH,
+    #[error("Negative d word tool radius index used")]
+    NegativeD,
+
+    // --- expressions and parameters ---
+    #[error("Unclosed expression")]
+    UnclosedExpression,
+    #[error("Unknown operation")]
+    UnknownOperation,
+    #[error("Unknown operation name starting with {0}")]
+    UnknownOperationName(char),
+    #[error("Attempt to divide by zero")]
+    DivisionByZero,
+    #[error("Negative argument to sqrt")]
+    SqrtOfNegative,
+    #[error("Zero or negative argument to ln")]
+    LogOfNonPositive,
+    #[error("Argument to acos out of range")]
+    AcosOutOfRange,
+    #[error("Argument to asin out of range")]
+    AsinOutOfRange,
+    #[error("Attempt to raise negative to non integer power")]
+    NegativePower,
+    #[error("Left bracket missing after slash with atan")]
+    AtanMissingBracket,
+    #[error("Slash missing after first atan argument")]
+    AtanMissingSlash,
+    #[error("Left bracket missing after unary operation name")]
+    UnaryMissingBracket,
+    #[error("Parameter number out of range")]
+    ParameterOutOfRange,
+    #[error("Equal sign missing in parameter setting")]
+    EqualSignMissing,
+    #[error("Named parameter not terminated")]
+    NamedParameterNotTerminated,
+    #[error("Expected # reading parameter")]
+    ExpectedHash,
+    #[error("Expected ] reading bracketed parameter")]
+    ExpectedCloseBracket,
+    #[error("Cannot create a non-global named parameter outside a subroutine: {0}")]
+    UnknownNamedParameter(String),
+    #[error("Named parameter #<{0}> not defined")]
+    NamedParameterNotDefined(String),
+    #[error("Cannot assign to read-only parameter #{0}")]
+    ReadOnlyParameter(String),
+
+    // --- block rules ---
+    #[error("All axes missing with motion code")]
+    AllAxesMissingWithMotion,
+    #[error("All axes missing with g52 or g92")]
+    AllAxesMissingWithG92,
+    #[error("Cannot use axis values with g80")]
+    AxisValuesWithG80,
+    #[error("Cannot use two g codes that both use axis values")]
+    TwoGCodesUseAxes,
+    #[error("Cannot use axis values without a g code that uses them")]
+    AxisValuesWithoutGCode,
+    #[error("Cannot put an a in canned cycle")]
+    AInCannedCycle,
+    #[error("Cannot put a b in canned cycle")]
+    BInCannedCycle,
+    #[error("Cannot put a c in canned cycle")]
+    CInCannedCycle,
+    #[error("D word with no G41, G41.1, G42, G42.1, G71, G71.1, G71.2 or G96 to use it")]
+    DWordUnused,
+    #[error("H word with no G43 or G76 to use it")]
+    HWordUnused,
+    #[error("I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it")]
+    IWordUnused,
+    #[error("J word with no G2, G3, G5, G5.1, G10, G76 or G87 to use it")]
+    JWordUnused,
+    #[error("K word with no G2, G3, G33, G33.1, G76, or G87 to use it")]
+    KWordUnused,
+    #[error("L word with no G10, cutter compensation, canned cycle, digital/analog input, M98 or NURBS code")]
+    LWordUnused,
+    #[error("P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it")]
+    PWordUnused,
+    #[error("Q word with no G5, G10, G64, G73, G76, G83, M19, M66, M67, M68 or user M code that uses it")]
+    QWordUnused,
+    #[error("R word with no g code that uses it")]
+    RWordUnused,
+    #[error("Dwell time missing with g4")]
+    DwellTimeMissing,
+    #[error("Must use g0 or g1 with g53")]
+    G53NeedsG0OrG1,
+    #[error("Cannot use g53 incremental")]
+    G53Incremental,
+    #[error("Cannot use g28 or g30 with cutter radius comp")]
+    HomeWithCutterComp,
+
+    // --- G10 and offsets ---
+    #[error("Line with G10 does not have L0, L1, L10, L11, L2, or L20")]
+    G10MissingL,
+    #[error("P value not an integer with G10")]
+    G10PNotInteger,
+    #[error("P value out of range (0-9) with G10 L{0}")]
+    G10POutOfRange(i64),
+    #[error("Requested tool {0} not found in the tool table")]
+    ToolNotFound(i64),
+    #[error("Invalid tool number in tool table")]
+    ToolIndexOutOfRange,
+
+    // --- motion ---
+    #[error("Cannot do g1 with zero feed rate")]
+    G1ZeroFeed,
+    #[error("Cannot make arc with zero feed rate")]
+    ArcZeroFeed,
+    #[error("F word missing with inverse time g1 move")]
+    InverseTimeG1MissingF,
+    #[error("F word missing with inverse time arc move")]
+    InverseTimeArcMissingF,
+    #[error("R i j k words all missing for arc")]
+    ArcMissingRIJK,
+    #[error("Mixed radius ijk format for arc")]
+    ArcMixedFormat,
+    #[error("{0} word given for arc in {1} plane")]
+    ArcWrongOffsetWord(char, &'static str),
+    #[error("{0} and {1} words missing for arc in {2} plane")]
+    ArcMissingEndWords(char, char, &'static str),
+    #[error("Radius to end of arc differs from radius to start: {0} abs_err={abs} rel_err={rel:.4}%", abs = format_g4(.0.abs_err), rel = .0.rel_err * 100.0)]
+    ArcRadiusMismatch(Box<ArcMismatch>),
+    #[error("Zero-radius arc: {0}")]
+    ZeroRadiusArc(Box<ArcMismatch>),
+    #[error("Arc radius too small to reach end point")]
+    ArcRadiusTooSmall,
+    #[error("Current point same as end point of arc")]
+    ArcEndIsStart,
+    #[error("P value should be 1 or greater with G2 or G3")]
+    ArcTurnsBelowOne,
+    #[error("P value not an integer with M19 G2 or G3")]
+    ArcTurnsNotInteger,
+    #[error("{0} word missing in absolute center arc")]
+    ArcAbsoluteCenterMissing(char),
+    #[error("Cannot feed with zero spindle speed in feed per rev mode")]
+    ZeroSpindleFeedPerRev,
+    #[error("Need non-negative Q-word to specify tool number with M61")]
+    M61NeedsQ,
+    #[error("{0} is not supported yet")]
+    Unsupported(String),
+    #[error("{0}")]
+    Abort(String),
+    #[error("Invalid value {0} for {1}")]
+    InvalidValue(String, &'static str),
+}

@@ -1,0 +1,202 @@
+//! The rules that tie a block's words together, checked before anything of it is executed:
+//! which motion the block makes, and whether every word has a code that uses it
+//! (LinuxCNC's `enhance_block`, `check_g_codes`, `check_m_codes`, `check_other_codes`).
+
+use crate::block::Block;
+use crate::codes::{ggroup, mgroup};
+use crate::error::ErrorKind;
+
+use super::state::State;
+
+/// LinuxCNC allows at most this many M codes in a block.
+const MAX_M_CODES: usize = 4;
+
+/// What a checked block will do.
+#[derive(Debug, Clone, Copy)]
+pub struct Plan {
+    /// The motion the block makes (G code ×10), explicit or modal.
+    pub motion: Option<u32>,
+}
+
+/// A check failure and the byte offset (in the line) of the word it concerns.
+pub type CheckError = (ErrorKind, u32);
+
+fn is_canned_cycle(g: u32) -> bool {
+    g == 730 || g == 740 || (810..=890).contains(&g)
+}
+
+/// Decide the block's motion and check that its words fit together.
+pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
+    let at_g = |group: usize| block.g[group].map_or(0, |c| c.at);
+    let mode0 = block.g(ggroup::NON_MODAL);
+    let axes = block.has_axis_words();
+    let covets_axes = matches!(mode0, Some(100 | 280 | 300 | 520 | 920));
+    let motion = match block.g(ggroup::MOTION) {
+        Some(800) => {
+            if axes && !covets_axes {
+                return Err((ErrorKind::AxisValuesWithG80, at_g(ggroup::MOTION)));
+            }
+            Some(800)
+        }
+        Some(m) => {
+            if covets_axes {
+                return Err((ErrorKind::TwoGCodesUseAxes, at_g(ggroup::NON_MODAL)));
+            }
+            if !axes && !matches!(m, 0 | 10 | 20 | 30 | 52) {
+                return Err((ErrorKind::AllAxesMissingWithMotion, at_g(ggroup::MOTION)));
+            }
+            Some(m)
+        }
+        None if covets_axes => {
+            if !axes && matches!(mode0, Some(520 | 920)) {
+                return Err((ErrorKind::AllAxesMissingWithG92, at_g(ggroup::NON_MODAL)));
+            }
+            None
+        }
+        None if axes => match state.motion {
+            None | Some(800) => {
+                let at = first_axis_at(block);
+                return Err((ErrorKind::AxisValuesWithoutGCode, at));
+            }
+            m => m,
+        },
+        None => None,
+    };
+    check_g_codes(block, state, motion)?;
+    if block.m_count > MAX_M_CODES {
+        return Err((ErrorKind::TooManyMCodes, 0));
+    }
+    check_other_words(block, motion)?;
+    Ok(Plan { motion })
+}
+
+fn first_axis_at(block: &Block) -> u32 {
+    [b'x', b'y', b'z', b'a', b'b', b'c']
+        .iter()
+        .filter_map(|&c| block.word(c))
+        .map(|w| w.at)
+        .min()
+        .unwrap_or(0)
+}
+
+fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<(), CheckError> {
+    let Some(code) = block.g[ggroup::NON_MODAL] else {
+        return Ok(());
+    };
+    let at = code.at;
+    match code.code {
+        40 => {
+            if block.get(b'p').is_none_or(|p| p < 0.0) {
+                return Err((ErrorKind::DwellTimeMissing, at));
+            }
+        }
+        100 => {
+            let l = block.get(b'l');
+            if !matches!(l.map(|l| l as i64), Some(0 | 1 | 2 | 10 | 11 | 20)) {
+                return Err((ErrorKind::G10MissingL, at));
+            }
+            let l = l.unwrap_or(0.0) as i64;
+            if l == 2 || l == 20 {
+                // LinuxCNC's test is one-sided: P2.6 passes (and means 2), P2.4 does not.
+                let p = block.get(b'p').unwrap_or(-1.0);
+                let rounded = p.round();
+                if (p + 0.0001) - rounded > 0.0002 {
+                    return Err((ErrorKind::G10PNotInteger, at));
+                }
+                if !(0.0..=9.0).contains(&rounded) {
+                    return Err((ErrorKind::G10POutOfRange(l), at));
+                }
+            } else {
+                return Err((
+                    ErrorKind::Unsupported(format!("G10 L{l} (tool table writes)")),
+                    at,
+                ));
+            }
+        }
+        530 => {
+            if !matches!(motion, Some(0 | 10)) {
+                return Err((ErrorKind::G53NeedsG0OrG1, at));
+            }
+            let incremental = match block.g(ggroup::DISTANCE) {
+                Some(910) => true,
+                Some(_) => false,
+                None => state.incremental,
+            };
+            if incremental {
+                return Err((ErrorKind::G53Incremental, at));
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckError> {
+    let mode0 = block.g(ggroup::NON_MODAL);
+    let g10 = mode0 == Some(100);
+    let arc = matches!(motion, Some(20 | 30));
+    let cycle = motion.is_some_and(is_canned_cycle);
+    let m = |group| block.m(group);
+    for (letter, kind) in [
+        (b'a', ErrorKind::AInCannedCycle),
+        (b'b', ErrorKind::BInCannedCycle),
+        (b'c', ErrorKind::CInCannedCycle),
+    ] {
+        if cycle && block.has(letter) {
+            return Err((kind, block.word(letter).map_or(0, |w| w.at)));
+        }
+    }
+    let rule = |letter: u8, allowed: bool, kind: ErrorKind| -> Result<(), CheckError> {
+        match block.word(letter) {
+            Some(w) if !allowed => Err((kind, w.at)),
+            _ => Ok(()),
+        }
+    };
+    let comp = block.g(ggroup::CUTTER_COMP);
+    rule(
+        b'd',
+        matches!(comp, Some(410 | 411 | 420 | 421)) || block.g(ggroup::SPINDLE_MODE) == Some(960),
+        ErrorKind::DWordUnused,
+    )?;
+    rule(b'e', false, ErrorKind::EWordUnused)?;
+    rule(
+        b'h',
+        matches!(block.g(ggroup::TOOL_LENGTH), Some(430 | 432)),
+        ErrorKind::HWordUnused,
+    )?;
+    let ij_user = arc || g10 || matches!(motion, Some(50 | 51 | 870));
+    rule(b'i', ij_user, ErrorKind::IWordUnused)?;
+    rule(b'j', ij_user, ErrorKind::JWordUnused)?;
+    rule(
+        b'k',
+        arc || matches!(motion, Some(330 | 331 | 760 | 870)),
+        ErrorKind::KWordUnused,
+    )?;
+    rule(
+        b'l',
+        g10 || cycle || matches!(motion, Some(52 | 760)) || matches!(m(mgroup::IO), Some(66)),
+        ErrorKind::LWordUnused,
+    )?;
+    let p_user = arc
+        || matches!(mode0, Some(40 | 100))
+        || block.g(ggroup::PATH_CONTROL) == Some(640)
+        || matches!(motion, Some(50 | 52 | 760 | 820 | 860 | 880 | 890))
+        || matches!(m(mgroup::OVERRIDE), Some(50..=53))
+        || matches!(m(mgroup::IO), Some(62..=66))
+        || m(mgroup::USER).is_some();
+    rule(b'p', p_user, ErrorKind::PWordUnused)?;
+    let q_user = g10
+        || block.g(ggroup::PATH_CONTROL) == Some(640)
+        || matches!(motion, Some(50 | 730 | 760 | 830))
+        || matches!(m(mgroup::SPINDLE), Some(19))
+        || matches!(m(mgroup::IO), Some(66..=68))
+        || matches!(m(mgroup::TOOL_CHANGE), Some(61))
+        || m(mgroup::USER).is_some();
+    rule(b'q', q_user, ErrorKind::QWordUnused)?;
+    rule(
+        b'r',
+        arc || g10 || cycle || matches!(m(mgroup::SPINDLE), Some(19)),
+        ErrorKind::RWordUnused,
+    )?;
+    Ok(())
+}

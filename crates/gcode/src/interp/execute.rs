@@ -1,0 +1,564 @@
+//! Executing a checked block: its words in LinuxCNC's fixed order (comment, feed mode, F, S, T,
+//! M6, spindle, coolant, dwell, plane, units, cutter compensation, tool length, coordinate
+//! system, path control, distance modes, retract mode, G10/G28/G92 group, motion, stops).
+
+use tezgah_geom::{FeedMode, Plane, Pose};
+
+use crate::block::Block;
+use crate::canon::{Canon, CanonSink, ControlMode, SpindleDir, Units};
+use crate::codes::{g_name, ggroup, mgroup};
+use crate::error::{ErrorKind, GcodeError};
+use crate::params::{self, coord_system_base};
+
+use super::checks;
+use super::{Flow, Interpreter, LineRef};
+
+/// An execution error and the byte offset in the line of the word it concerns.
+pub(super) type ExecError = (ErrorKind, u32);
+pub(super) type Exec<T = ()> = Result<T, ExecError>;
+
+impl Interpreter {
+    pub(super) fn execute_block(
+        &mut self,
+        block: &Block,
+        line: LineRef,
+        sink: &mut impl CanonSink,
+    ) -> Result<Flow, GcodeError> {
+        let plan = checks::check(block, &self.state)
+            .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
+        self.assign_parameters(block);
+        self.execute_words(block, plan.motion, sink)
+            .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))
+    }
+
+    fn execute_words(
+        &mut self,
+        block: &Block,
+        motion: Option<u32>,
+        sink: &mut impl CanonSink,
+    ) -> Exec<Flow> {
+        if let Some(i) = block.comment {
+            self.comment(&self.norm.comments[i].text.clone(), sink)?;
+        }
+        if let Some(c) = block.g[ggroup::SPINDLE_MODE] {
+            return Err(unsupported(c.code, c.at));
+        }
+        if let Some(g) = block.g(ggroup::FEED_MODE) {
+            self.feed_mode(g, sink);
+        }
+        if let Some(f) = block.get(b'f') {
+            if self.state.feed_mode != FeedMode::InverseTime {
+                self.state.feed_rate = f;
+                self.emit(sink, Canon::SetFeedRate(f));
+            }
+        }
+        if let Some(s) = block.get(b's') {
+            self.state.speed = s;
+            self.emit(sink, Canon::SetSpindleSpeed(s));
+        }
+        if let Some(t) = block.word(b't') {
+            self.select_tool(t.value as i64, t.at, sink)?;
+        }
+        if let Some(m) = block.m[mgroup::TOOL_CHANGE] {
+            self.tool_change(block, m.code, m.at, sink)?;
+        }
+        if let Some(m) = block.m(mgroup::SPINDLE) {
+            match m {
+                3 | 4 => {
+                    let dir = if m == 3 {
+                        SpindleDir::Clockwise
+                    } else {
+                        SpindleDir::CounterClockwise
+                    };
+                    self.state.spindle = Some(dir);
+                    self.emit(sink, Canon::StartSpindle(dir));
+                }
+                5 => {
+                    self.state.spindle = None;
+                    self.emit(sink, Canon::StopSpindle);
+                }
+                _ => return Err(unsupported_m(block, mgroup::SPINDLE)),
+            }
+        }
+        match block.m(mgroup::COOLANT) {
+            Some(7) => {
+                self.state.mist = true;
+                self.emit(sink, Canon::MistOn);
+            }
+            Some(8) => {
+                self.state.flood = true;
+                self.emit(sink, Canon::FloodOn);
+            }
+            Some(_) => {
+                self.state.mist = false;
+                self.state.flood = false;
+                self.emit(sink, Canon::MistOff);
+                self.emit(sink, Canon::FloodOff);
+            }
+            None => {}
+        }
+        for group in [mgroup::IO, mgroup::OVERRIDE, mgroup::USER] {
+            if block.m[group].is_some() {
+                return Err(unsupported_m(block, group));
+            }
+        }
+        if block.g(ggroup::NON_MODAL) == Some(40) {
+            self.emit(sink, Canon::Dwell(block.get(b'p').unwrap_or(0.0)));
+        }
+        if let Some(g) = block.g(ggroup::PLANE) {
+            self.state.plane = match g {
+                170 => Some(Plane::XY),
+                180 => Some(Plane::ZX),
+                190 => Some(Plane::YZ),
+                _ => None,
+            };
+            self.emit(sink, Canon::SelectPlane(self.state.plane));
+        }
+        if let Some(g) = block.g(ggroup::UNITS) {
+            let units = if g == 200 {
+                Units::Inches
+            } else {
+                Units::Millimeters
+            };
+            self.change_units(units);
+            self.emit(sink, Canon::UseLengthUnits(units));
+        }
+        if let Some(g) = block.g(ggroup::LATHE_DIAMETER) {
+            let diameter = g == 70;
+            if diameter != self.state.lathe_diameter {
+                self.state.lathe_diameter = diameter;
+                let what = if diameter { "diameter" } else { "radius" };
+                self.comment_call(sink, format!("Lathe diameter mode changed to {what}"));
+            }
+        }
+        if let Some(c) = block.g[ggroup::CUTTER_COMP] {
+            if c.code != 400 {
+                return Err(unsupported(c.code, c.at));
+            }
+            self.comment_call(sink, "cutter radius compensation off".into());
+        }
+        if let Some(c) = block.g[ggroup::TOOL_LENGTH] {
+            self.tool_length(block, c.code, c.at, sink)?;
+        }
+        if let Some(g) = block.g(ggroup::COORD_SYSTEM) {
+            self.select_coordinate_system(coord_index(g), sink);
+        }
+        if let Some(g) = block.g(ggroup::PATH_CONTROL) {
+            self.path_control(block, g, sink);
+        }
+        if let Some(g) = block.g(ggroup::DISTANCE) {
+            let incremental = g == 910;
+            if incremental != self.state.incremental {
+                self.state.incremental = incremental;
+                let what = if incremental {
+                    "incremental"
+                } else {
+                    "absolute"
+                };
+                self.comment_call(sink, format!("distance mode changed to {what}"));
+            }
+        }
+        if let Some(g) = block.g(ggroup::ARC_DISTANCE) {
+            let incremental = g == 911;
+            if incremental != self.state.ijk_incremental {
+                self.state.ijk_incremental = incremental;
+                let what = if incremental {
+                    "incremental"
+                } else {
+                    "absolute"
+                };
+                self.comment_call(sink, format!("IJK distance mode changed to {what}"));
+            }
+        }
+        if let Some(g) = block.g(ggroup::RETRACT) {
+            let what = if g == 980 { "old_z" } else { "r_plane" };
+            self.comment_call(sink, format!("retract mode set to {what}"));
+        }
+        if let Some(c) = block.g[ggroup::NON_MODAL] {
+            self.non_modal(block, c.code, c.at, sink)?;
+        }
+        if let Some(m) = motion {
+            self.motion(block, m, sink)?;
+        }
+        if let Some(m) = block.m(mgroup::STOP) {
+            return Ok(self.stop(m, sink));
+        }
+        Ok(Flow::Continue)
+    }
+
+    /// `COMMENT`, or `MESSAGE` for `(MSG,…)` and `(DEBUG,…)`.
+    fn comment(&mut self, text: &str, sink: &mut impl CanonSink) -> Exec {
+        let lower = text.get(..6).unwrap_or(text).to_ascii_lowercase();
+        if lower.starts_with("msg,") {
+            self.emit(sink, Canon::Message(text[4..].to_string()));
+        } else if lower.starts_with("debug,") {
+            let expanded = self.substitute_parameters(&text[6..]);
+            self.emit(sink, Canon::Message(expanded));
+        } else {
+            self.emit(sink, Canon::Comment(text.to_string()));
+        }
+        Ok(())
+    }
+
+    /// Replace `#n` and `#<name>` in a DEBUG text with their values (`%.6f`, as LinuxCNC).
+    fn substitute_parameters(&self, text: &str) -> String {
+        let mut out = String::with_capacity(text.len());
+        let b = text.as_bytes();
+        let mut i = 0;
+        while i < b.len() {
+            if b[i] == b'#' {
+                if b.get(i + 1) == Some(&b'<') {
+                    if let Some(end) = text[i + 2..].find('>') {
+                        let name: String = text[i + 2..i + 2 + end]
+                            .chars()
+                            .filter(|c| !c.is_whitespace())
+                            .collect::<String>()
+                            .to_ascii_lowercase();
+                        let v = self.params.named(&name).unwrap_or(0.0);
+                        out.push_str(&format!("{v:.6}"));
+                        i += 3 + end;
+                        continue;
+                    }
+                } else {
+                    let digits = b[i + 1..].iter().take_while(|c| c.is_ascii_digit()).count();
+                    if digits > 0 {
+                        let n: usize = text[i + 1..i + 1 + digits].parse().unwrap_or(0);
+                        let v = if crate::params::Params::in_range(n as i64) {
+                            self.params.get(n)
+                        } else {
+                            0.0
+                        };
+                        out.push_str(&format!("{v:.6}"));
+                        i += 1 + digits;
+                        continue;
+                    }
+                }
+            }
+            let ch = text[i..].chars().next().unwrap_or(' ');
+            out.push(ch);
+            i += ch.len_utf8();
+        }
+        out
+    }
+
+    /// `COMMENT("interpreter: …")`, the notes LinuxCNC makes on mode changes.
+    pub(super) fn comment_call(&self, sink: &mut impl CanonSink, what: String) {
+        self.emit(sink, Canon::Comment(format!("interpreter: {what}")));
+    }
+
+    fn feed_mode(&mut self, g: u32, sink: &mut impl CanonSink) {
+        let (mode, what, code) = match g {
+            930 => (FeedMode::InverseTime, "inverse time", 0),
+            940 => (FeedMode::UnitsPerMinute, "units per minute", 0),
+            _ => (FeedMode::UnitsPerRevolution, "units per revolution", 1),
+        };
+        self.state.feed_mode = mode;
+        self.comment_call(sink, format!("feed mode set to {what}"));
+        self.emit(sink, Canon::SetFeedMode(code));
+        if mode != FeedMode::InverseTime {
+            self.state.feed_rate = 0.0;
+            self.emit(sink, Canon::SetFeedRate(0.0));
+        }
+    }
+
+    fn select_tool(&mut self, t: i64, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if t < 0 {
+            return Err((ErrorKind::NegativeTool, at));
+        }
+        if t != 0 && self.cfg.tool_table.get(t).is_none() {
+            return Err((ErrorKind::ToolNotFound(t), at));
+        }
+        self.state.selected_tool = Some(t);
+        self.emit(sink, Canon::SelectTool(t));
+        Ok(())
+    }
+
+    fn pocket_of(&self, tool: i64) -> usize {
+        self.cfg.tool_table.get(tool).map_or(0, |t| t.row)
+    }
+
+    fn tool_change(&mut self, block: &Block, m: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if m == 6 {
+            let tool = self.state.selected_tool.unwrap_or(0);
+            self.emit(sink, Canon::StartChange);
+            self.state.spindle = None;
+            self.emit(sink, Canon::StopSpindle);
+            self.emit(sink, Canon::ChangeTool(self.pocket_of(tool)));
+            if let Some(offset) = self.table_offset(tool).filter(|_| tool != 0) {
+                self.state.spindle_tool_offset = offset;
+            }
+            return Ok(());
+        }
+        // M61 Q: declare the tool in the spindle.
+        let q = block.get(b'q').filter(|&q| q >= 0.0);
+        let Some(q) = q else {
+            return Err((ErrorKind::M61NeedsQ, at));
+        };
+        let tool = q.round() as i64;
+        if tool != 0 && self.cfg.tool_table.get(tool).is_none() {
+            return Err((ErrorKind::ToolNotFound(tool), at));
+        }
+        self.emit(sink, Canon::ChangeToolNumber(self.pocket_of(tool)));
+        Ok(())
+    }
+
+    fn tool_length(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let offset = match g {
+            430 => match block.get(b'h').map(|h| h as i64) {
+                None | Some(0) => self.state.spindle_tool_offset,
+                Some(h) => self
+                    .table_offset(h)
+                    .ok_or((ErrorKind::ToolNotFound(h), at))?,
+            },
+            431 => {
+                let mut o = Pose::ZERO;
+                for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+                    o.0[i] = block.get(letter).unwrap_or(0.0);
+                }
+                o
+            }
+            490 => Pose::ZERO,
+            _ => return Err(unsupported(g, at)),
+        };
+        // The tip stays where it is: program coordinates shift by the change of offset.
+        self.state.pos = self.state.pos + self.state.tool_offset - offset;
+        self.state.tool_offset = offset;
+        self.emit(sink, Canon::UseToolLengthOffset(offset));
+        Ok(())
+    }
+
+    /// G20/G21: convert the position and the offsets in force (parameters keep their values).
+    fn change_units(&mut self, units: Units) {
+        if units == self.state.units {
+            return;
+        }
+        let k = self.state.units.mm() / units.mm();
+        let s = &mut self.state;
+        s.pos = s.pos.scale_linear(k);
+        s.origin = s.origin.scale_linear(k);
+        s.axis_offset = s.axis_offset.scale_linear(k);
+        s.tool_offset = s.tool_offset.scale_linear(k);
+        s.spindle_tool_offset = s.spindle_tool_offset.scale_linear(k);
+        s.units = units;
+    }
+
+    /// G54 … G59.3.
+    pub(super) fn select_coordinate_system(&mut self, index: usize, sink: &mut impl CanonSink) {
+        if index == self.state.origin_index {
+            self.comment_call(sink, "continuing to use same coordinate system".into());
+            return;
+        }
+        let machine = self.state.to_machine(self.state.pos);
+        let base = coord_system_base(index);
+        self.state.origin_index = index;
+        self.params.set(params::COORD_SYSTEM, index as f64);
+        self.state.origin = Pose(self.params.get6(base));
+        self.state.rotation = self.params.get(base + 9);
+        self.state.pos = self.state.from_machine(machine);
+        self.emit(
+            sink,
+            Canon::SetG5xOffset {
+                index: index as u8,
+                offset: self.state.origin,
+            },
+        );
+        self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
+        self.emit(sink, Canon::SetXyRotation(self.state.rotation));
+    }
+
+    fn path_control(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) {
+        let mode = match g {
+            610 => ControlMode::ExactPath,
+            611 => ControlMode::ExactStop,
+            _ => ControlMode::Continuous(block.get(b'p').unwrap_or(0.0).max(0.0)),
+        };
+        self.state.control = mode;
+        self.emit(sink, Canon::SetMotionControlMode(mode));
+        if let ControlMode::Continuous(p) = mode {
+            let q = block.get(b'q').unwrap_or(p);
+            self.emit(sink, Canon::SetNaivecamTolerance(q));
+        }
+    }
+
+    /// G10, G28, G28.1, G30, G30.1, G52, G92, G92.1, G92.2, G92.3 (G4 and G53 are elsewhere).
+    fn non_modal(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        match g {
+            100 => self.set_coordinate_system(block, sink),
+            280 | 300 => self.go_home(block, g, sink)?,
+            281 | 301 => {
+                let base = if g == 281 {
+                    params::G28_HOME
+                } else {
+                    params::G30_HOME
+                };
+                let machine = self.state.to_machine(self.state.pos);
+                // Home positions are kept in millimetres.
+                self.params
+                    .set6(base, machine.scale_linear(self.state.units.mm()).0);
+            }
+            520 | 920 => self.set_axis_offsets(block, g == 520, sink),
+            921 | 922 => {
+                self.state.pos = self.state.pos + self.state.axis_offset;
+                self.state.axis_offset = Pose::ZERO;
+                if g == 921 {
+                    self.params.set6(params::G92_OFFSET, [0.0; 6]);
+                }
+                self.params.set(params::G92_ENABLED, 0.0);
+                self.emit(sink, Canon::SetG92Offset(Pose::ZERO));
+            }
+            923 => {
+                let offset = Pose(self.params.get6(params::G92_OFFSET));
+                self.state.pos = self.state.pos + self.state.axis_offset - offset;
+                self.state.axis_offset = offset;
+                self.params.set(params::G92_ENABLED, 1.0);
+                self.emit(sink, Canon::SetG92Offset(offset));
+            }
+            40 | 530 => {}
+            _ => return Err(unsupported(g, at)),
+        }
+        Ok(())
+    }
+
+    /// G10 L2 / L20: set a coordinate system's offsets directly or so that the current point
+    /// takes the given coordinates.
+    fn set_coordinate_system(&mut self, block: &Block, sink: &mut impl CanonSink) {
+        let l20 = block.get(b'l').is_some_and(|l| l as i64 == 20);
+        // LinuxCNC checks round(P) but uses the truncated P.
+        let p = block.get(b'p').unwrap_or(0.0).trunc() as usize;
+        let index = if p == 0 { self.state.origin_index } else { p };
+        let base = coord_system_base(index);
+        let mut offset = Pose(self.params.get6(base));
+        let mut rotation = self.params.get(base + 9);
+        let machine = self.state.to_machine(self.state.pos);
+        if let Some(r) = block.get(b'r') {
+            rotation = r;
+        }
+        for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+            if let Some(v) = block.get(letter) {
+                offset.0[i] = if l20 {
+                    // The current point is to become v: offset = machine − (v + G92).
+                    machine.0[i] - (v + self.state.axis_offset.0[i])
+                } else {
+                    v
+                };
+            }
+        }
+        self.params.set6(base, offset.0);
+        self.params.set(base + 9, rotation);
+        if index == self.state.origin_index {
+            self.state.origin = offset;
+            self.state.rotation = rotation;
+            self.state.pos = self.state.from_machine(machine);
+            self.emit(
+                sink,
+                Canon::SetG5xOffset {
+                    index: index as u8,
+                    offset,
+                },
+            );
+            self.emit(sink, Canon::SetXyRotation(rotation));
+        } else {
+            self.comment_call(sink, "setting coordinate system origin".into());
+        }
+    }
+
+    /// G92 (offsets that make the current point the given coordinates) and G52 (local offsets).
+    fn set_axis_offsets(&mut self, block: &Block, local: bool, sink: &mut impl CanonSink) {
+        for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+            if let Some(v) = block.get(letter) {
+                let old = self.state.axis_offset.0[i];
+                let new = if local {
+                    v
+                } else {
+                    self.state.pos.0[i] + old - v
+                };
+                self.state.pos.0[i] += old - new;
+                self.state.axis_offset.0[i] = new;
+            }
+        }
+        self.params
+            .set6(params::G92_OFFSET, self.state.axis_offset.0);
+        self.params.set(params::G92_ENABLED, 1.0);
+        self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
+    }
+
+    /// M0, M1, M60 pause; M2 and M30 end the program with LinuxCNC's resets.
+    fn stop(&mut self, m: u32, sink: &mut impl CanonSink) -> Flow {
+        match m {
+            0 => self.emit(sink, Canon::ProgramStop),
+            1 => self.emit(sink, Canon::OptionalProgramStop),
+            60 => {
+                self.emit(sink, Canon::PalletShuttle);
+                self.emit(sink, Canon::ProgramStop);
+            }
+            _ => {
+                self.end_program(m == 30, sink);
+                return Flow::End;
+            }
+        }
+        Flow::Continue
+    }
+
+    fn end_program(&mut self, pallet: bool, sink: &mut impl CanonSink) {
+        let machine = self.state.to_machine(self.state.pos);
+        let base = coord_system_base(1);
+        self.state.origin_index = 1;
+        self.params.set(params::COORD_SYSTEM, 1.0);
+        self.state.origin = Pose(self.params.get6(base));
+        self.state.rotation = self.params.get(base + 9);
+        self.state.pos = self.state.from_machine(machine);
+        self.emit(
+            sink,
+            Canon::SetG5xOffset {
+                index: 1,
+                offset: self.state.origin,
+            },
+        );
+        self.emit(sink, Canon::SetXyRotation(self.state.rotation));
+        if self.state.plane != Some(Plane::XY) {
+            self.state.plane = Some(Plane::XY);
+            self.emit(sink, Canon::SelectPlane(Some(Plane::XY)));
+        }
+        self.state.incremental = false;
+        self.state.feed_mode = FeedMode::UnitsPerMinute;
+        self.emit(sink, Canon::SetFeedMode(0));
+        self.state.feed_rate = 0.0;
+        self.emit(sink, Canon::SetFeedRate(0.0));
+        self.state.spindle = None;
+        self.emit(sink, Canon::StopSpindle);
+        self.emit(sink, Canon::SetSpindleMode(0.0));
+        if self.state.mist {
+            self.state.mist = false;
+            self.emit(sink, Canon::MistOff);
+        }
+        if self.state.flood {
+            self.state.flood = false;
+            self.emit(sink, Canon::FloodOff);
+        }
+        if pallet {
+            self.emit(sink, Canon::PalletShuttle);
+        }
+        self.emit(sink, Canon::ProgramEnd);
+        if self.percent == super::Percent::Open {
+            self.comment_call(sink, "percent sign missing from end of file".into());
+        }
+        self.state.motion = Some(10);
+        self.ended = true;
+    }
+}
+
+fn coord_index(g: u32) -> usize {
+    match g {
+        540..=590 => ((g - 540) / 10 + 1) as usize,
+        _ => (g - 591 + 7) as usize,
+    }
+}
+
+pub(super) fn unsupported(g10: u32, at: u32) -> ExecError {
+    (ErrorKind::Unsupported(g_name(g10)), at)
+}
+
+fn unsupported_m(block: &Block, group: usize) -> ExecError {
+    let c = block.m[group].expect("group present");
+    (ErrorKind::Unsupported(format!("M{}", c.code)), c.at)
+}

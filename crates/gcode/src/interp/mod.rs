@@ -1,0 +1,319 @@
+//! The interpreter: blocks in, canonical calls out, with LinuxCNC's semantics.
+//!
+//! It reads a program line by line (lexer → block reader), checks each block against the modal
+//! rules, and executes its words in LinuxCNC's fixed order, sending canonical calls to a
+//! [`CanonSink`]. [`Interpreter::run`] stops at the first error, as a controller must;
+//! [`check`] goes on after an error to report every one (the pre-flight).
+
+mod arc;
+mod checks;
+mod execute;
+mod motion;
+mod state;
+
+pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
+pub use state::State;
+
+use tezgah_geom::Pose;
+
+use crate::block::Block;
+use crate::canon::{Canon, CanonSink, Origin, Units};
+use crate::error::{ErrorKind, GcodeError};
+use crate::lexer::NormLine;
+use crate::params::Params;
+use crate::span::Span;
+use crate::tooltable::ToolTable;
+
+/// What the interpreter needs to know about the machine it runs for.
+#[derive(Debug, Clone, Default)]
+pub struct Config {
+    pub tool_table: ToolTable,
+    /// Units of the tool table's offsets. LinuxCNC's standalone `rs274` reads them as inches.
+    pub tool_table_units: Units,
+}
+
+impl Config {
+    /// The configuration under which `canon` reproduces LinuxCNC's `rs274`.
+    pub fn linuxcnc(tool_table: ToolTable) -> Self {
+        Config {
+            tool_table,
+            tool_table_units: Units::Inches,
+        }
+    }
+}
+
+/// Whether the program goes on after a line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Flow {
+    Continue,
+    /// M2/M30 or the closing `%`: nothing after this line is read.
+    End,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Percent {
+    /// Nothing read yet: a first line `%` opens percent mode.
+    Unknown,
+    Open,
+    Off,
+}
+
+/// An RS274/NGC interpreter with its state, parameters and reusable line buffers.
+#[derive(Debug, Clone)]
+pub struct Interpreter {
+    cfg: Config,
+    state: State,
+    params: Params,
+    norm: NormLine,
+    block: Block,
+    percent: Percent,
+    ended: bool,
+    /// Source line being executed, for the canonical calls' origin.
+    origin: Origin,
+}
+
+/// Where in the source a line sits, for error spans.
+#[derive(Debug, Clone, Copy)]
+pub struct LineRef<'a> {
+    pub number: u32,
+    pub text: &'a str,
+    /// Byte offset of the line in the whole program.
+    pub start: usize,
+}
+
+impl LineRef<'_> {
+    pub fn span(&self, byte: usize) -> Span {
+        Span::in_line(self.number, self.text, self.start, byte)
+    }
+}
+
+impl Interpreter {
+    pub fn new(cfg: Config) -> Self {
+        let mut params = Params::default();
+        params.set(crate::params::COORD_SYSTEM, 1.0);
+        Interpreter {
+            cfg,
+            state: State::default(),
+            params,
+            norm: NormLine::default(),
+            block: Block::default(),
+            percent: Percent::Unknown,
+            ended: false,
+            origin: Origin::default(),
+        }
+    }
+
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Whether M2/M30 or the closing `%` has been reached.
+    pub fn ended(&self) -> bool {
+        self.ended
+    }
+
+    /// The calls LinuxCNC makes before the first block (its `rs274` prints them all).
+    pub fn start(&mut self, sink: &mut impl CanonSink) {
+        self.origin = Origin::default();
+        let o = self.origin;
+        sink.call(o, Canon::UseLengthUnits(self.state.units));
+        sink.call(
+            o,
+            Canon::SetG5xOffset {
+                index: 1,
+                offset: self.state.origin,
+            },
+        );
+        sink.call(o, Canon::SetG92Offset(self.state.axis_offset));
+        sink.call(o, Canon::SetXyRotation(self.state.rotation));
+        sink.call(o, Canon::SetFeedReference);
+        sink.call(o, Canon::OnReset);
+    }
+
+    /// Interpret a whole program; stops at the first error. Calls [`Self::start`] first.
+    pub fn run(&mut self, program: &str, sink: &mut impl CanonSink) -> Result<(), GcodeError> {
+        self.start(sink);
+        let mut last = LineRef {
+            number: 0,
+            text: "",
+            start: 0,
+        };
+        for line in lines(program) {
+            last = line;
+            if self.execute_line(line, sink)? == Flow::End {
+                return Ok(());
+            }
+        }
+        self.finish(last)
+    }
+
+    /// The end of the text was reached without M2/M30 or closing `%`: an error, as in LinuxCNC.
+    pub fn finish(&mut self, last: LineRef) -> Result<(), GcodeError> {
+        if self.ended {
+            return Ok(());
+        }
+        let kind = if self.percent == Percent::Open || last.number == 0 {
+            ErrorKind::NoClosingPercent
+        } else {
+            ErrorKind::NoProgramEnd
+        };
+        Err(GcodeError::new(kind, last.span(last.text.len())))
+    }
+
+    /// Read, check and execute one line.
+    pub fn execute_line(
+        &mut self,
+        line: LineRef,
+        sink: &mut impl CanonSink,
+    ) -> Result<Flow, GcodeError> {
+        if self.ended {
+            return Ok(Flow::End);
+        }
+        if let Some(flow) = self.percent_line(line)? {
+            if flow == Flow::End {
+                sink.call(Origin::default(), Canon::Finish);
+            }
+            return Ok(flow);
+        }
+        let Self {
+            norm,
+            block,
+            params,
+            ..
+        } = self;
+        norm.lex(line.text)
+            .map_err(|(kind, byte)| GcodeError::new(kind, line.span(byte)))?;
+        let to_span = |norm: &NormLine, idx: usize| {
+            let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
+            line.span(byte)
+        };
+        let live = block
+            .read(norm, params)
+            .map_err(|(kind, idx)| GcodeError::new(kind, to_span(norm, idx)))?;
+        if !live {
+            return Ok(Flow::Continue);
+        }
+        self.origin = Origin {
+            line: line.number,
+            n: self.block.n,
+        };
+        let block = std::mem::take(&mut self.block);
+        let result = self.execute_block(&block, line, sink);
+        self.block = block;
+        result
+    }
+
+    /// Handle `%` lines. `Some(flow)` when the line was a percent line.
+    fn percent_line(&mut self, line: LineRef) -> Result<Option<Flow>, GcodeError> {
+        let is_percent = line.text.trim() == "%";
+        let first = self.percent == Percent::Unknown;
+        if first {
+            self.percent = if is_percent {
+                Percent::Open
+            } else {
+                Percent::Off
+            };
+            if is_percent {
+                return Ok(Some(Flow::Continue));
+            }
+        } else if is_percent && self.percent == Percent::Open {
+            self.ended = true;
+            return Ok(Some(Flow::End));
+        }
+        if let Some(at) = line.text.find('%') {
+            // A `%` anywhere else is not G-code.
+            let before = &line.text[..at];
+            if !before.contains('(') && !before.contains(';') {
+                return Err(GcodeError::new(ErrorKind::BadCharacter('%'), line.span(at)));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Apply a block's parameter assignments (after the whole line was read, as LinuxCNC).
+    fn assign_parameters(&mut self, block: &Block) {
+        for a in &block.assignments {
+            match &a.target {
+                crate::reader::ParamRef::Numbered(n) => self.params.set(*n, a.value),
+                crate::reader::ParamRef::Named(name) => self.params.set_named(name, a.value),
+            }
+        }
+    }
+
+    fn emit(&self, sink: &mut impl CanonSink, call: Canon) {
+        sink.call(self.origin, call);
+    }
+
+    /// Linear factor from the tool table's units to the program's.
+    fn tool_units_factor(&self) -> f64 {
+        self.cfg.tool_table_units.mm() / self.state.units.mm()
+    }
+
+    /// Tool offsets of `tool` from the table, in program units.
+    fn table_offset(&self, number: i64) -> Option<Pose> {
+        let k = self.tool_units_factor();
+        self.cfg
+            .tool_table
+            .get(number)
+            .map(|t| t.offset.scale_linear(k))
+    }
+}
+
+/// Split a program into lines with their numbers and byte offsets (`\n`, `\r\n` or `\r`).
+pub fn lines(program: &str) -> impl Iterator<Item = LineRef<'_>> {
+    let mut start = 0;
+    let mut number = 0;
+    let bytes = program.as_bytes();
+    std::iter::from_fn(move || {
+        if start >= bytes.len() {
+            return None;
+        }
+        let rest = &bytes[start..];
+        let len = memchr_newline(rest);
+        let text = &program[start..start + len];
+        let text = text.strip_suffix('\r').unwrap_or(text);
+        number += 1;
+        let line = LineRef {
+            number,
+            text,
+            start,
+        };
+        start += (len + 1).min(rest.len());
+        Some(line)
+    })
+}
+
+fn memchr_newline(s: &[u8]) -> usize {
+    s.iter().position(|&b| b == b'\n').unwrap_or(s.len())
+}
+
+/// Pre-flight: interpret the whole program and collect every error instead of stopping at the
+/// first. After an error, interpretation goes on with the next line from the state the failed
+/// block left (the words executed before the failing one keep their effect, as in LinuxCNC).
+pub fn check(program: &str, cfg: Config) -> Vec<GcodeError> {
+    let mut interp = Interpreter::new(cfg);
+    let mut sink = crate::canon::Discard;
+    interp.start(&mut sink);
+    let mut errors = Vec::new();
+    let mut last = LineRef {
+        number: 0,
+        text: "",
+        start: 0,
+    };
+    for line in lines(program) {
+        last = line;
+        match interp.execute_line(line, &mut sink) {
+            Ok(Flow::End) => return errors,
+            Ok(Flow::Continue) => {}
+            Err(e) => errors.push(e),
+        }
+    }
+    if let Err(e) = interp.finish(last) {
+        errors.push(e);
+    }
+    errors
+}

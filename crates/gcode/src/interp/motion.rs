@@ -1,0 +1,227 @@
+//! The motion of a block: G0/G1 (also under G53), G2/G3 arcs and helices, G28/G30 returns.
+//!
+//! End points are computed in program coordinates as LinuxCNC's `find_ends` does; feeds in
+//! inverse time become a rate per move (`F × length`), as LinuxCNC sends them.
+
+use tezgah_geom::{FeedMode, Plane, Pose};
+
+use crate::block::{is_integer, Block};
+use crate::canon::{Canon, CanonSink};
+use crate::codes::ggroup;
+use crate::error::ErrorKind;
+use crate::params;
+
+use super::arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
+use super::execute::{unsupported, Exec};
+use super::Interpreter;
+
+const AXIS_LETTERS: [u8; 6] = [b'x', b'y', b'z', b'a', b'b', b'c'];
+
+impl Interpreter {
+    pub(super) fn motion(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) -> Exec {
+        let at = block.g[ggroup::MOTION].map_or(0, |c| c.at);
+        match g {
+            0 | 10 => self.straight(block, g == 0, at, sink)?,
+            20 | 30 => self.arc(block, g == 20, at, sink)?,
+            800 => self.comment_call(sink, "motion mode set to none".into()),
+            _ => return Err(unsupported(g, at)),
+        }
+        self.state.motion = Some(g);
+        Ok(())
+    }
+
+    /// End point of the block's axis words, absolute, incremental or (G53) machine.
+    fn find_ends(&self, block: &Block) -> Pose {
+        let s = &self.state;
+        if block.g(ggroup::NON_MODAL) == Some(530) {
+            let mut m = s.to_machine(s.pos) + s.tool_offset;
+            for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
+                if let Some(v) = block.get(letter) {
+                    m.0[i] = v;
+                }
+            }
+            return s.from_machine(m - s.tool_offset);
+        }
+        let mut end = s.pos;
+        for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
+            if let Some(v) = block.get(letter) {
+                end.0[i] = if s.incremental { s.pos.0[i] + v } else { v };
+            }
+        }
+        end
+    }
+
+    /// The feed checks every feed move makes; in inverse time, the F word of the block.
+    fn feed_for_move(&self, block: &Block, arc: bool, at: u32) -> Exec<Option<f64>> {
+        let s = &self.state;
+        match s.feed_mode {
+            FeedMode::UnitsPerMinute | FeedMode::UnitsPerRevolution => {
+                if s.feed_rate == 0.0 {
+                    let kind = if arc {
+                        ErrorKind::ArcZeroFeed
+                    } else {
+                        ErrorKind::G1ZeroFeed
+                    };
+                    return Err((kind, at));
+                }
+                if s.feed_mode == FeedMode::UnitsPerRevolution && s.speed == 0.0 {
+                    return Err((ErrorKind::ZeroSpindleFeedPerRev, at));
+                }
+                Ok(None)
+            }
+            FeedMode::InverseTime => match block.get(b'f') {
+                Some(f) => Ok(Some(f)),
+                None => Err((
+                    if arc {
+                        ErrorKind::InverseTimeArcMissingF
+                    } else {
+                        ErrorKind::InverseTimeG1MissingF
+                    },
+                    at,
+                )),
+            },
+        }
+    }
+
+    fn straight(&mut self, block: &Block, rapid: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let end = self.find_ends(block);
+        if rapid {
+            self.emit(sink, Canon::StraightTraverse(end));
+        } else {
+            if let Some(f) = self.feed_for_move(block, false, at)? {
+                let d = end - self.state.pos;
+                let length = match d.linear_norm() {
+                    l if l > 0.0 => l,
+                    _ => d.rotary_norm(),
+                };
+                self.emit(sink, Canon::SetFeedRate(f * length));
+            }
+            self.emit(sink, Canon::StraightFeed(end));
+        }
+        self.state.pos = end;
+        Ok(())
+    }
+
+    /// G28/G30: rapid to the point the axis words give, then to the stored home position of
+    /// those axes (all axes when none is given).
+    pub(super) fn go_home(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) -> Exec {
+        let intermediate = self.find_ends(block);
+        self.emit(sink, Canon::StraightTraverse(intermediate));
+        self.state.pos = intermediate;
+        let base = if g == 280 {
+            params::G28_HOME
+        } else {
+            params::G30_HOME
+        };
+        let home_mm = Pose(self.params.get6(base));
+        let home = self
+            .state
+            .from_machine(home_mm.scale_linear(1.0 / self.state.units.mm()));
+        let any = block.has_axis_words();
+        let mut end = intermediate;
+        for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
+            if !any || block.has(letter) {
+                end.0[i] = home.0[i];
+            }
+        }
+        self.emit(sink, Canon::StraightTraverse(end));
+        self.state.pos = end;
+        Ok(())
+    }
+
+    fn arc(&mut self, block: &Block, clockwise: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let Some(plane) = self.state.plane else {
+            return Err((
+                ErrorKind::Unsupported("arcs in the U V W planes".into()),
+                at,
+            ));
+        };
+        let ijk = block.has(b'i') || block.has(b'j') || block.has(b'k');
+        let radius = block.get(b'r');
+        if radius.is_none() && !ijk {
+            return Err((ErrorKind::ArcMissingRIJK, at));
+        }
+        if radius.is_some() && ijk {
+            return Err((ErrorKind::ArcMixedFormat, at));
+        }
+        let inverse_feed = self.feed_for_move(block, true, at)?;
+        let (first, second, normal) = plane.axes();
+        let (name, offsets, forbidden, missing_ends) = match plane {
+            Plane::XY => ("xy", [b'i', b'j'], b'k', ('X', 'y')),
+            Plane::ZX => ("xz", [b'k', b'i'], b'j', ('X', 'z')),
+            Plane::YZ => ("yz", [b'j', b'k'], b'i', ('Y', 'z')),
+        };
+        if ijk && block.has(forbidden) {
+            let letter = (forbidden as char).to_ascii_uppercase();
+            return Err((ErrorKind::ArcWrongOffsetWord(letter, name), at));
+        }
+        let in_plane_end = block.has(AXIS_LETTERS[first]) || block.has(AXIS_LETTERS[second]);
+        if radius.is_some() && !in_plane_end {
+            return Err((
+                ErrorKind::ArcMissingEndWords(missing_ends.0, missing_ends.1, name),
+                at,
+            ));
+        }
+        let turns = match block.get(b'p') {
+            None => 1,
+            Some(p) if !is_integer(p) => return Err((ErrorKind::ArcTurnsNotInteger, at)),
+            Some(p) if p.round() < 1.0 => return Err((ErrorKind::ArcTurnsBelowOne, at)),
+            Some(p) => p.round() as i32,
+        };
+        let start = self.state.pos;
+        let end = self.find_ends(block);
+        let s2 = [start.0[first], start.0[second]];
+        let e2 = [end.0[first], end.0[second]];
+        let tol = ArcTolerance::for_units(self.state.inches());
+        let sense = if clockwise {
+            Sense::Clockwise
+        } else {
+            Sense::CounterClockwise
+        };
+        let letters = (
+            (AXIS_LETTERS[first] as char).to_ascii_uppercase(),
+            (AXIS_LETTERS[second] as char).to_ascii_uppercase(),
+        );
+        let center = match radius {
+            Some(r) => center_from_radius(s2, e2, r, sense, tol),
+            None => {
+                let mut c = [0.0; 2];
+                for (k, &letter) in offsets.iter().enumerate() {
+                    let v = block.get(letter);
+                    c[k] = if self.state.ijk_incremental {
+                        s2[k] + v.unwrap_or(0.0)
+                    } else {
+                        v.ok_or((
+                            ErrorKind::ArcAbsoluteCenterMissing(
+                                (letter as char).to_ascii_uppercase(),
+                            ),
+                            at,
+                        ))?
+                    };
+                }
+                center_from_offset(s2, e2, c, tol, letters)
+            }
+        }
+        .map_err(|kind| (kind, at))?;
+        if let Some(f) = inverse_feed {
+            let radius = (s2[0] - center[0]).hypot(s2[1] - center[1]);
+            let planar = radius * sweep(s2, e2, center, sense, turns as u32);
+            let length = planar.hypot(end.0[normal] - start.0[normal]);
+            self.emit(sink, Canon::SetFeedRate(f * length));
+        }
+        self.emit(
+            sink,
+            Canon::ArcFeed {
+                first_end: e2[0],
+                second_end: e2[1],
+                first_axis: center[0],
+                second_axis: center[1],
+                rotation: sense.turn(turns),
+                axis_end: end.0[normal],
+                abc: [end.0[3], end.0[4], end.0[5]],
+            },
+        );
+        self.state.pos = end;
+        Ok(())
+    }
+}

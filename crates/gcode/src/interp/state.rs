@@ -1,0 +1,99 @@
+//! The interpreter's modal state and the frames between program and machine coordinates.
+//!
+//! Positions are kept as LinuxCNC keeps them: in program coordinates and the current length
+//! units. The machine position (without tool length) is `g5x + R(p + g92)` where R is the XY
+//! rotation of the active coordinate system (LinuxCNC's `rotate_and_offset_pos`).
+
+use tezgah_geom::{FeedMode, Plane, Pose};
+
+use crate::canon::{ControlMode, SpindleDir, Units};
+
+/// The modal state of a running program.
+#[derive(Debug, Clone)]
+pub struct State {
+    /// Current point, program coordinates, current units (degrees for A B C).
+    pub pos: Pose,
+    pub units: Units,
+    /// `None` while a U V W plane (G17.1 …) is selected.
+    pub plane: Option<Plane>,
+    pub incremental: bool,
+    pub ijk_incremental: bool,
+    pub feed_mode: FeedMode,
+    pub feed_rate: f64,
+    pub speed: f64,
+    pub spindle: Option<SpindleDir>,
+    /// Active motion mode (G code ×10), `None` after G80 or at start.
+    pub motion: Option<u32>,
+    pub control: ControlMode,
+    /// Active coordinate system, 1 (G54) … 9 (G59.3).
+    pub origin_index: usize,
+    /// Its offsets and XY rotation (degrees).
+    pub origin: Pose,
+    pub rotation: f64,
+    /// G92/G52 offsets in force.
+    pub axis_offset: Pose,
+    pub tool_offset: Pose,
+    /// Tool number chosen by the last T word (`None` before any).
+    pub selected_tool: Option<i64>,
+    /// Offsets of the tool in the spindle (LinuxCNC's pocket 0), used by G43 without H.
+    pub spindle_tool_offset: Pose,
+    pub mist: bool,
+    pub flood: bool,
+    pub lathe_diameter: bool,
+}
+
+impl Default for State {
+    fn default() -> Self {
+        State {
+            pos: Pose::ZERO,
+            units: Units::Millimeters,
+            plane: Some(Plane::XY),
+            incremental: false,
+            ijk_incremental: true,
+            feed_mode: FeedMode::UnitsPerMinute,
+            feed_rate: 0.0,
+            speed: 0.0,
+            spindle: None,
+            motion: None,
+            control: ControlMode::Continuous(0.0),
+            origin_index: 1,
+            origin: Pose::ZERO,
+            rotation: 0.0,
+            axis_offset: Pose::ZERO,
+            tool_offset: Pose::ZERO,
+            selected_tool: None,
+            spindle_tool_offset: Pose::ZERO,
+            mist: false,
+            flood: false,
+            lathe_diameter: false,
+        }
+    }
+}
+
+/// Rotate the XY part of `p` by `deg` degrees about the origin.
+pub fn rotate_xy(p: Pose, deg: f64) -> Pose {
+    if deg == 0.0 {
+        return p;
+    }
+    let (s, c) = deg.to_radians().sin_cos();
+    let mut q = p;
+    q.0[0] = p.0[0] * c - p.0[1] * s;
+    q.0[1] = p.0[0] * s + p.0[1] * c;
+    q
+}
+
+impl State {
+    /// Machine position (without tool length) of program point `p`.
+    pub fn to_machine(&self, p: Pose) -> Pose {
+        self.origin + rotate_xy(p + self.axis_offset, self.rotation)
+    }
+
+    /// Program point of machine position `m` (without tool length).
+    pub fn from_machine(&self, m: Pose) -> Pose {
+        rotate_xy(m - self.origin, -self.rotation) - self.axis_offset
+    }
+
+    pub fn inches(&self) -> bool {
+        self.units == Units::Inches
+    }
+}

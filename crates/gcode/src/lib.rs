@@ -1,0 +1,23 @@
+//! tezgah-gcode: RS274/NGC as LinuxCNC speaks it, turned into canonical calls and moves.
+//!
+//! The flow inside this crate is: [`lexer`] (one line, normalised, spans kept) → [`block`]
+//! (words, evaluated with [`reader`]'s expressions and [`params`]) → [`interp`] (modal state,
+//! offsets, units, arcs) → [`canon`] calls, which [`moves`] turns into `tezgah_geom::Move`s for
+//! the planner. Nothing here knows about files or terminals.
+
+pub mod block;
+pub mod canon;
+pub mod codes;
+pub mod error;
+pub mod interp;
+pub mod lexer;
+pub mod params;
+pub mod reader;
+pub mod span;
+pub mod tooltable;
+
+pub use canon::{Canon, CanonSink, Origin, Units};
+pub use error::{ErrorKind, GcodeError};
+pub use interp::{check, Config, Interpreter};
+pub use span::Span;
+pub use tooltable::{Tool, ToolTable, ToolTableError};

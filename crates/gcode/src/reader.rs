@@ -1,0 +1,497 @@
+//! Reading values from a normalised line: numbers, parameters, `[ … ]` expressions and the
+//! unary functions, with LinuxCNC's precedence and its degree-based trigonometry.
+//!
+//! As in LinuxCNC, values are evaluated while the line is read, against the parameter values as
+//! they stood before the line (a block's own assignments take effect after it is read).
+
+use crate::error::ErrorKind;
+use crate::params::Params;
+
+/// Equality tolerance of `EQ`/`NE` (LinuxCNC 2.9 `TOLERANCE_EQUAL`).
+const TOLERANCE_EQUAL: f64 = 1e-6;
+
+/// An error and the index in the normalised text where it was found.
+pub type ReadError = (ErrorKind, usize);
+pub type ReadResult<T> = Result<T, ReadError>;
+
+/// A cursor over one normalised line.
+pub struct Reader<'a> {
+    pub text: &'a [u8],
+    pub pos: usize,
+    pub params: &'a Params,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum BinOp {
+    Power,
+    Times,
+    Divide,
+    Modulo,
+    Plus,
+    Minus,
+    Eq,
+    Ne,
+    Gt,
+    Ge,
+    Lt,
+    Le,
+    And,
+    Or,
+    Xor,
+}
+
+impl BinOp {
+    /// LinuxCNC's precedence: `**` > `* / MOD` > `+ -` > comparisons > logic; all left-assoc.
+    fn precedence(self) -> u8 {
+        use BinOp::*;
+        match self {
+            Power => 6,
+            Times | Divide | Modulo => 5,
+            Plus | Minus => 4,
+            Eq | Ne | Gt | Ge | Lt | Le => 3,
+            And | Or | Xor => 2,
+        }
+    }
+
+    fn apply(self, l: f64, r: f64) -> Result<f64, ErrorKind> {
+        use BinOp::*;
+        let truth = |b: bool| if b { 1.0 } else { 0.0 };
+        Ok(match self {
+            Power => {
+                if l < 0.0 && r.floor() != r {
+                    return Err(ErrorKind::NegativePower);
+                }
+                l.powf(r)
+            }
+            Times => l * r,
+            Divide => {
+                if r == 0.0 {
+                    return Err(ErrorKind::DivisionByZero);
+                }
+                l / r
+            }
+            Modulo => {
+                let m = l % r;
+                if m < 0.0 {
+                    m + r.abs()
+                } else {
+                    m
+                }
+            }
+            Plus => l + r,
+            Minus => l - r,
+            Eq => truth((l - r).abs() < TOLERANCE_EQUAL),
+            Ne => truth((l - r).abs() >= TOLERANCE_EQUAL),
+            Gt => truth(l > r),
+            Ge => truth(l >= r),
+            Lt => truth(l < r),
+            Le => truth(l <= r),
+            And => truth(l != 0.0 && r != 0.0),
+            Or => truth(l != 0.0 || r != 0.0),
+            Xor => truth((l != 0.0) != (r != 0.0)),
+        })
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Unary {
+    Abs,
+    Acos,
+    Asin,
+    Atan,
+    Cos,
+    Exp,
+    Exists,
+    Fix,
+    Fup,
+    Ln,
+    Round,
+    Sin,
+    Sqrt,
+    Tan,
+}
+
+const UNARY_NAMES: [(&[u8], Unary); 14] = [
+    (b"abs", Unary::Abs),
+    (b"acos", Unary::Acos),
+    (b"asin", Unary::Asin),
+    (b"atan", Unary::Atan),
+    (b"cos", Unary::Cos),
+    (b"exp", Unary::Exp),
+    (b"exists", Unary::Exists),
+    (b"fix", Unary::Fix),
+    (b"fup", Unary::Fup),
+    (b"ln", Unary::Ln),
+    (b"round", Unary::Round),
+    (b"sin", Unary::Sin),
+    (b"sqrt", Unary::Sqrt),
+    (b"tan", Unary::Tan),
+];
+
+impl Unary {
+    fn apply(self, x: f64) -> Result<f64, ErrorKind> {
+        use Unary::*;
+        let rad = x.to_radians();
+        Ok(match self {
+            Abs => x.abs(),
+            Acos => {
+                if !(-1.0..=1.0).contains(&x) {
+                    return Err(ErrorKind::AcosOutOfRange);
+                }
+                x.acos().to_degrees()
+            }
+            Asin => {
+                if !(-1.0..=1.0).contains(&x) {
+                    return Err(ErrorKind::AsinOutOfRange);
+                }
+                x.asin().to_degrees()
+            }
+            Cos => rad.cos(),
+            Sin => rad.sin(),
+            Tan => rad.tan(),
+            Exp => x.exp(),
+            Fix => x.floor(),
+            Fup => x.ceil(),
+            Ln => {
+                if x <= 0.0 {
+                    return Err(ErrorKind::LogOfNonPositive);
+                }
+                x.ln()
+            }
+            // C's (int)(x ± 0.5): rounds half away from zero.
+            Round => (x + if x < 0.0 { -0.5 } else { 0.5 }).trunc(),
+            Sqrt => {
+                if x < 0.0 {
+                    return Err(ErrorKind::SqrtOfNegative);
+                }
+                x.sqrt()
+            }
+            Atan | Exists => unreachable!("two-argument and parameter functions are read apart"),
+        })
+    }
+}
+
+/// Where a parameter lives.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParamRef {
+    Numbered(usize),
+    Named(String),
+}
+
+impl<'a> Reader<'a> {
+    pub fn new(text: &'a [u8], pos: usize, params: &'a Params) -> Self {
+        Reader { text, pos, params }
+    }
+
+    fn peek(&self) -> Option<u8> {
+        self.text.get(self.pos).copied()
+    }
+
+    fn err<T>(&self, kind: ErrorKind) -> ReadResult<T> {
+        Err((kind, self.pos))
+    }
+
+    /// A real value: a number, a parameter, a bracketed expression, a unary function, or one of
+    /// these after a sign.
+    pub fn real_value(&mut self) -> ReadResult<f64> {
+        match self.peek() {
+            None => self.err(ErrorKind::NoCharactersInRealValue),
+            Some(b'[') => self.expression(),
+            Some(b'#') => self.parameter_value(),
+            Some(c @ (b'+' | b'-'))
+                if !matches!(self.text.get(self.pos + 1), Some(b'0'..=b'9' | b'.')) =>
+            {
+                self.pos += 1;
+                let v = self.real_value()?;
+                Ok(if c == b'-' { -v } else { v })
+            }
+            Some(b'a'..=b'z') => self.unary(),
+            Some(_) => self.number(),
+        }
+    }
+
+    /// A value that must be an integer (within 1e-4), rounded to it.
+    pub fn integer_value(&mut self) -> ReadResult<i64> {
+        let start = self.pos;
+        let v = self.real_value()?;
+        integer_of(v).ok_or((ErrorKind::NonIntegerValue, start))
+    }
+
+    /// A literal number: signs, then digits and dots, read exactly as C++ streams read them.
+    pub fn number(&mut self) -> ReadResult<f64> {
+        let start = self.pos;
+        let t = self.text;
+        let mut i = start;
+        while i < t.len() && matches!(t[i], b'+' | b'-') {
+            i += 1;
+        }
+        let signs = i - start;
+        let mut first_extra_dot = None;
+        let mut dots = 0;
+        let mut digits = 0;
+        while i < t.len() && matches!(t[i], b'0'..=b'9' | b'.') {
+            if t[i] == b'.' {
+                dots += 1;
+                if dots == 2 {
+                    first_extra_dot = Some(i);
+                }
+            } else if first_extra_dot.is_none() {
+                digits += 1;
+            }
+            i += 1;
+        }
+        let whole = String::from_utf8_lossy(&t[start..i]).into_owned();
+        if signs > 1 || digits == 0 {
+            return Err((ErrorKind::BadNumberFormat(whole), start));
+        }
+        if first_extra_dot.is_some() {
+            return Err((ErrorKind::TrailingCharacters(whole), start));
+        }
+        // The slice holds ASCII signs, digits and at most one dot, with a digit: valid UTF-8 and
+        // valid for Rust's correctly rounded float parser (the same grammar as C's strtod here).
+        let v: f64 = std::str::from_utf8(&t[start..i])
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .ok_or((ErrorKind::BadNumberFormat(whole), start))?;
+        let end = i;
+        self.pos = end;
+        Ok(v)
+    }
+
+    /// `#n`, `##n`, `#[expr]` or `#<name>`: the parameter's value.
+    fn parameter_value(&mut self) -> ReadResult<f64> {
+        let at = self.pos;
+        match self.parameter_ref()? {
+            ParamRef::Numbered(n) => Ok(self.params.get(n)),
+            ParamRef::Named(name) => match self.params.named(&name) {
+                Some(v) => Ok(v),
+                None => Err((ErrorKind::NamedParameterNotDefined(name), at)),
+            },
+        }
+    }
+
+    /// Read `#…` and say which parameter it names (used for reads and for assignments).
+    pub fn parameter_ref(&mut self) -> ReadResult<ParamRef> {
+        debug_assert_eq!(self.peek(), Some(b'#'));
+        self.pos += 1;
+        if self.peek() == Some(b'<') {
+            return self.named_parameter().map(ParamRef::Named);
+        }
+        let at = self.pos;
+        let n = self.integer_value()?;
+        if !Params::in_range(n) {
+            return Err((ErrorKind::ParameterOutOfRange, at));
+        }
+        Ok(ParamRef::Numbered(n as usize))
+    }
+
+    /// `<name>` after `#`; returns the name (already lower case, blanks removed).
+    fn named_parameter(&mut self) -> ReadResult<String> {
+        let start = self.pos + 1;
+        let t = self.text;
+        let mut i = start;
+        while i < t.len() && t[i] != b'>' {
+            i += 1;
+        }
+        if i >= t.len() {
+            return Err((ErrorKind::NamedParameterNotTerminated, self.pos));
+        }
+        let name = String::from_utf8_lossy(&t[start..i]).into_owned();
+        self.pos = i + 1;
+        Ok(name)
+    }
+
+    /// `[ value { op value } ]`, evaluated by precedence climbing.
+    pub fn expression(&mut self) -> ReadResult<f64> {
+        debug_assert_eq!(self.peek(), Some(b'['));
+        self.pos += 1;
+        let v = self.binary(1)?;
+        match self.peek() {
+            Some(b']') => {
+                self.pos += 1;
+                Ok(v)
+            }
+            None => self.err(ErrorKind::UnclosedExpression),
+            Some(_) => self.err(ErrorKind::UnknownOperation),
+        }
+    }
+
+    /// Left-associative precedence climbing over operators binding at least `min`.
+    fn binary(&mut self, min: u8) -> ReadResult<f64> {
+        let mut left = self.real_value()?;
+        loop {
+            let save = self.pos;
+            let Some(op) = self.operator()? else {
+                return Ok(left);
+            };
+            if op.precedence() < min {
+                self.pos = save;
+                return Ok(left);
+            }
+            let at = save;
+            let right = self.binary(op.precedence() + 1)?;
+            left = op.apply(left, right).map_err(|k| (k, at))?;
+        }
+    }
+
+    /// The binary operator at the cursor, or `None` at a closing bracket.
+    fn operator(&mut self) -> ReadResult<Option<BinOp>> {
+        let t = &self.text[self.pos..];
+        let (op, len) = match t {
+            [] => return self.err(ErrorKind::UnclosedExpression),
+            [b']', ..] => return Ok(None),
+            [b'*', b'*', ..] => (BinOp::Power, 2),
+            [b'*', ..] => (BinOp::Times, 1),
+            [b'/', ..] => (BinOp::Divide, 1),
+            [b'+', ..] => (BinOp::Plus, 1),
+            [b'-', ..] => (BinOp::Minus, 1),
+            [b'm', b'o', b'd', ..] => (BinOp::Modulo, 3),
+            [b'a', b'n', b'd', ..] => (BinOp::And, 3),
+            [b'x', b'o', b'r', ..] => (BinOp::Xor, 3),
+            [b'o', b'r', ..] => (BinOp::Or, 2),
+            [b'e', b'q', ..] => (BinOp::Eq, 2),
+            [b'n', b'e', ..] => (BinOp::Ne, 2),
+            [b'g', b't', ..] => (BinOp::Gt, 2),
+            [b'g', b'e', ..] => (BinOp::Ge, 2),
+            [b'l', b't', ..] => (BinOp::Lt, 2),
+            [b'l', b'e', ..] => (BinOp::Le, 2),
+            [c @ (b'm' | b'a' | b'x' | b'o' | b'e' | b'n' | b'g' | b'l'), ..] => {
+                return self.err(ErrorKind::UnknownOperationName(
+                    c.to_ascii_uppercase() as char
+                ))
+            }
+            _ => return self.err(ErrorKind::UnknownOperation),
+        };
+        self.pos += len;
+        Ok(Some(op))
+    }
+
+    /// A unary function: `name[expr]`, `atan[y]/[x]` or `exists[#param]`.
+    fn unary(&mut self) -> ReadResult<f64> {
+        let at = self.pos;
+        let rest = &self.text[self.pos..];
+        let Some(&(name, op)) = UNARY_NAMES
+            .iter()
+            .filter(|(name, _)| rest.starts_with(name))
+            .max_by_key(|(name, _)| name.len())
+        else {
+            return self.err(ErrorKind::UnknownWord(rest[0] as char));
+        };
+        self.pos += name.len();
+        if self.peek() != Some(b'[') {
+            return self.err(ErrorKind::UnaryMissingBracket);
+        }
+        match op {
+            Unary::Exists => self.exists(),
+            Unary::Atan => {
+                let y = self.expression()?;
+                if self.peek() != Some(b'/') {
+                    return self.err(ErrorKind::AtanMissingSlash);
+                }
+                self.pos += 1;
+                if self.peek() != Some(b'[') {
+                    return self.err(ErrorKind::AtanMissingBracket);
+                }
+                let x = self.expression()?;
+                Ok(y.atan2(x).to_degrees())
+            }
+            _ => {
+                let x = self.expression()?;
+                op.apply(x).map_err(|k| (k, at))
+            }
+        }
+    }
+
+    /// `exists[#<name>]`: 1 if the named parameter is defined (numbered ones always exist).
+    fn exists(&mut self) -> ReadResult<f64> {
+        self.pos += 1; // '['
+        if self.peek() != Some(b'#') {
+            return self.err(ErrorKind::ExpectedHash);
+        }
+        let found = match self.parameter_ref()? {
+            ParamRef::Numbered(_) => true,
+            ParamRef::Named(name) => self.params.named(&name).is_some(),
+        };
+        if self.peek() != Some(b']') {
+            return self.err(ErrorKind::ExpectedCloseBracket);
+        }
+        self.pos += 1;
+        Ok(if found { 1.0 } else { 0.0 })
+    }
+}
+
+/// The integer `v` stands for, if it is within 1e-4 of one (LinuxCNC's `read_integer_value`).
+pub fn integer_of(v: f64) -> Option<i64> {
+    let r = v.round();
+    ((v - r).abs() < 1e-4 && r.abs() < 9.0e15).then_some(r as i64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn eval(s: &str) -> ReadResult<f64> {
+        let p = Params::default();
+        let mut r = Reader::new(s.as_bytes(), 0, &p);
+        r.real_value()
+    }
+
+    #[test]
+    fn numbers_read_exactly() {
+        assert_eq!(eval("95."), Ok(95.0));
+        assert_eq!(eval("-.5"), Ok(-0.5));
+        assert_eq!(eval("+3"), Ok(3.0));
+        assert_eq!(eval("0.1"), Ok(0.1));
+        assert_eq!(eval("."), Err((ErrorKind::BadNumberFormat(".".into()), 0)));
+        assert_eq!(
+            eval("1.2.3"),
+            Err((ErrorKind::TrailingCharacters("1.2.3".into()), 0))
+        );
+        assert_eq!(
+            eval("-."),
+            Err((ErrorKind::BadNumberFormat("-.".into()), 0))
+        );
+    }
+
+    #[test]
+    fn precedence_and_associativity() {
+        assert_eq!(eval("[1+2*3]"), Ok(7.0));
+        assert_eq!(eval("[2**3**2]"), Ok(64.0));
+        assert_eq!(eval("[10-4-3]"), Ok(3.0));
+        assert_eq!(eval("[1+2eq3]"), Ok(1.0));
+        assert_eq!(eval("[1lt2and3gt4]"), Ok(0.0));
+        assert_eq!(eval("[-7mod3]"), Ok(2.0));
+        assert_eq!(eval("[2*[3+4]]"), Ok(14.0));
+    }
+
+    #[test]
+    fn functions_in_degrees() {
+        assert!((eval("sin[30]").unwrap() - 0.5).abs() < 1e-15);
+        assert!((eval("atan[1]/[1]").unwrap() - 45.0).abs() < 1e-12);
+        assert_eq!(eval("sqrt[16]"), Ok(4.0));
+        assert_eq!(eval("round[-2.5]"), Ok(-3.0));
+        assert_eq!(eval("fix[-2.5]"), Ok(-3.0));
+        assert_eq!(eval("fup[2.1]"), Ok(3.0));
+        assert_eq!(eval("-sqrt[4]"), Ok(-2.0));
+        assert_eq!(eval("sqrt[-1]").unwrap_err().0, ErrorKind::SqrtOfNegative);
+        assert_eq!(eval("[1/0]").unwrap_err().0, ErrorKind::DivisionByZero);
+    }
+
+    #[test]
+    fn exists_errors_match_linuxcnc() {
+        assert_eq!(eval("exists[1]").unwrap_err().0, ErrorKind::ExpectedHash);
+        assert_eq!(
+            eval("exists[#1+#2]").unwrap_err().0,
+            ErrorKind::ExpectedCloseBracket
+        );
+        assert_eq!(
+            eval("exists[#<foo]").unwrap_err().0,
+            ErrorKind::NamedParameterNotTerminated
+        );
+        assert_eq!(
+            eval("exists[#foo]").unwrap_err().0,
+            ErrorKind::UnknownWord('f')
+        );
+        assert_eq!(eval("exists[#<foo>]"), Ok(0.0));
+    }
+}

@@ -1,0 +1,121 @@
+//! The typed moves that flow from any program source (G-code, CAM, MDI) into path planning.
+//!
+//! Positions are absolute, in mm and degrees, in the workpiece frame seen by the machine (work
+//! offsets and tool length already applied). Each move carries the 1-based source line it came
+//! from so that samples, reports and errors can point back at the program.
+
+use crate::pose::Pose;
+
+/// The plane of an arc: G17 (XY), G18 (ZX) or G19 (YZ).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Plane {
+    #[default]
+    XY,
+    ZX,
+    YZ,
+}
+
+impl Plane {
+    /// Indices of (first in-plane axis, second in-plane axis, normal axis), ordered so that a
+    /// positive rotation from first to second is counter-clockwise seen from the normal's + side.
+    pub const fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Plane::XY => (0, 1, 2),
+            Plane::ZX => (2, 0, 1),
+            Plane::YZ => (1, 2, 0),
+        }
+    }
+}
+
+/// Sense and number of turns of an arc: `+n` counter-clockwise, `-n` clockwise, as LinuxCNC's
+/// `ARC_FEED` rotation argument (1 = less than one full turn, 2 = one extra full turn, …).
+pub type Turn = i32;
+
+/// A circular or helical feed move.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ArcMove {
+    pub plane: Plane,
+    /// End of the move (all six axes).
+    pub end: Pose,
+    /// Centre in the two in-plane coordinates (first, second axis of `plane`).
+    pub center: [f64; 2],
+    pub turn: Turn,
+}
+
+/// What a move does.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MoveKind {
+    /// G0: straight line at the machine's rapid speed.
+    Rapid { end: Pose },
+    /// G1: straight line at the programmed feed.
+    Feed { end: Pose },
+    /// G2/G3: arc or helix at the programmed feed.
+    Arc(ArcMove),
+    /// G4: wait, motion stopped.
+    Dwell { seconds: f64 },
+    /// The feed in force from here on, mm/min (or 1/min in inverse time, mm/rev with G95).
+    FeedRate { value: f64 },
+    /// G93/G94/G95.
+    FeedMode(FeedMode),
+    /// G61 / G61.1 / G64 P Q.
+    PathMode(PathMode),
+    /// M0/M1/M60 pauses and M2/M30 program end.
+    Stop(StopKind),
+}
+
+/// Feed-rate interpretation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FeedMode {
+    /// G93: F is the inverse of the move's duration in minutes.
+    InverseTime,
+    /// G94: F in length units per minute.
+    #[default]
+    UnitsPerMinute,
+    /// G95: F in length units per spindle revolution.
+    UnitsPerRevolution,
+}
+
+/// Path-control (tolerance) mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PathMode {
+    /// G61.1: stop exactly at the end of every block.
+    ExactStop,
+    /// G61: follow the programmed path exactly; corners are passed at zero speed.
+    ExactPath,
+    /// G64 [P tolerance] [Q naive-CAM tolerance]: blend within the tolerance (mm); `None` means
+    /// "as fast as possible" (the machine file's tolerance applies).
+    Continuous {
+        tolerance: Option<f64>,
+        naive_cam: Option<f64>,
+    },
+}
+
+impl Default for PathMode {
+    /// LinuxCNC starts in G64 without P: blend as fast as possible.
+    fn default() -> Self {
+        PathMode::Continuous {
+            tolerance: None,
+            naive_cam: None,
+        }
+    }
+}
+
+/// Program stops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopKind {
+    /// M0.
+    Pause,
+    /// M1, honoured only when optional stop is on.
+    OptionalPause,
+    /// M60 pallet change pause.
+    PalletPause,
+    /// M2 or M30.
+    End,
+}
+
+/// One move with the source line it came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Move {
+    pub line: u32,
+    pub kind: MoveKind,
+}
