@@ -79,6 +79,8 @@ pub enum Canon {
     Dwell(f64),
     Comment(String),
     Message(String),
+    /// `(PRINT,…)`: text for the operator's console, printed bare by `rs274`.
+    Print(String),
     SelectTool(i64),
     StartChange,
     /// Load the tool of the given pocket (LinuxCNC's pocket = 1-based row of the tool table).
@@ -180,6 +182,7 @@ impl fmt::Display for Canon {
             Dwell(s) => write!(f, "DWELL({s:.4})"),
             Comment(s) => write!(f, "COMMENT(\"{s}\")"),
             Message(s) => write!(f, "MESSAGE(\"{s}\")"),
+            Print(s) => f.write_str(s),
             SelectTool(t) => write!(f, "SELECT_TOOL({t})"),
             StartChange => f.write_str("START_CHANGE()"),
             ChangeTool(p) => write!(f, "CHANGE_TOOL({p})"),

@@ -30,7 +30,9 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
     let at_g = |group: usize| block.g[group].map_or(0, |c| c.at);
     let mode0 = block.g(ggroup::NON_MODAL);
     let axes = block.has_axis_words();
-    let covets_axes = matches!(mode0, Some(100 | 280 | 300 | 520 | 920));
+    // Codes whose axis words are data, not a move (G43.1 takes its offsets from them too).
+    let covets_axes = matches!(mode0, Some(100 | 280 | 300 | 520 | 920))
+        || block.g(ggroup::TOOL_LENGTH) == Some(431);
     let motion = match block.g(ggroup::MOTION) {
         Some(800) => {
             if axes && !covets_axes {

@@ -10,7 +10,7 @@ use crate::codes::{g_name, ggroup, mgroup};
 use crate::error::{ErrorKind, GcodeError};
 use crate::params::{self, coord_system_base};
 
-use super::checks;
+use super::{checks, state};
 use super::{Flow, Interpreter, LineRef};
 
 /// An execution error and the byte offset in the line of the word it concerns.
@@ -194,6 +194,9 @@ impl Interpreter {
         } else if lower.starts_with("debug,") {
             let expanded = self.substitute_parameters(&text[6..]);
             self.emit(sink, Canon::Message(expanded));
+        } else if lower.starts_with("print,") {
+            let expanded = self.substitute_parameters(&text[6..]);
+            self.emit(sink, Canon::Print(expanded));
         } else {
             self.emit(sink, Canon::Comment(text.to_string()));
         }
@@ -433,14 +436,27 @@ impl Interpreter {
         if let Some(r) = block.get(b'r') {
             rotation = r;
         }
-        for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-            if let Some(v) = block.get(letter) {
-                offset.0[i] = if l20 {
-                    // The current point is to become v: offset = machine − (v + G92).
-                    machine.0[i] - (v + self.state.axis_offset.0[i])
-                } else {
-                    v
-                };
+        if l20 {
+            // The offsets that make the current point read as the given coordinates, solved
+            // in the target system's rotated frame: offset = machine − R(target + G92).
+            let mut target = self.state.pos;
+            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+                if let Some(v) = block.get(letter) {
+                    target.0[i] = v;
+                }
+            }
+            let solved = machine - state::rotate_xy(target + self.state.axis_offset, rotation);
+            let xy = block.has(b'x') || block.has(b'y');
+            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+                if block.has(letter) || (xy && i < 2) {
+                    offset.0[i] = solved.0[i];
+                }
+            }
+        } else {
+            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
+                if let Some(v) = block.get(letter) {
+                    offset.0[i] = v;
+                }
             }
         }
         self.params.set6(base, offset.0);

@@ -12,7 +12,7 @@ mod motion;
 mod state;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
-pub use state::State;
+pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
 
@@ -179,6 +179,9 @@ impl Interpreter {
             }
             return Ok(flow);
         }
+        // Programs read the current point from #5420…#5425 (program coordinates).
+        self.params
+            .set6(crate::params::CURRENT_POSITION, self.state.pos.0);
         let Self {
             norm,
             block,

@@ -1,0 +1,197 @@
+//! From canonical calls to the typed moves the planner consumes (LinuxCNC's `emccanon` layer).
+//!
+//! Canonical calls speak program coordinates in program units and announce offsets apart;
+//! moves are absolute, in mm and degrees, with work offsets, G92/G52, XY rotation and tool
+//! length applied (`machine = g5x + R(p + g92) + tool`). Inverse-time feeds already arrive as
+//! a rate per move, so the planner sees one feed unit: mm/min (or mm/rev under G95).
+
+use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, StopKind};
+
+use crate::canon::{Canon, CanonSink, ControlMode, Origin, Units};
+use crate::interp::state_rotate_xy as rotate_xy;
+
+/// A [`CanonSink`] that turns calls into [`Move`]s and hands them to `out`.
+#[derive(Debug)]
+pub struct MoveBuilder<F: FnMut(Move)> {
+    out: F,
+    units: Units,
+    plane: Plane,
+    g5x: Pose,
+    g92: Pose,
+    rotation: f64,
+    tool: Pose,
+    naive_cam: Option<f64>,
+}
+
+impl<F: FnMut(Move)> MoveBuilder<F> {
+    pub fn new(out: F) -> Self {
+        MoveBuilder {
+            out,
+            units: Units::Millimeters,
+            plane: Plane::XY,
+            g5x: Pose::ZERO,
+            g92: Pose::ZERO,
+            rotation: 0.0,
+            tool: Pose::ZERO,
+            naive_cam: None,
+        }
+    }
+
+    /// Machine position in mm of program point `p` (program units).
+    fn machine(&self, p: Pose) -> Pose {
+        (self.g5x + rotate_xy(p + self.g92, self.rotation) + self.tool)
+            .scale_linear(self.units.mm())
+    }
+
+    fn push(&mut self, line: u32, kind: MoveKind) {
+        (self.out)(Move { line, kind });
+    }
+}
+
+impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
+    fn call(&mut self, origin: Origin, call: Canon) {
+        let line = origin.line;
+        match call {
+            Canon::UseLengthUnits(u) => self.units = u,
+            Canon::SetG5xOffset { offset, .. } => self.g5x = offset,
+            Canon::SetG92Offset(p) => self.g92 = p,
+            Canon::SetXyRotation(r) => self.rotation = r,
+            Canon::UseToolLengthOffset(p) => self.tool = p,
+            Canon::SelectPlane(p) => self.plane = p.unwrap_or(self.plane),
+            Canon::StraightTraverse(p) => {
+                let end = self.machine(p);
+                self.push(line, MoveKind::Rapid { end });
+            }
+            Canon::StraightFeed(p) => {
+                let end = self.machine(p);
+                self.push(line, MoveKind::Feed { end });
+            }
+            Canon::ArcFeed {
+                first_end,
+                second_end,
+                first_axis,
+                second_axis,
+                rotation,
+                axis_end,
+                abc,
+            } => {
+                let (i, j, k) = self.plane.axes();
+                let mut end = Pose([0.0, 0.0, 0.0, abc[0], abc[1], abc[2]]);
+                end.0[i] = first_end;
+                end.0[j] = second_end;
+                end.0[k] = axis_end;
+                let mut center = end;
+                center.0[i] = first_axis;
+                center.0[j] = second_axis;
+                let (end, center) = (self.machine(end), self.machine(center));
+                self.push(
+                    line,
+                    MoveKind::Arc(ArcMove {
+                        plane: self.plane,
+                        end,
+                        center: [center.0[i], center.0[j]],
+                        turn: rotation,
+                    }),
+                );
+            }
+            Canon::Dwell(seconds) => self.push(line, MoveKind::Dwell { seconds }),
+            Canon::SetFeedRate(f) => {
+                let value = f * self.units.mm();
+                self.push(line, MoveKind::FeedRate { value });
+            }
+            Canon::SetFeedMode(m) => {
+                let mode = if m == 1 {
+                    FeedMode::UnitsPerRevolution
+                } else {
+                    FeedMode::UnitsPerMinute
+                };
+                self.push(line, MoveKind::FeedMode(mode));
+            }
+            Canon::SetNaivecamTolerance(q) => self.naive_cam = Some(q * self.units.mm()),
+            Canon::SetMotionControlMode(m) => {
+                let mode = match m {
+                    ControlMode::ExactStop => PathMode::ExactStop,
+                    ControlMode::ExactPath => PathMode::ExactPath,
+                    ControlMode::Continuous(p) => PathMode::Continuous {
+                        tolerance: (p > 0.0).then(|| p * self.units.mm()),
+                        naive_cam: None,
+                    },
+                };
+                self.push(line, MoveKind::PathMode(mode));
+            }
+            Canon::ProgramStop => self.push(line, MoveKind::Stop(StopKind::Pause)),
+            Canon::OptionalProgramStop => self.push(line, MoveKind::Stop(StopKind::OptionalPause)),
+            Canon::PalletShuttle => self.push(line, MoveKind::Stop(StopKind::PalletPause)),
+            Canon::ProgramEnd | Canon::Finish => self.push(line, MoveKind::Stop(StopKind::End)),
+            _ => {}
+        }
+    }
+}
+
+/// Interpret a whole program into moves (stops at the first error).
+pub fn program_moves(program: &str, cfg: crate::Config) -> Result<Vec<Move>, crate::GcodeError> {
+    let mut moves = Vec::new();
+    let mut builder = MoveBuilder::new(|m| moves.push(m));
+    crate::Interpreter::new(cfg).run(program, &mut builder)?;
+    Ok(moves)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Config;
+
+    fn moves(program: &str) -> Vec<Move> {
+        program_moves(program, Config::default()).unwrap()
+    }
+
+    #[test]
+    fn offsets_units_and_lines_reach_the_moves() {
+        let m = moves("G20\nG10 L2 P1 X1\nG92 X0\nG0 X1 Y2\nG1 X2 F10\nM2\n");
+        let rapid = m
+            .iter()
+            .find(|m| matches!(m.kind, MoveKind::Rapid { .. }))
+            .unwrap();
+        assert_eq!(rapid.line, 4);
+        let MoveKind::Rapid { end } = rapid.kind else {
+            unreachable!()
+        };
+        // G54 X1 puts the start at X-1; G92 X0 there makes g92 = -1; program X1 is then
+        // machine 1 + (1 - 1) = 1 in = 25.4 mm.
+        assert!((end.x() - 25.4).abs() < 1e-9, "{end:?}");
+        assert!((end.y() - 50.8).abs() < 1e-9);
+        let feed = m.iter().find_map(|m| match m.kind {
+            MoveKind::FeedRate { value } if value > 0.0 => Some(value),
+            _ => None,
+        });
+        assert_eq!(feed, Some(254.0));
+    }
+
+    #[test]
+    fn arcs_keep_plane_and_centre() {
+        let m = moves("G18 G2 X10 Z0 I5 K0 F100\nM2\n");
+        let arc = m.iter().find_map(|m| match m.kind {
+            MoveKind::Arc(a) => Some(a),
+            _ => None,
+        });
+        let arc = arc.unwrap();
+        assert_eq!(arc.plane, Plane::ZX);
+        assert_eq!(arc.center, [0.0, 5.0]); // (Z, X)
+        assert_eq!(arc.end.x(), 10.0);
+        assert_eq!(arc.turn, -1);
+    }
+
+    #[test]
+    fn tool_length_is_added() {
+        let m = moves("G43.1 Z5\nG0 Z0\nM2\n");
+        let MoveKind::Rapid { end } = m
+            .iter()
+            .find(|m| matches!(m.kind, MoveKind::Rapid { .. }))
+            .unwrap()
+            .kind
+        else {
+            unreachable!()
+        };
+        assert_eq!(end.z(), 5.0);
+    }
+}

@@ -1,0 +1,303 @@
+//! LinuxCNC's own interpreter tests (`tests/interp` of LinuxCNC), run through tezgah.
+//!
+//! The test data is not in this repository (it is GPL-2 test data): it is read at test time
+//! from `$TEZGAH_LINUXCNC_INTERP`, or from `../shared/data/linuxcnc-interp` beside the
+//! repository. Motion calls (and the feed rate in force) must equal LinuxCNC's expected output
+//! within 1e-4; every `bad/` program in scope must fail with LinuxCNC's exact error text.
+//! The lists below say which tests run and why the others do not yet.
+
+use std::path::{Path, PathBuf};
+
+use tezgah_gcode::{Canon, Config, Interpreter, Origin, ToolTable};
+
+/// A folder test: its program, tool table, and whether `expected` keeps rs274's counter field
+/// (LinuxCNC's script for the folder does or does not strip it with awk).
+struct Run {
+    folder: &'static str,
+    program: &'static str,
+    table: Option<&'static str>,
+    counter: bool,
+}
+
+const fn run(folder: &'static str, program: &'static str) -> Run {
+    Run {
+        folder,
+        program,
+        table: None,
+        counter: false,
+    }
+}
+
+/// Folders whose `expected` output this interpreter reproduces call for call.
+const RUNS: &[Run] = &[
+    run("fractional-linenumbers", "test.ngc"),
+    run("g6164", "test.ngc"),
+    run("unit-conversion", "test.ngc"),
+    run("namedparam-bug424", "test.ngc"),
+    run("g10/g10-l2-while-active", "test.ngc"),
+    run("g10/g10-l20-while-active", "test.ngc"),
+    Run {
+        table: Some("test.tbl"),
+        ..run("g10/g10-with-g92", "test.ngc")
+    },
+    Run {
+        counter: true,
+        ..run("g52/g52-g92-interaction", "g52-g92-interaction.ngc")
+    },
+    Run {
+        counter: true,
+        ..run("rotation/g28", "g28.ngc")
+    },
+    Run {
+        counter: true,
+        ..run("rotation/g53", "g53.ngc")
+    },
+];
+
+/// Folders that need the full-dialect issue or are out of scope, with the reason.
+#[allow(dead_code)]
+const FOLDERS_NOT_YET: &[(&str, &str)] = &[
+    ("abort-hot-comment", "INI parameters (-i test.ini)"),
+    ("cam-nisley", "cutter compensation G41/G42"),
+    ("crazy-paths", "O-words, cutter compensation"),
+    ("do-while-break", "O-words"),
+    ("exists", "O-words"),
+    ("flowsnake", "O-words"),
+    ("g10/g10-l1-l10", "G10 L1/L10 tool table writes"),
+    ("g10/g10-l11", "G10 L11 tool table writes"),
+    ("g33.1", "spindle-synchronised motion, out of scope"),
+    ("g52/g92-offset-persistence", "parameter files (-v), INI"),
+    ("g64-r-planner", "G64 R of LinuxCNC master, not in 2.9"),
+    ("g71-*, g72-*, g76", "lathe cycles, out of scope"),
+    ("g81/*", "canned cycles"),
+    ("g84/*", "canned cycles"),
+    ("inside-corners", "O-words, cutter compensation"),
+    ("inverse-time-with-comp", "cutter compensation"),
+    ("iniparam, iniparam-failassign", "INI parameters"),
+    ("m19", "spindle orientation"),
+    ("m98m99/*", "Fanuc M98/M99 subprograms"),
+    ("machine-coord-params", "O-words"),
+    ("magic_comments", "parameter formatting comments"),
+    ("mdi-oword-m66", "MDI and M66, no expected file"),
+    (
+        "nested-sub-error, nested-sub-in-file-error",
+        "O-word subroutines",
+    ),
+    ("oword-*", "O-words"),
+    (
+        "plug, pymove, python, python-self",
+        "Python plug-ins, out of scope",
+    ),
+    ("return-value, value-returned", "O-word return values"),
+    ("rotation/abs-pts", "O-words"),
+    ("sequence-number", "INI, O-words"),
+    (
+        "sub-call-from-sub, subroutine-return, subs-follow-main",
+        "O-word subroutines",
+    ),
+];
+
+/// `bad/` programs that need the full-dialect issue (canned cycles, cutter compensation,
+/// O-words, M19), with the feature they need.
+const BAD_NOT_YET: &[(&str, &str)] = &[
+    ("a-in-canned-cycle.ngc", "canned cycles"),
+    ("ccomp-arcexit.ngc", "cutter compensation"),
+    ("ccomp-gouging.ngc", "cutter compensation"),
+    ("g64-m19-r-ambiguous.ngc", "M19 spindle orientation"),
+    ("nested.ngc", "O-word subroutines"),
+    ("probe-no-axes.ngc", "probing (G38.x) is out of scope"),
+];
+
+fn data_dir() -> Option<PathBuf> {
+    let candidates = [
+        std::env::var_os("TEZGAH_LINUXCNC_INTERP").map(PathBuf::from),
+        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/linuxcnc-interp")),
+        Some(PathBuf::from("/work/shared/data/linuxcnc-interp")),
+    ];
+    candidates
+        .into_iter()
+        .flatten()
+        .find(|p| p.join("good").is_dir())
+}
+
+/// Skip (loudly) when the data is absent, unless the environment demands it.
+fn data_or_skip() -> Option<PathBuf> {
+    let dir = data_dir();
+    if dir.is_none() {
+        assert!(
+            std::env::var_os("TEZGAH_REQUIRE_LINUXCNC_DATA").is_none(),
+            "LinuxCNC test data not found: set TEZGAH_LINUXCNC_INTERP"
+        );
+        eprintln!("LinuxCNC interpreter tests skipped: data not found");
+    }
+    dir
+}
+
+fn config(table: Option<&Path>) -> Config {
+    let table = table.map_or_else(ToolTable::default, |p| {
+        ToolTable::parse(&std::fs::read_to_string(p).unwrap()).unwrap()
+    });
+    Config::linuxcnc(table)
+}
+
+/// Our calls for a program, one string per call, as `rs274` prints them after its two fields.
+fn our_calls(program: &str, cfg: Config) -> (Vec<String>, Result<(), tezgah_gcode::GcodeError>) {
+    let mut calls: Vec<(Origin, Canon)> = Vec::new();
+    let result = Interpreter::new(cfg).run(program, &mut calls);
+    let mut out: Vec<String> = calls.iter().map(|(_, c)| c.to_string()).collect();
+    out.push("ON_RESET()".into());
+    out.push("ON_RESET()".into());
+    (out, result)
+}
+
+/// Expected lines without rs274's counter and `N…` fields. Lines without them (the bare text
+/// of `(PRINT,…)`) are kept whole.
+fn expected_calls(text: &str, has_counter: bool) -> Vec<String> {
+    text.lines()
+        .filter_map(|l| {
+            let mut rest = l.trim_start();
+            if has_counter {
+                let digits =
+                    rest.len() - rest.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+                if digits == 0 {
+                    return Some(l.to_string());
+                }
+                rest = rest[digits..].trim_start();
+            }
+            if !rest.starts_with('N') {
+                return Some(rest.to_string());
+            }
+            // The N field: `N.....` or `N` and digits, padded; `N1234567STRAIGHT_…` is glued.
+            let call = rest[1..]
+                .trim_start_matches(['.', '0', '1', '2', '3', '4', '5', '6', '7', '8', '9']);
+            let call = call.trim_start();
+            (!call.is_empty()).then(|| call.to_string())
+        })
+        .collect()
+}
+
+const MOTION: [&str; 5] = [
+    "STRAIGHT_TRAVERSE(",
+    "STRAIGHT_FEED(",
+    "ARC_FEED(",
+    "DWELL(",
+    "SET_FEED_RATE(",
+];
+
+fn is_motion(call: &str) -> bool {
+    MOTION.iter().any(|m| call.starts_with(m))
+}
+
+fn numbers(call: &str) -> Vec<f64> {
+    call.split(|c: char| c == '(' || c == ')' || c == ',' || c == ' ')
+        .filter_map(|t| t.parse().ok())
+        .collect()
+}
+
+/// Compare the motion calls of two call lists numerically; `Err` describes the first mismatch.
+fn compare_motion(ours: &[String], theirs: &[String]) -> Result<usize, String> {
+    let a: Vec<&String> = ours.iter().filter(|c| is_motion(c)).collect();
+    let b: Vec<&String> = theirs.iter().filter(|c| is_motion(c)).collect();
+    for (i, (x, y)) in a.iter().zip(&b).enumerate() {
+        let name = |s: &str| s.split('(').next().unwrap_or("").to_string();
+        let (nx, ny) = (numbers(x), numbers(y));
+        let close = nx.len() == ny.len()
+            && nx
+                .iter()
+                .zip(&ny)
+                .all(|(p, q)| (p - q).abs() <= 1e-4 + 1e-9 * q.abs());
+        if name(x) != name(y) || !close {
+            return Err(format!("motion call {i}: ours {x} / LinuxCNC {y}"));
+        }
+    }
+    if a.len() != b.len() {
+        return Err(format!("{} motion calls, LinuxCNC {}", a.len(), b.len()));
+    }
+    Ok(a.len())
+}
+
+#[test]
+fn good_programs_match_linuxcnc() {
+    let Some(dir) = data_or_skip() else { return };
+    let mut checked = 0;
+    for entry in std::fs::read_dir(dir.join("good")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "ngc") {
+            continue;
+        }
+        let program = std::fs::read_to_string(&path).unwrap();
+        let expected = std::fs::read_to_string(path.with_extension("ngc.expected")).unwrap();
+        let (ours, result) = our_calls(&program, config(None));
+        assert!(result.is_ok(), "{}: {result:?}", path.display());
+        let theirs = expected_calls(&expected, true);
+        assert_eq!(ours, theirs, "{}", path.display());
+        checked += 1;
+    }
+    assert_eq!(checked, 6);
+}
+
+#[test]
+fn bad_programs_fail_with_linuxcnc_text() {
+    let Some(dir) = data_or_skip() else { return };
+    let (mut checked, mut total) = (0, 0);
+    for entry in std::fs::read_dir(dir.join("bad")).unwrap() {
+        let path = entry.unwrap().path();
+        let file = path.file_name().unwrap().to_string_lossy().to_string();
+        if !file.ends_with(".ngc") {
+            continue;
+        }
+        total += 1;
+        if BAD_NOT_YET.iter().any(|(f, _)| *f == file) {
+            continue;
+        }
+        let program = std::fs::read_to_string(&path).unwrap();
+        let first = program.lines().next().unwrap_or("");
+        let want = if let Some(t) = first.strip_prefix(';') {
+            t.to_string()
+        } else {
+            first
+                .trim_start_matches('(')
+                .trim_end_matches(')')
+                .to_string()
+        };
+        let (_, result) = our_calls(&program, config(None));
+        let err = result.expect_err(&file);
+        assert_eq!(err.kind.to_string(), want, "{file}");
+        checked += 1;
+    }
+    assert_eq!(
+        checked + BAD_NOT_YET.len(),
+        total,
+        "every bad program runs or is listed"
+    );
+    assert!(checked >= 17);
+}
+
+#[test]
+fn folder_tests_match_linuxcnc() {
+    let Some(dir) = data_or_skip() else { return };
+    for r in RUNS {
+        let folder = r.folder;
+        let base = dir.join(folder);
+        let text = std::fs::read_to_string(base.join(r.program)).unwrap();
+        let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+        let table = r.table.map(|t| base.join(t));
+        let (ours, result) = our_calls(&text, config(table.as_deref()));
+        assert!(result.is_ok(), "{folder}: {result:?}");
+        let theirs = expected_calls(&expected, r.counter);
+        if let Err(e) = compare_motion(&ours, &theirs) {
+            panic!("{folder}: {e}");
+        }
+        // Beyond motion, every call LinuxCNC makes must be ours too, in order.
+        assert_eq!(
+            ours.len(),
+            theirs.len(),
+            "{folder}: call counts differ\nours: {ours:#?}\ntheirs: {theirs:#?}"
+        );
+        for (a, b) in ours.iter().zip(&theirs) {
+            let same =
+                a == b || (is_motion(a) && compare_motion(&[a.clone()], &[b.clone()]).is_ok());
+            assert!(same, "{folder}: ours {a} / LinuxCNC {b}");
+        }
+    }
+}
