@@ -41,7 +41,11 @@ fn listing_of_reference_000_section_1_2() {
     for (k, (origin, call)) in moves.iter().enumerate() {
         assert_eq!(origin.n, Some(310 + 10 * k as i64));
         assert_eq!(origin.line, 3 + k as u32);
-        assert_eq!(matches!(call, Canon::ArcFeed { .. }), k % 2 == 0, "block {k}");
+        assert_eq!(
+            matches!(call, Canon::ArcFeed { .. }),
+            k % 2 == 0,
+            "block {k}"
+        );
     }
     // `Y95.` is exactly 95, and each fillet's end lies on its circle of radius R.
     let mut start = (-80.0, 95.0);
@@ -57,7 +61,10 @@ fn listing_of_reference_000_section_1_2() {
                 let r0 = (start.0 - first_axis).hypot(start.1 - second_axis);
                 let r1 = (first_end - first_axis).hypot(second_end - second_axis);
                 assert!((r0 - r1).abs() < 1e-9);
-                assert!((r0 - 12.499).abs() < 1e-9 || (r0 - 3.125).abs() < 1e-9, "{r0}");
+                assert!(
+                    (r0 - 12.499).abs() < 1e-9 || (r0 - 3.125).abs() < 1e-9,
+                    "{r0}"
+                );
                 start = (*first_end, *second_end);
             }
             Canon::StraightFeed(p) => start = (p.x(), p.y()),

@@ -189,7 +189,7 @@ fn is_motion(call: &str) -> bool {
 }
 
 fn numbers(call: &str) -> Vec<f64> {
-    call.split(|c: char| c == '(' || c == ')' || c == ',' || c == ' ')
+    call.split(['(', ')', ',', ' '])
         .filter_map(|t| t.parse().ok())
         .collect()
 }
@@ -295,8 +295,9 @@ fn folder_tests_match_linuxcnc() {
             "{folder}: call counts differ\nours: {ours:#?}\ntheirs: {theirs:#?}"
         );
         for (a, b) in ours.iter().zip(&theirs) {
-            let same =
-                a == b || (is_motion(a) && compare_motion(&[a.clone()], &[b.clone()]).is_ok());
+            let same = a == b
+                || (is_motion(a)
+                    && compare_motion(std::slice::from_ref(a), std::slice::from_ref(b)).is_ok());
             assert!(same, "{folder}: ours {a} / LinuxCNC {b}");
         }
     }

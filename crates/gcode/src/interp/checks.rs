@@ -87,10 +87,8 @@ fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<()
     };
     let at = code.at;
     match code.code {
-        40 => {
-            if block.get(b'p').is_none_or(|p| p < 0.0) {
-                return Err((ErrorKind::DwellTimeMissing, at));
-            }
+        40 if block.get(b'p').is_none_or(|p| p < 0.0) => {
+            return Err((ErrorKind::DwellTimeMissing, at));
         }
         100 => {
             let l = block.get(b'l');
