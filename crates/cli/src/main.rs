@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use miette::{IntoDiagnostic, Result, WrapErr};
-use tezgah_gcode::{Canon, Config, Interpreter, Origin, ToolTable};
+use tezgah_gcode::{Canon, CanonSink, Config, Interpreter, Origin, ToolTable};
 
 #[derive(Parser)]
 #[command(name = "tezgah", version, about = "CNC motion control and CAM")]
@@ -86,7 +86,6 @@ fn canon(program: &Path, tool_table: Option<&Path>) -> Result<ExitCode> {
     // rs274's driver resets the interpreter twice when it stops, whatever the outcome.
     sink.call(Origin::default(), Canon::OnReset);
     sink.call(Origin::default(), Canon::OnReset);
-    drop(sink);
     use std::io::Write;
     out.flush().into_diagnostic()?;
     match result {
@@ -102,16 +101,10 @@ struct Printer<'a, W: std::io::Write> {
     out: &'a mut W,
 }
 
-impl<W: std::io::Write> Printer<'_, W> {
+impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
     fn call(&mut self, _origin: Origin, call: Canon) {
         // A closed pipe (`| head`) is not an error worth reporting.
         let _ = writeln!(self.out, "{call}");
-    }
-}
-
-impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
-    fn call(&mut self, origin: Origin, call: Canon) {
-        Printer::call(self, origin, call);
     }
 }
 
