@@ -1,0 +1,51 @@
+//! Replays the fuzzing corpus (`fuzz/corpus/interpret`) as an ordinary test: every input goes
+//! through the same calls as the `interpret` fuzz target, and none may panic. Errors are fine.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+use tezgah_gcode::{canon::Discard, check, Config, Interpreter};
+
+fn corpus_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/interpret")
+}
+
+/// What the fuzz target does with one input.
+fn run_input(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let mut interp = Interpreter::new(Config::default());
+    let _ = interp.run(&text, &mut Discard);
+    let _ = check(&text, Config::default());
+}
+
+#[test]
+fn fuzz_corpus_never_panics() {
+    let dir = corpus_dir();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("reading {}: {e}", dir.display()))
+        .map(|entry| entry.expect("reading a corpus entry").path())
+        .filter(|path| path.is_file())
+        .collect();
+    files.sort();
+    assert!(
+        !files.is_empty(),
+        "the fuzz corpus {} is empty",
+        dir.display()
+    );
+
+    let mut panicked = Vec::new();
+    for path in &files {
+        let data =
+            std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+        if catch_unwind(AssertUnwindSafe(|| run_input(&data))).is_err() {
+            panicked.push(path.display().to_string());
+        }
+    }
+    assert!(
+        panicked.is_empty(),
+        "{} of {} corpus inputs panicked:\n{}",
+        panicked.len(),
+        files.len(),
+        panicked.join("\n")
+    );
+}
