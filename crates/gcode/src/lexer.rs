@@ -50,6 +50,8 @@ impl NormLine {
                     i = self.lex_comment(raw, i)?;
                     continue;
                 }
+                // The source may not hold the byte that stands for a comment here.
+                COMMENT_MARK => return Err((ErrorKind::BadCharacter(b as char), i)),
                 _ => {
                     self.text.push(b.to_ascii_lowercase());
                     self.at.push(i as u32);
@@ -116,5 +118,10 @@ mod tests {
         let mut l = NormLine::default();
         assert_eq!(l.lex("g0 (open"), Err((ErrorKind::UnclosedComment, 3)));
         assert_eq!(l.lex("g0 (a (b) c)"), Err((ErrorKind::NestedComment, 6)));
+        // Found by fuzzing: a raw comment-marker byte once reached the comment table.
+        assert_eq!(
+            l.lex("G0 X1\x01"),
+            Err((ErrorKind::BadCharacter('\x01'), 5))
+        );
     }
 }
