@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use miette::{miette, LabeledSpan, NamedSource, Report};
-use tezgah_gcode::{Canon, CanonSink, Config, GcodeError, Interpreter, Origin};
+use tezgah_gcode::{Canon, CanonSink, GcodeError, Origin};
 
 /// A report naming `file:line:col` and underlining the place in the source.
 pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
@@ -24,7 +24,7 @@ pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
 
 /// Counts of what a program does, for `check`'s summary line.
 #[derive(Default)]
-struct Counts {
+pub struct Counts {
     lines: u32,
     rapids: usize,
     feeds: usize,
@@ -45,13 +45,12 @@ impl CanonSink for Counts {
     }
 }
 
-/// One line saying what the (already checked) program does.
-pub fn summarize(text: &str, config: Config) -> String {
-    let mut counts = Counts::default();
-    let mut interp = Interpreter::new(config);
-    let _ = interp.run(text, &mut counts);
-    format!(
-        "{} lines, {} rapid, {} feed, {} arc moves, {} dwells",
-        counts.lines, counts.rapids, counts.feeds, counts.arcs, counts.dwells
-    )
+impl std::fmt::Display for Counts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} lines, {} rapid, {} feed, {} arc moves, {} dwells",
+            self.lines, self.rapids, self.feeds, self.arcs, self.dwells
+        )
+    }
 }

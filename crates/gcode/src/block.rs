@@ -4,6 +4,8 @@
 //! of one modal group, negative feeds, …); the rules that tie words together are the
 //! interpreter's. Every word keeps the byte offset of its letter in the source line.
 
+use tezgah_geom::Pose;
+
 use crate::codes::{g_group, ggroup, m_group, mgroup};
 use crate::error::ErrorKind;
 use crate::lexer::{NormLine, COMMENT_MARK};
@@ -45,6 +47,9 @@ pub struct Block {
     pub comment: Option<usize>,
     pub assignments: Vec<Assignment>,
 }
+
+/// Letters of the six axes, in [`Pose`] order.
+pub const AXIS_LETTERS: [u8; 6] = [b'x', b'y', b'z', b'a', b'b', b'c'];
 
 /// Letters that are words of their own (everything but G, M, N, O).
 const fn is_value_letter(c: u8) -> bool {
@@ -102,9 +107,23 @@ impl Block {
 
     /// Whether any axis word (X Y Z A B C) is present.
     pub fn has_axis_words(&self) -> bool {
-        [b'x', b'y', b'z', b'a', b'b', b'c']
-            .iter()
-            .any(|&c| self.has(c))
+        self.axis_words().iter().any(Option::is_some)
+    }
+
+    /// The values of the axis words X Y Z A B C, in [`Pose`] order.
+    pub fn axis_words(&self) -> [Option<f64>; 6] {
+        AXIS_LETTERS.map(|c| self.get(c))
+    }
+
+    /// `base` with each axis the block names replaced by the block's value.
+    pub fn axes_over(&self, base: Pose) -> Pose {
+        let mut p = base;
+        for (slot, word) in p.0.iter_mut().zip(self.axis_words()) {
+            if let Some(v) = word {
+                *slot = v;
+            }
+        }
+        p
     }
 
     fn clear(&mut self) {

@@ -135,12 +135,8 @@ pub enum ErrorKind {
     NegativeSpindleSpeed,
     #[error("Negative tool id (tool not found)")]
     NegativeTool,
-    #[error("Negative P word used")]
-    NegativeP,
     #[error("Negative l word used")]
     NegativeL,
-    #[error("Negative h word used")]
-    NegativeH,
     #[error("Negative d word tool radius index used")]
     NegativeD,
 
@@ -179,12 +175,8 @@ pub enum ErrorKind {
     ExpectedHash,
     #[error("Expected ] reading bracketed parameter")]
     ExpectedCloseBracket,
-    #[error("Cannot create a non-global named parameter outside a subroutine: {0}")]
-    UnknownNamedParameter(String),
     #[error("Named parameter #<{0}> not defined")]
     NamedParameterNotDefined(String),
-    #[error("Cannot assign to read-only parameter #{0}")]
-    ReadOnlyParameter(String),
 
     // --- block rules ---
     #[error("All axes missing with motion code")]
@@ -227,8 +219,6 @@ pub enum ErrorKind {
     G53NeedsG0OrG1,
     #[error("Cannot use g53 incremental")]
     G53Incremental,
-    #[error("Cannot use g28 or g30 with cutter radius comp")]
-    HomeWithCutterComp,
 
     // --- G10 and offsets ---
     #[error("Line with G10 does not have L0, L1, L10, L11, L2, or L20")]
@@ -239,8 +229,6 @@ pub enum ErrorKind {
     G10POutOfRange(i64),
     #[error("Requested tool {0} not found in the tool table")]
     ToolNotFound(i64),
-    #[error("Invalid tool number in tool table")]
-    ToolIndexOutOfRange,
 
     // --- motion ---
     #[error("Cannot do g1 with zero feed rate")]
@@ -279,8 +267,4 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
-    #[error("{0}")]
-    Abort(String),
-    #[error("Invalid value {0} for {1}")]
-    InvalidValue(String, &'static str),
 }

@@ -19,7 +19,7 @@ pub mod tooltable;
 
 pub use canon::{Canon, CanonSink, Origin, Units};
 pub use error::{ErrorKind, GcodeError};
-pub use interp::{check, Config, Interpreter};
+pub use interp::{check, check_into, Config, Interpreter};
 pub use moves::{program_moves, MoveBuilder};
 pub use span::Span;
 pub use tooltable::{Tool, ToolTable, ToolTableError};

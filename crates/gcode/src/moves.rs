@@ -20,7 +20,6 @@ pub struct MoveBuilder<F: FnMut(Move)> {
     g92: Pose,
     rotation: f64,
     tool: Pose,
-    naive_cam: Option<f64>,
 }
 
 impl<F: FnMut(Move)> MoveBuilder<F> {
@@ -33,7 +32,6 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
             g92: Pose::ZERO,
             rotation: 0.0,
             tool: Pose::ZERO,
-            naive_cam: None,
         }
     }
 
@@ -107,14 +105,12 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 };
                 self.push(line, MoveKind::FeedMode(mode));
             }
-            Canon::SetNaivecamTolerance(q) => self.naive_cam = Some(q * self.units.mm()),
             Canon::SetMotionControlMode(m) => {
                 let mode = match m {
                     ControlMode::ExactStop => PathMode::ExactStop,
                     ControlMode::ExactPath => PathMode::ExactPath,
                     ControlMode::Continuous(p) => PathMode::Continuous {
                         tolerance: (p > 0.0).then(|| p * self.units.mm()),
-                        naive_cam: None,
                     },
                 };
                 self.push(line, MoveKind::PathMode(mode));

@@ -253,8 +253,7 @@ impl<'a> Reader<'a> {
             .ok()
             .and_then(|s| s.parse().ok())
             .ok_or((ErrorKind::BadNumberFormat(whole), start))?;
-        let end = i;
-        self.pos = end;
+        self.pos = i;
         Ok(v)
     }
 

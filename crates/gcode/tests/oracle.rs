@@ -379,6 +379,44 @@ impl Writer {
         }
     }
 
+    /// `G2|G3` with the in-plane end words and the optional helix word. The end `e` is put on
+    /// the 4-decimal grid the program is written in (increments under G91) and left as the
+    /// interpreter will read it, the normal axis included.
+    #[allow(clippy::too_many_arguments)]
+    fn arc_head(
+        &self,
+        deco: &Deco,
+        restore: &str,
+        cw: bool,
+        (a, b, n): (usize, usize, usize),
+        normal: Option<f64>,
+        s: [f64; 3],
+        e: &mut [f64; 3],
+    ) -> String {
+        let (wa, wb) = if self.incremental {
+            let w = (round4(e[a] - s[a]), round4(e[b] - s[b]));
+            (e[a], e[b]) = (s[a] + w.0, s[b] + w.1);
+            w
+        } else {
+            (e[a], e[b]) = (round4(e[a]), round4(e[b]));
+            (e[a], e[b])
+        };
+        let mut words = format!(
+            "{}{restore}G{} {}{} {}{}",
+            Self::extra(deco),
+            if cw { 2 } else { 3 },
+            AXES[a],
+            num(wa),
+            AXES[b],
+            num(wb)
+        );
+        if let Some(v) = normal {
+            words.push_str(&format!(" {}{}", AXES[n], num(v)));
+            e[n] = if self.incremental { s[n] + v } else { v };
+        }
+        words
+    }
+
     fn extra(deco: &Deco) -> String {
         deco.extra
             .map_or(String::new(), |e| format!("{} ", EXTRAS[e]))
@@ -420,34 +458,14 @@ impl Writer {
                     da += 1.0;
                 }
                 let mut e = s;
-                let (wa, wb);
-                if self.incremental {
-                    e[a] = s[a] + da;
-                    e[b] = s[b] + db;
-                    (wa, wb) = (da, db);
-                } else {
-                    e[a] = round4(s[a] + da);
-                    e[b] = round4(s[b] + db);
-                    (wa, wb) = (e[a], e[b]);
-                }
+                e[a] += da;
+                e[b] += db;
+                let mut words = self.arc_head(deco, restore, *cw, (a, b, n), *normal, s, &mut e);
                 let half = (e[a] - s[a]).hypot(e[b] - s[b]) / 2.0;
                 // Rounded up, so that the radius always reaches.
                 let mut r = (half * factor * 1e4).ceil() / 1e4;
                 if *negative {
                     r = -r;
-                }
-                let mut words = format!(
-                    "{}{restore}G{} {}{} {}{}",
-                    Self::extra(deco),
-                    if *cw { 2 } else { 3 },
-                    AXES[a],
-                    num(wa),
-                    AXES[b],
-                    num(wb)
-                );
-                if let Some(v) = normal {
-                    words.push_str(&format!(" {}{}", AXES[n], num(*v)));
-                    e[n] = if self.incremental { s[n] + v } else { *v };
                 }
                 words.push_str(&format!(" R{}", num(r)));
                 if let Some(p) = turns {
@@ -486,29 +504,7 @@ impl Writer {
                 if let Some(dp) = perturb {
                     e[a] += dp;
                 }
-                let (wa, wb);
-                if self.incremental {
-                    (wa, wb) = (round4(e[a] - s[a]), round4(e[b] - s[b]));
-                    e[a] = s[a] + wa;
-                    e[b] = s[b] + wb;
-                } else {
-                    e[a] = round4(e[a]);
-                    e[b] = round4(e[b]);
-                    (wa, wb) = (e[a], e[b]);
-                }
-                let mut words = format!(
-                    "{}{restore}G{} {}{} {}{}",
-                    Self::extra(deco),
-                    if *cw { 2 } else { 3 },
-                    AXES[a],
-                    num(wa),
-                    AXES[b],
-                    num(wb)
-                );
-                if let Some(v) = normal {
-                    words.push_str(&format!(" {}{}", AXES[n], num(*v)));
-                    e[n] = if self.incremental { s[n] + v } else { *v };
-                }
+                let mut words = self.arc_head(deco, restore, *cw, (a, b, n), *normal, s, &mut e);
                 if let Some(v) = a_word {
                     words.push_str(&format!(" A{}", num(*v)));
                 }

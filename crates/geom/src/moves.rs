@@ -82,21 +82,16 @@ pub enum PathMode {
     ExactStop,
     /// G61: follow the programmed path exactly; corners are passed at zero speed.
     ExactPath,
-    /// G64 [P tolerance] [Q naive-CAM tolerance]: blend within the tolerance (mm); `None` means
-    /// "as fast as possible" (the machine file's tolerance applies).
-    Continuous {
-        tolerance: Option<f64>,
-        naive_cam: Option<f64>,
-    },
+    /// G64 [P tolerance]: blend within the tolerance (mm); `None` means "as fast as possible"
+    /// (the machine file's tolerance applies). LinuxCNC's Q (naive-CAM collinearity) has no
+    /// role here: compressing short moves is the path stage's job, under the same tolerance.
+    Continuous { tolerance: Option<f64> },
 }
 
 impl Default for PathMode {
     /// LinuxCNC starts in G64 without P: blend as fast as possible.
     fn default() -> Self {
-        PathMode::Continuous {
-            tolerance: None,
-            naive_cam: None,
-        }
+        PathMode::Continuous { tolerance: None }
     }
 }
 

@@ -2,7 +2,7 @@
 //! which motion the block makes, and whether every word has a code that uses it
 //! (LinuxCNC's `enhance_block`, `check_g_codes`, `check_m_codes`, `check_other_codes`).
 
-use crate::block::Block;
+use crate::block::{Block, AXIS_LETTERS};
 use crate::codes::{ggroup, mgroup};
 use crate::error::ErrorKind;
 
@@ -73,7 +73,7 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
 }
 
 fn first_axis_at(block: &Block) -> u32 {
-    [b'x', b'y', b'z', b'a', b'b', b'c']
+    AXIS_LETTERS
         .iter()
         .filter_map(|&c| block.word(c))
         .map(|w| w.at)

@@ -314,11 +314,8 @@ impl Interpreter {
                     .ok_or((ErrorKind::ToolNotFound(h), at))?,
             },
             431 => {
-                let mut o = Pose::ZERO;
-                for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-                    o.0[i] = block.get(letter).unwrap_or(0.0);
-                }
-                o
+                // Axes it does not name get no offset.
+                block.axes_over(Pose::ZERO)
             }
             490 => Pose::ZERO,
             _ => return Err(unsupported(g, at)),
@@ -351,6 +348,14 @@ impl Interpreter {
             self.comment_call(sink, "continuing to use same coordinate system".into());
             return;
         }
+        self.load_coordinate_system(index, sink);
+        self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
+        self.emit(sink, Canon::SetXyRotation(self.state.rotation));
+    }
+
+    /// Make system `index` active with the offsets and rotation its parameters hold; the tool
+    /// stays where it is, so the program position is re-expressed in the new frame.
+    fn load_coordinate_system(&mut self, index: usize, sink: &mut impl CanonSink) {
         let machine = self.state.to_machine(self.state.pos);
         let base = coord_system_base(index);
         self.state.origin_index = index;
@@ -365,8 +370,6 @@ impl Interpreter {
                 offset: self.state.origin,
             },
         );
-        self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
-        self.emit(sink, Canon::SetXyRotation(self.state.rotation));
     }
 
     fn path_control(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) {
@@ -439,25 +442,16 @@ impl Interpreter {
         if l20 {
             // The offsets that make the current point read as the given coordinates, solved
             // in the target system's rotated frame: offset = machine − R(target + G92).
-            let mut target = self.state.pos;
-            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-                if let Some(v) = block.get(letter) {
-                    target.0[i] = v;
-                }
-            }
+            let target = block.axes_over(self.state.pos);
             let solved = machine - state::rotate_xy(target + self.state.axis_offset, rotation);
             let xy = block.has(b'x') || block.has(b'y');
-            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-                if block.has(letter) || (xy && i < 2) {
+            for (i, word) in block.axis_words().into_iter().enumerate() {
+                if word.is_some() || (xy && i < 2) {
                     offset.0[i] = solved.0[i];
                 }
             }
         } else {
-            for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-                if let Some(v) = block.get(letter) {
-                    offset.0[i] = v;
-                }
-            }
+            offset = block.axes_over(offset);
         }
         self.params.set6(base, offset.0);
         self.params.set(base + 9, rotation);
@@ -480,8 +474,8 @@ impl Interpreter {
 
     /// G92 (offsets that make the current point the given coordinates) and G52 (local offsets).
     fn set_axis_offsets(&mut self, block: &Block, local: bool, sink: &mut impl CanonSink) {
-        for (i, letter) in [b'x', b'y', b'z', b'a', b'b', b'c'].into_iter().enumerate() {
-            if let Some(v) = block.get(letter) {
+        for (i, word) in block.axis_words().into_iter().enumerate() {
+            if let Some(v) = word {
                 let old = self.state.axis_offset.0[i];
                 let new = if local {
                     v
@@ -516,20 +510,8 @@ impl Interpreter {
     }
 
     fn end_program(&mut self, pallet: bool, sink: &mut impl CanonSink) {
-        let machine = self.state.to_machine(self.state.pos);
-        let base = coord_system_base(1);
-        self.state.origin_index = 1;
-        self.params.set(params::COORD_SYSTEM, 1.0);
-        self.state.origin = Pose(self.params.get6(base));
-        self.state.rotation = self.params.get(base + 9);
-        self.state.pos = self.state.from_machine(machine);
-        self.emit(
-            sink,
-            Canon::SetG5xOffset {
-                index: 1,
-                offset: self.state.origin,
-            },
-        );
+        // LinuxCNC reloads G54 even when it is already active.
+        self.load_coordinate_system(1, sink);
         self.emit(sink, Canon::SetXyRotation(self.state.rotation));
         if self.state.plane != Some(Plane::XY) {
             self.state.plane = Some(Plane::XY);

@@ -298,9 +298,13 @@ fn memchr_newline(s: &[u8]) -> usize {
 /// first. After an error, interpretation goes on with the next line from the state the failed
 /// block left (the words executed before the failing one keep their effect, as in LinuxCNC).
 pub fn check(program: &str, cfg: Config) -> Vec<GcodeError> {
+    check_into(program, cfg, &mut crate::canon::Discard)
+}
+
+/// [`check`], sending the calls of the blocks that pass to `sink` (for summaries).
+pub fn check_into(program: &str, cfg: Config, sink: &mut impl CanonSink) -> Vec<GcodeError> {
     let mut interp = Interpreter::new(cfg);
-    let mut sink = crate::canon::Discard;
-    interp.start(&mut sink);
+    interp.start(sink);
     let mut errors = Vec::new();
     let mut last = LineRef {
         number: 0,
@@ -309,7 +313,7 @@ pub fn check(program: &str, cfg: Config) -> Vec<GcodeError> {
     };
     for line in lines(program) {
         last = line;
-        match interp.execute_line(line, &mut sink) {
+        match interp.execute_line(line, sink) {
             Ok(Flow::End) => return errors,
             Ok(Flow::Continue) => {}
             Err(e) => errors.push(e),

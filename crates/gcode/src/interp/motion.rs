@@ -5,7 +5,7 @@
 
 use tezgah_geom::{FeedMode, Plane, Pose};
 
-use crate::block::{is_integer, Block};
+use crate::block::{is_integer, Block, AXIS_LETTERS};
 use crate::canon::{Canon, CanonSink};
 use crate::codes::ggroup;
 use crate::error::ErrorKind;
@@ -14,8 +14,6 @@ use crate::params;
 use super::arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
 use super::execute::{unsupported, Exec};
 use super::Interpreter;
-
-const AXIS_LETTERS: [u8; 6] = [b'x', b'y', b'z', b'a', b'b', b'c'];
 
 impl Interpreter {
     pub(super) fn motion(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) -> Exec {
@@ -34,17 +32,12 @@ impl Interpreter {
     fn find_ends(&self, block: &Block) -> Pose {
         let s = &self.state;
         if block.g(ggroup::NON_MODAL) == Some(530) {
-            let mut m = s.to_machine(s.pos) + s.tool_offset;
-            for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
-                if let Some(v) = block.get(letter) {
-                    m.0[i] = v;
-                }
-            }
+            let m = block.axes_over(s.to_machine(s.pos) + s.tool_offset);
             return s.from_machine(m - s.tool_offset);
         }
         let mut end = s.pos;
-        for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
-            if let Some(v) = block.get(letter) {
+        for (i, word) in block.axis_words().into_iter().enumerate() {
+            if let Some(v) = word {
                 end.0[i] = if s.incremental { s.pos.0[i] + v } else { v };
             }
         }
@@ -117,10 +110,11 @@ impl Interpreter {
         let home = self
             .state
             .from_machine(home_mm.scale_linear(1.0 / self.state.units.mm()));
-        let any = block.has_axis_words();
+        let words = block.axis_words();
+        let any = words.iter().any(Option::is_some);
         let mut end = intermediate;
-        for (i, &letter) in AXIS_LETTERS.iter().enumerate() {
-            if !any || block.has(letter) {
+        for (i, word) in words.iter().enumerate() {
+            if !any || word.is_some() {
                 end.0[i] = home.0[i];
             }
         }
