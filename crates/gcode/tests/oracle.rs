@@ -286,14 +286,8 @@ impl Writer {
     }
 
     /// F word of a feed move: always in inverse time, else when asked or when none is in force.
-    /// `length` is a lower bound of the move's length (inverse time only).
-    fn feed_word(&mut self, f: f64, with_f: bool, length: f64) -> String {
+    fn feed_word(&mut self, f: f64, with_f: bool) -> String {
         if self.inverse {
-            // BUG: LinuxCNC sends an inverse-time rate of at least 0.1 (`MAX(0.1, length × F)`
-            // in inverse_time_rate_straight/_arc); tezgah sends length × F unclamped, so
-            // `G93 / G1 X0.01 F1` gives SET_FEED_RATE(0.1000) there and (0.0100) here. Inverse
-            // time F words are raised so that length × F stays above 0.1 until that is fixed.
-            let f = f.max((0.2 / length.max(1e-6) * 1e4).ceil() / 1e4);
             format!(" F{}", num(f))
         } else if with_f || !self.feed_set {
             self.feed_set = true;
@@ -310,26 +304,6 @@ impl Writer {
 
     fn xyz(&self) -> Option<[f64; 3]> {
         Some([self.pos[0]?, self.pos[1]?, self.pos[2]?])
-    }
-
-    /// Length of a straight move to `axes`, as LinuxCNC measures it, when it is known.
-    fn straight_length(&self, axes: &Axes) -> Option<f64> {
-        let mut d = [0.0; 6];
-        for (i, v) in axes.iter().enumerate() {
-            if let Some(v) = v {
-                d[i] = if self.incremental {
-                    *v
-                } else {
-                    v - self.pos[i]?
-                };
-            }
-        }
-        let linear = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        Some(if linear > 0.0 {
-            linear
-        } else {
-            (d[3] * d[3] + d[4] * d[4] + d[5] * d[5]).sqrt()
-        })
     }
 
     fn move_to(&mut self, axes: &Axes) {
@@ -364,18 +338,6 @@ impl Writer {
     fn set_xyz(&mut self, p: [f64; 3]) {
         for (i, v) in p.into_iter().enumerate() {
             self.pos[i] = Some(v);
-        }
-    }
-
-    /// Lower bound of an arc's length from `s` to `e`, for the inverse-time F word: the
-    /// straight distance, or a full turn when the end is the start in the plane.
-    fn arc_length_bound(s: [f64; 3], e: [f64; 3], in_plane: (usize, usize), r: f64) -> f64 {
-        let (a, b) = in_plane;
-        let straight = ((0..3).map(|i| (e[i] - s[i]).powi(2)).sum::<f64>()).sqrt();
-        if e[a] == s[a] && e[b] == s[b] {
-            straight.max(std::f64::consts::TAU * r)
-        } else {
-            straight
         }
     }
 
@@ -430,13 +392,10 @@ impl Writer {
                 f,
                 with_f,
             } => {
-                // In inverse time the length must be known (see `feed_word`).
-                let length = self.straight_length(axes).filter(|&l| l >= 1e-3);
-                let rapid = *rapid || (self.inverse && length.is_none());
-                let mut words = format!("{}G{}", Self::extra(deco), if rapid { 0 } else { 1 });
+                let mut words = format!("{}G{}", Self::extra(deco), if *rapid { 0 } else { 1 });
                 words.push_str(&axis_words(axes));
-                if !rapid {
-                    words.push_str(&self.feed_word(*f, *with_f, length.unwrap_or(0.0)));
+                if !*rapid {
+                    words.push_str(&self.feed_word(*f, *with_f));
                 }
                 self.block(deco, &words);
                 self.move_to(axes);
@@ -471,8 +430,7 @@ impl Writer {
                 if let Some(p) = turns {
                     words.push_str(&format!(" P{p}"));
                 }
-                let length = Self::arc_length_bound(s, e, (a, b), r.abs());
-                words.push_str(&self.feed_word(*f, false, length));
+                words.push_str(&self.feed_word(*f, false));
                 self.block(deco, &words);
                 self.set_xyz(e);
             }
@@ -519,15 +477,15 @@ impl Writer {
                 }
                 let chord = (e[a] - s[a]).hypot(e[b] - s[b]);
                 if self.inverse && chord > 0.0 && chord < 1e-6 {
-                    // Edge case: an end a rounding error away from the start (X-53.0708 after
+                    // Deliberate: an end a rounding error away from the start (X-53.0708 after
                     // X-26.8929 plus incremental X-26.1779) is a full circle to tezgah's `sweep`
                     // (angles within 1e-12) but an almost empty arc to LinuxCNC's
                     // find_arc_length (full only when the angles are exactly equal), and only
-                    // the inverse-time feed rate shows it. Not generated.
+                    // the inverse-time feed rate shows it. tezgah keeps one answer for the rate and
+                    // the motion: the full circle. Not generated.
                     return;
                 }
-                let length = Self::arc_length_bound(s, e, (a, b), r);
-                words.push_str(&self.feed_word(*f, false, length));
+                words.push_str(&self.feed_word(*f, false));
                 self.block(deco, &words);
                 self.set_xyz(e);
                 if let Some(v) = a_word {
@@ -663,12 +621,10 @@ impl Writer {
                     String::new()
                 };
                 self.incremental = false;
-                // In inverse time the length of a G53 move is not known: a rapid then.
-                let rapid = *rapid || self.inverse;
-                words.push_str(&format!("G53 G{}", if rapid { 0 } else { 1 }));
+                words.push_str(&format!("G53 G{}", if *rapid { 0 } else { 1 }));
                 words.push_str(&axis_words(axes));
-                if !rapid {
-                    words.push_str(&self.feed_word(*f, false, 0.0));
+                if !*rapid {
+                    words.push_str(&self.feed_word(*f, false));
                 }
                 self.block(deco, &words);
                 self.forget();

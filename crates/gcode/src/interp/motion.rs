@@ -87,7 +87,7 @@ impl Interpreter {
                     l if l > 0.0 => l,
                     _ => d.rotary_norm(),
                 };
-                self.emit(sink, Canon::SetFeedRate(f * length));
+                self.emit(sink, Canon::SetFeedRate(inverse_time_rate(f, length)));
             }
             self.emit(sink, Canon::StraightFeed(end));
         }
@@ -201,7 +201,7 @@ impl Interpreter {
             let radius = (s2[0] - center[0]).hypot(s2[1] - center[1]);
             let planar = radius * sweep(s2, e2, center, sense, turns as u32);
             let length = planar.hypot(end.0[normal] - start.0[normal]);
-            self.emit(sink, Canon::SetFeedRate(f * length));
+            self.emit(sink, Canon::SetFeedRate(inverse_time_rate(f, length)));
         }
         self.emit(
             sink,
@@ -218,4 +218,11 @@ impl Interpreter {
         self.state.pos = end;
         Ok(())
     }
+}
+
+/// The feed rate an inverse-time move is sent with: its length over its time `1/F`. LinuxCNC
+/// floors it at 0.1 units per minute (`inverse_time_rate_straight`/`_arc`), so a tiny move never
+/// gets a near-zero feed; tezgah does the same to run the same programs at the same speed.
+fn inverse_time_rate(f: f64, length: f64) -> f64 {
+    (length * f).max(0.1)
 }
