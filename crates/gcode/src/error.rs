@@ -227,6 +227,8 @@ pub enum ErrorKind {
     G10PNotInteger,
     #[error("P value out of range (0-9) with G10 L{0}")]
     G10POutOfRange(i64),
+    #[error("R not allowed in G10 L20")]
+    G10L20Rotation,
     #[error("Requested tool {0} not found in the tool table")]
     ToolNotFound(i64),
 

@@ -92,8 +92,8 @@ struct Deco {
 enum ToolLength {
     /// G43, with H1..H3 or (0) without H.
     Table(u8),
-    /// G43.1 Z… X….
-    Dynamic { z: f64, x: f64 },
+    /// G43.1 with Z…, X… or both.
+    Dynamic { z: Option<f64>, x: Option<f64> },
     /// G49.
     Cancel,
 }
@@ -157,6 +157,8 @@ enum Item {
         l20: bool,
         p: u8,
         axes: Axes,
+        /// XY rotation R (degrees).
+        r: Option<f64>,
     },
     G92 {
         axes: Axes,
@@ -248,8 +250,6 @@ struct Writer {
     pos: [Option<f64>; 6],
     /// An M6 was written: tool length words are no longer generated.
     changed_tool: bool,
-    /// A G10, G92 or G52 stored offsets in the parameters: units no longer change.
-    offsets_stored: bool,
     /// A G43 or G43.1 is in force (not cancelled by G49).
     tool_offset: bool,
     /// A G43, G43.1 or G49 was written: no M6 from then on.
@@ -267,7 +267,6 @@ impl Writer {
             inches: false,
             pos: [Some(0.0); 6],
             changed_tool: false,
-            offsets_stored: false,
             tool_offset: false,
             tool_length_used: false,
         }
@@ -501,14 +500,6 @@ impl Writer {
                 self.incremental = *incremental;
             }
             Item::Units { inches } => {
-                // BUG: tezgah keeps the offsets stored in the parameters (G10 L2/L20 → #5221…,
-                // G92/G52 → #5211…) as raw numbers in the units of the moment, while LinuxCNC
-                // stores them in fixed user units and converts them when it reads them back
-                // (G54…G59.3, G92.3, M2). So `G52 X1 / G20 / G92.3` restores X1 inch instead of
-                // 1 mm. No unit change after offsets have been stored until that is fixed.
-                if self.offsets_stored {
-                    return;
-                }
                 // Deliberate: on G20/G21 LinuxCNC re-reads the tool length offset from its canon
                 // layer. The standalone rs274's canon returns it unconverted (`G43 H1 / G20`
                 // leaves 12.9794 "inches" of offset; a later G43/G49/G53 shifts by that), while
@@ -566,23 +557,13 @@ impl Writer {
                 self.block(deco, COORD_SYSTEMS[*i]);
                 self.forget();
             }
-            Item::G10 { l20, p, axes } => {
-                self.offsets_stored = true;
+            Item::G10 { l20, p, axes, r } => {
                 let l = if *l20 { 20 } else { 2 };
-                let mut axes = *axes;
-                if *l20 && axes[0].is_some() != axes[1].is_some() {
-                    // BUG: tezgah's G10 L20 with only one of X and Y also rewrites the other's
-                    // offset, from the current point in the *active* system: `G10 L2 P1 Y1 /
-                    // G10 L20 P2 X0 / G55` leaves LinuxCNC's G55 Y offset at 0 and makes
-                    // tezgah's 1. G10 L20 names both X and Y or neither until fixed.
-                    axes[0] = Some(axes[0].unwrap_or(0.0));
-                    axes[1] = Some(axes[1].unwrap_or(0.0));
-                }
-                self.block(deco, &format!("G10 L{l} P{p}{}", axis_words(&axes)));
+                let r = r.map_or(String::new(), |r| format!(" R{}", num(r)));
+                self.block(deco, &format!("G10 L{l} P{p}{}{r}", axis_words(axes)));
                 self.forget();
             }
             Item::G92 { axes } => {
-                self.offsets_stored = true;
                 self.block(deco, &format!("G92{}", axis_words(axes)));
                 self.forget();
             }
@@ -591,27 +572,16 @@ impl Writer {
                 self.forget();
             }
             Item::G52 { axes } => {
-                self.offsets_stored = true;
                 self.block(deco, &format!("G52{}", axis_words(axes)));
                 self.forget();
             }
             Item::Home { g30, axes } => {
-                // BUG: tezgah's G28/G30 leave the tool length offset out of the home point in
-                // program coordinates: after `G43 H1`, `G28` ends at Z0 where LinuxCNC ends at
-                // Z-12.9794 (machine Z0). G28.1/G30.1 likewise store the point without the
-                // offset. No G28/G30/G28.1/G30.1 under a tool length offset until fixed.
-                if self.tool_offset {
-                    return;
-                }
                 let g = if *g30 { "G30" } else { "G28" };
                 self.block(deco, &format!("{g}{}", axis_words(axes)));
                 self.forget();
             }
             Item::SetHome { g30 } => {
-                // BUG: see `Item::Home`.
-                if !self.tool_offset {
-                    self.block(deco, if *g30 { "G30.1" } else { "G28.1" });
-                }
+                self.block(deco, if *g30 { "G30.1" } else { "G28.1" });
             }
             Item::Machine { rapid, axes, f } => {
                 // G53 needs absolute distance mode.
@@ -662,11 +632,15 @@ impl Writer {
                 let words = match tl {
                     ToolLength::Table(0) => "G43".to_string(),
                     ToolLength::Table(h) => format!("G43 H{h}"),
-                    // BUG: LinuxCNC's G43.1 replaces the offsets of the axes it names and keeps
-                    // the others; tezgah's sets the others to zero (`G43 H1 / G43.1 X1` gives
-                    // USE_TOOL_LENGTH_OFFSET(1 0 12.9794, …) there, (1 0 0, …) here). G43.1
-                    // names both axes the generator gives offsets to (X and Z) until fixed.
-                    ToolLength::Dynamic { z, x } => format!("G43.1 Z{} X{}", num(*z), num(*x)),
+                    ToolLength::Dynamic { z, x } => {
+                        let mut words = "G43.1".to_string();
+                        for (letter, v) in [("Z", z), ("X", x)] {
+                            if let Some(v) = v {
+                                words.push_str(&format!(" {letter}{}", num(*v)));
+                            }
+                        }
+                        words
+                    }
                     ToolLength::Cancel => "G49".to_string(),
                 };
                 self.block(deco, &words);
@@ -802,7 +776,10 @@ fn item() -> impl Strategy<Value = Item> {
         );
     let tool_length = prop_oneof![
         (0u8..=3).prop_map(ToolLength::Table),
-        (value(5.0), value(2.0)).prop_map(|(z, x)| ToolLength::Dynamic { z, x }),
+        (value(5.0), value(2.0), 0u8..3).prop_map(|(z, x, which)| ToolLength::Dynamic {
+            z: (which != 1).then_some(z),
+            x: (which != 0).then_some(x),
+        }),
         Just(ToolLength::Cancel),
     ];
     let valid = prop_oneof![
@@ -822,7 +799,13 @@ fn item() -> impl Strategy<Value = Item> {
         )
             .prop_map(|(mode, p, q)| Item::PathControl { mode, p, q }),
         2 => (0..COORD_SYSTEMS.len()).prop_map(Item::CoordSystem),
-        2 => (any::<bool>(), 0u8..=9, axes()).prop_map(|(l20, p, axes)| Item::G10 { l20, p, axes }),
+        2 => (
+            any::<bool>(),
+            0u8..=9,
+            axes(),
+            proptest::option::weighted(0.3, value(90.0))
+        )
+            .prop_map(|(l20, p, axes, r)| Item::G10 { l20, p, axes, r }),
         1 => axes().prop_map(|axes| Item::G92 { axes }),
         1 => (1u8..=3).prop_map(Item::G92x),
         1 => axes().prop_map(|axes| Item::G52 { axes }),

@@ -313,21 +313,22 @@ impl Interpreter {
                     .table_offset(h)
                     .ok_or((ErrorKind::ToolNotFound(h), at))?,
             },
-            431 => {
-                // Axes it does not name get no offset.
-                block.axes_over(Pose::ZERO)
-            }
+            // Axes it does not name keep their offsets.
+            431 => block.axes_over(self.state.tool_offset),
             490 => Pose::ZERO,
             _ => return Err(unsupported(g, at)),
         };
-        // The tip stays where it is: program coordinates shift by the change of offset.
-        self.state.pos = self.state.pos + self.state.tool_offset - offset;
+        // The tip stays where it is: program coordinates shift by the change of offset, which
+        // is in the machine's (unrotated) frame.
+        let shift = state::rotate_xy(self.state.tool_offset - offset, -self.state.rotation);
+        self.state.pos = self.state.pos + shift;
         self.state.tool_offset = offset;
         self.emit(sink, Canon::UseToolLengthOffset(offset));
         Ok(())
     }
 
-    /// G20/G21: convert the position and the offsets in force (parameters keep their values).
+    /// G20/G21: convert the position and the offsets in force (parameters, in the machine's
+    /// units, keep their values).
     fn change_units(&mut self, units: Units) {
         if units == self.state.units {
             return;
@@ -342,32 +343,44 @@ impl Interpreter {
         s.units = units;
     }
 
-    /// G54 … G59.3.
+    /// G54 … G59.3: the tool stays where it is and its point is re-expressed in the new system.
     pub(super) fn select_coordinate_system(&mut self, index: usize, sink: &mut impl CanonSink) {
         if index == self.state.origin_index {
             self.comment_call(sink, "continuing to use same coordinate system".into());
             return;
         }
-        self.load_coordinate_system(index, sink);
+        let (origin, rotation) = self.coordinate_system(index);
+        let pos = self.state.current_in(origin, rotation);
+        self.activate_coordinate_system(index, origin, rotation, pos, sink);
         self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
         self.emit(sink, Canon::SetXyRotation(self.state.rotation));
     }
 
-    /// Make system `index` active with the offsets and rotation its parameters hold; the tool
-    /// stays where it is, so the program position is re-expressed in the new frame.
-    fn load_coordinate_system(&mut self, index: usize, sink: &mut impl CanonSink) {
-        let machine = self.state.to_machine(self.state.pos);
+    /// Offsets (program units) and XY rotation (degrees) stored for system `index`.
+    fn coordinate_system(&self, index: usize) -> (Pose, f64) {
         let base = coord_system_base(index);
+        (self.offset_params(base), self.params.get(base + 9))
+    }
+
+    /// Make system `index` active with `origin` and `rotation`, the current point being `pos`.
+    fn activate_coordinate_system(
+        &mut self,
+        index: usize,
+        origin: Pose,
+        rotation: f64,
+        pos: Pose,
+        sink: &mut impl CanonSink,
+    ) {
         self.state.origin_index = index;
         self.params.set(params::COORD_SYSTEM, index as f64);
-        self.state.origin = Pose(self.params.get6(base));
-        self.state.rotation = self.params.get(base + 9);
-        self.state.pos = self.state.from_machine(machine);
+        self.state.origin = origin;
+        self.state.rotation = rotation;
+        self.state.pos = pos;
         self.emit(
             sink,
             Canon::SetG5xOffset {
                 index: index as u8,
-                offset: self.state.origin,
+                offset: origin,
             },
         );
     }
@@ -389,7 +402,7 @@ impl Interpreter {
     /// G10, G28, G28.1, G30, G30.1, G52, G92, G92.1, G92.2, G92.3 (G4 and G53 are elsewhere).
     fn non_modal(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
         match g {
-            100 => self.set_coordinate_system(block, sink),
+            100 => self.set_coordinate_system(block, at, sink)?,
             280 | 300 => self.go_home(block, g, sink)?,
             281 | 301 => {
                 let base = if g == 281 {
@@ -397,10 +410,9 @@ impl Interpreter {
                 } else {
                     params::G30_HOME
                 };
-                let machine = self.state.to_machine(self.state.pos);
-                // Home positions are kept in millimetres.
-                self.params
-                    .set6(base, machine.scale_linear(self.state.units.mm()).0);
+                // The home point is where the spindle (not the tool tip) is.
+                let machine = self.state.to_machine(self.state.pos) + self.state.tool_offset;
+                self.set_offset_params(base, machine);
             }
             520 | 920 => self.set_axis_offsets(block, g == 520, sink),
             921 | 922 => {
@@ -413,7 +425,7 @@ impl Interpreter {
                 self.emit(sink, Canon::SetG92Offset(Pose::ZERO));
             }
             923 => {
-                let offset = Pose(self.params.get6(params::G92_OFFSET));
+                let offset = self.offset_params(params::G92_OFFSET);
                 self.state.pos = self.state.pos + self.state.axis_offset - offset;
                 self.state.axis_offset = offset;
                 self.params.set(params::G92_ENABLED, 1.0);
@@ -425,51 +437,40 @@ impl Interpreter {
         Ok(())
     }
 
-    /// G10 L2 / L20: set a coordinate system's offsets directly or so that the current point
-    /// takes the given coordinates.
-    fn set_coordinate_system(&mut self, block: &Block, sink: &mut impl CanonSink) {
+    /// G10 L2 / L20: set a coordinate system's offsets directly, or so that the current point
+    /// reads as the given coordinates in it.
+    fn set_coordinate_system(&mut self, block: &Block, at: u32, sink: &mut impl CanonSink) -> Exec {
         let l20 = block.get(b'l').is_some_and(|l| l as i64 == 20);
+        if l20 && block.has(b'r') {
+            return Err((ErrorKind::G10L20Rotation, at));
+        }
         // LinuxCNC checks round(P) but uses the truncated P.
         let p = block.get(b'p').unwrap_or(0.0).trunc() as usize;
         let index = if p == 0 { self.state.origin_index } else { p };
-        let base = coord_system_base(index);
-        let mut offset = Pose(self.params.get6(base));
-        let mut rotation = self.params.get(base + 9);
-        let machine = self.state.to_machine(self.state.pos);
+        let (mut offset, mut rotation) = self.coordinate_system(index);
         if let Some(r) = block.get(b'r') {
             rotation = r;
         }
         if l20 {
-            // The offsets that make the current point read as the given coordinates, solved
-            // in the target system's rotated frame: offset = machine − R(target + G92).
-            let target = block.axes_over(self.state.pos);
-            let solved = machine - state::rotate_xy(target + self.state.axis_offset, rotation);
-            let xy = block.has(b'x') || block.has(b'y');
-            for (i, word) in block.axis_words().into_iter().enumerate() {
-                if word.is_some() || (xy && i < 2) {
-                    offset.0[i] = solved.0[i];
-                }
-            }
+            // The offsets move by the difference between where the point is in that system
+            // and where it should read, turned into the unrotated frame.
+            let current = self.state.current_in(offset, rotation);
+            let wanted = block.axes_over(current);
+            offset = offset + state::rotate_xy(current - wanted, rotation);
         } else {
             offset = block.axes_over(offset);
         }
-        self.params.set6(base, offset.0);
+        let base = coord_system_base(index);
+        self.set_offset_params(base, offset);
         self.params.set(base + 9, rotation);
         if index == self.state.origin_index {
-            self.state.origin = offset;
-            self.state.rotation = rotation;
-            self.state.pos = self.state.from_machine(machine);
-            self.emit(
-                sink,
-                Canon::SetG5xOffset {
-                    index: index as u8,
-                    offset,
-                },
-            );
+            let pos = self.state.reframed(offset, rotation);
+            self.activate_coordinate_system(index, offset, rotation, pos, sink);
             self.emit(sink, Canon::SetXyRotation(rotation));
         } else {
             self.comment_call(sink, "setting coordinate system origin".into());
         }
+        Ok(())
     }
 
     /// G92 (offsets that make the current point the given coordinates) and G52 (local offsets).
@@ -486,8 +487,7 @@ impl Interpreter {
                 self.state.axis_offset.0[i] = new;
             }
         }
-        self.params
-            .set6(params::G92_OFFSET, self.state.axis_offset.0);
+        self.set_offset_params(params::G92_OFFSET, self.state.axis_offset);
         self.params.set(params::G92_ENABLED, 1.0);
         self.emit(sink, Canon::SetG92Offset(self.state.axis_offset));
     }
@@ -511,7 +511,9 @@ impl Interpreter {
 
     fn end_program(&mut self, pallet: bool, sink: &mut impl CanonSink) {
         // LinuxCNC reloads G54 even when it is already active.
-        self.load_coordinate_system(1, sink);
+        let (origin, rotation) = self.coordinate_system(1);
+        let pos = self.state.reframed(origin, rotation);
+        self.activate_coordinate_system(1, origin, rotation, pos, sink);
         self.emit(sink, Canon::SetXyRotation(self.state.rotation));
         if self.state.plane != Some(Plane::XY) {
             self.state.plane = Some(Plane::XY);

@@ -28,8 +28,10 @@ use crate::tooltable::ToolTable;
 #[derive(Debug, Clone, Default)]
 pub struct Config {
     pub tool_table: ToolTable,
-    /// Units of the tool table's offsets. LinuxCNC's standalone `rs274` reads them as inches.
-    pub tool_table_units: Units,
+    /// The machine's length units (LinuxCNC's external units): the tool table's offsets and
+    /// the offsets and home points kept in parameters (`#5161…`, `#5211…`, `#5221…`) are in
+    /// these, whatever G20/G21 is in force. LinuxCNC's standalone `rs274` uses inches.
+    pub machine_units: Units,
 }
 
 impl Config {
@@ -37,7 +39,7 @@ impl Config {
     pub fn linuxcnc(tool_table: ToolTable) -> Self {
         Config {
             tool_table,
-            tool_table_units: Units::Inches,
+            machine_units: Units::Inches,
         }
     }
 }
@@ -251,18 +253,32 @@ impl Interpreter {
         sink.call(self.origin, call);
     }
 
-    /// Linear factor from the tool table's units to the program's.
-    fn tool_units_factor(&self) -> f64 {
-        self.cfg.tool_table_units.mm() / self.state.units.mm()
+    /// A pose in the machine's units (tool table, parameters) in the program's units
+    /// (LinuxCNC's `USER_TO_PROGRAM_LEN`).
+    fn to_program_units(&self, p: Pose) -> Pose {
+        p.scale_linear(self.cfg.machine_units.mm() / self.state.units.mm())
+    }
+
+    /// A pose in the program's units in the machine's (LinuxCNC's `PROGRAM_TO_USER_LEN`).
+    fn to_machine_units(&self, p: Pose) -> Pose {
+        p.scale_linear(self.state.units.mm() / self.cfg.machine_units.mm())
+    }
+
+    /// Six offset parameters from `base` on, in program units.
+    fn offset_params(&self, base: usize) -> Pose {
+        self.to_program_units(Pose(self.params.get6(base)))
+    }
+
+    /// Store an offset given in program units in the six parameters from `base` on.
+    fn set_offset_params(&mut self, base: usize, p: Pose) {
+        let stored = self.to_machine_units(p);
+        self.params.set6(base, stored.0);
     }
 
     /// Tool offsets of `tool` from the table, in program units.
     fn table_offset(&self, number: i64) -> Option<Pose> {
-        let k = self.tool_units_factor();
-        self.cfg
-            .tool_table
-            .get(number)
-            .map(|t| t.offset.scale_linear(k))
+        let offset = self.cfg.tool_table.get(number)?.offset;
+        Some(self.to_program_units(offset))
     }
 }
 

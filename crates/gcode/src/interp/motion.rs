@@ -82,11 +82,7 @@ impl Interpreter {
             self.emit(sink, Canon::StraightTraverse(end));
         } else {
             if let Some(f) = self.feed_for_move(block, false, at)? {
-                let d = end - self.state.pos;
-                let length = match d.linear_norm() {
-                    l if l > 0.0 => l,
-                    _ => d.rotary_norm(),
-                };
+                let length = straight_length(end - self.state.pos);
                 self.emit(sink, Canon::SetFeedRate(inverse_time_rate(f, length)));
             }
             self.emit(sink, Canon::StraightFeed(end));
@@ -106,10 +102,11 @@ impl Interpreter {
         } else {
             params::G30_HOME
         };
-        let home_mm = Pose(self.params.get6(base));
+        // The stored point is the spindle's; the tool tip ends a tool length below it.
+        let home_machine = self.offset_params(base);
         let home = self
             .state
-            .from_machine(home_mm.scale_linear(1.0 / self.state.units.mm()));
+            .from_machine(home_machine - self.state.tool_offset);
         let words = block.axis_words();
         let any = words.iter().any(Option::is_some);
         let mut end = intermediate;
@@ -217,6 +214,20 @@ impl Interpreter {
         );
         self.state.pos = end;
         Ok(())
+    }
+}
+
+/// Below this (program units) an axis does not count as moving when a straight move's length
+/// is measured (LinuxCNC's `find_straight_length`).
+const STILL: f64 = 1e-7;
+
+/// Length of a straight move for its inverse-time rate: the XYZ distance if X, Y or Z moves,
+/// else the rotary distance in degrees (LinuxCNC's `find_straight_length`).
+fn straight_length(d: Pose) -> f64 {
+    if d.0[..3].iter().any(|v| v.abs() > STILL) {
+        d.linear_norm()
+    } else {
+        d.rotary_norm()
     }
 }
 

@@ -93,6 +93,24 @@ impl State {
         rotate_xy(m - self.origin, -self.rotation) - self.axis_offset
     }
 
+    /// The current point in the frame of another coordinate system (origin and rotation),
+    /// with the G92 offsets in force (LinuxCNC's `find_current_in_system`).
+    pub fn current_in(&self, origin: Pose, rotation: f64) -> Pose {
+        rotate_xy(self.to_machine(self.pos) - origin, -rotation) - self.axis_offset
+    }
+
+    /// The current point after the active system's origin and rotation change in place (G10
+    /// on the active system, M2). LinuxCNC re-expresses it as `R(−r')(R(r)·p + o − o')`,
+    /// which leaves the G92 offsets out of the rotation, unlike `current_in`; the two agree
+    /// unless a rotation changes while G92 offsets are in force. tezgah keeps LinuxCNC's
+    /// arithmetic so that the same program ends at the same place.
+    pub fn reframed(&self, origin: Pose, rotation: f64) -> Pose {
+        rotate_xy(
+            rotate_xy(self.pos, self.rotation) + self.origin - origin,
+            -rotation,
+        )
+    }
+
     pub fn inches(&self) -> bool {
         self.units == Units::Inches
     }
