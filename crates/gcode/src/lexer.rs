@@ -11,6 +11,13 @@ use crate::error::ErrorKind;
 /// Byte that stands in the normalised text where a `( … )` comment was.
 pub const COMMENT_MARK: u8 = 0x01;
 
+/// Whether `b` is copied to the normalised text as it is (lower-cased): anything but blanks,
+/// comment openers, `%` and the comment marker.
+#[inline]
+fn is_plain(b: u8) -> bool {
+    !matches!(b, b' ' | b'\t' | b'\r' | b';' | b'(' | b'%' | COMMENT_MARK)
+}
+
 /// A `( … )` comment: its text without the parentheses and leading blanks, and where it began.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Comment {
@@ -29,6 +36,9 @@ pub struct NormLine {
     pub at: Vec<u32>,
     /// The comments, in order; the i-th [`COMMENT_MARK`] stands for the i-th comment.
     pub comments: Vec<Comment>,
+    /// Byte offset in the source line of a `%` that no comment precedes. Lexing stops there:
+    /// such a line is either a lone `%` (a program delimiter) or an error.
+    pub percent: Option<usize>,
 }
 
 impl NormLine {
@@ -38,24 +48,41 @@ impl NormLine {
         self.text.clear();
         self.at.clear();
         self.comments.clear();
+        self.percent = None;
         let bytes = raw.as_bytes();
+        self.text.reserve(bytes.len());
+        self.at.reserve(bytes.len());
         let mut i = 0;
         while i < bytes.len() {
-            let b = bytes[i];
-            match b {
-                b' ' | b'\t' | b'\r' => {}
+            // Copy a run of ordinary bytes at once: it is most of every line.
+            let run = bytes[i..].iter().take_while(|&&b| is_plain(b)).count();
+            if run > 0 {
+                let end = i + run;
+                self.text
+                    .extend(bytes[i..end].iter().map(u8::to_ascii_lowercase));
+                self.at.extend(i as u32..end as u32);
+                i = end;
+                continue;
+            }
+            match bytes[i] {
                 // A semicolon makes the rest of the line a comment that LinuxCNC ignores.
                 b';' => break,
                 b'(' => {
                     i = self.lex_comment(raw, i)?;
                     continue;
                 }
-                // The source may not hold the byte that stands for a comment here.
-                COMMENT_MARK => return Err((ErrorKind::BadCharacter(b as char), i)),
-                _ => {
-                    self.text.push(b.to_ascii_lowercase());
+                b'%' if self.comments.is_empty() => {
+                    self.percent = Some(i);
+                    break;
+                }
+                b'%' => {
+                    self.text.push(b'%');
                     self.at.push(i as u32);
                 }
+                // The source may not hold the byte that stands for a comment here.
+                COMMENT_MARK => return Err((ErrorKind::BadCharacter(COMMENT_MARK as char), i)),
+                // Blanks.
+                _ => {}
             }
             i += 1;
         }

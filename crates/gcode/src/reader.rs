@@ -214,7 +214,7 @@ impl<'a> Reader<'a> {
     pub fn integer_value(&mut self) -> ReadResult<i64> {
         let start = self.pos;
         let v = self.real_value()?;
-        integer_of(v).ok_or((ErrorKind::NonIntegerValue, start))
+        integer_of(v).ok_or_else(|| (ErrorKind::NonIntegerValue, start))
     }
 
     /// A literal number: signs, then digits and dots, read exactly as C++ streams read them.
@@ -226,33 +226,35 @@ impl<'a> Reader<'a> {
             i += 1;
         }
         let signs = i - start;
-        let mut first_extra_dot = None;
+        // One pass gathers the digits as an integer (while they fit) for the quick path.
+        let mut digits = Digits::default();
         let mut dots = 0;
-        let mut digits = 0;
-        while i < t.len() && matches!(t[i], b'0'..=b'9' | b'.') {
-            if t[i] == b'.' {
-                dots += 1;
-                if dots == 2 {
-                    first_extra_dot = Some(i);
-                }
-            } else if first_extra_dot.is_none() {
-                digits += 1;
+        while let Some(&b) = t.get(i) {
+            match b {
+                b'0'..=b'9' if dots < 2 => digits.push(b - b'0', dots == 1),
+                b'0'..=b'9' => {}
+                b'.' => dots += 1,
+                _ => break,
             }
             i += 1;
         }
-        let whole = String::from_utf8_lossy(&t[start..i]).into_owned();
-        if signs > 1 || digits == 0 {
-            return Err((ErrorKind::BadNumberFormat(whole), start));
+        let whole = || String::from_utf8_lossy(&t[start..i]).into_owned();
+        if signs > 1 || digits.count == 0 {
+            return Err((ErrorKind::BadNumberFormat(whole()), start));
         }
-        if first_extra_dot.is_some() {
-            return Err((ErrorKind::TrailingCharacters(whole), start));
+        if dots > 1 {
+            return Err((ErrorKind::TrailingCharacters(whole()), start));
         }
-        // The slice holds ASCII signs, digits and at most one dot, with a digit: valid UTF-8 and
-        // valid for Rust's correctly rounded float parser (the same grammar as C's strtod here).
-        let v: f64 = std::str::from_utf8(&t[start..i])
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .ok_or((ErrorKind::BadNumberFormat(whole), start))?;
+        let v = match digits.exact_value() {
+            Some(v) if t[start] == b'-' => -v,
+            Some(v) => v,
+            // The slice holds ASCII signs, digits and at most one dot, with a digit: valid
+            // UTF-8 and valid for Rust's correctly rounded float parser (C's strtod grammar).
+            None => std::str::from_utf8(&t[start..i])
+                .ok()
+                .and_then(|s| s.parse().ok())
+                .ok_or_else(|| (ErrorKind::BadNumberFormat(whole()), start))?,
+        };
         self.pos = i;
         Ok(v)
     }
@@ -425,6 +427,47 @@ pub fn integer_of(v: f64) -> Option<i64> {
     ((v - r).abs() < 1e-4 && r.abs() < 9.0e15).then_some(r as i64)
 }
 
+/// Exact powers of ten up to 10²² (every one is an `f64` without rounding).
+const POW10: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// The digits of a decimal number read so far, as one integer while it fits.
+#[derive(Default)]
+struct Digits {
+    count: usize,
+    /// All digits as an integer, `None` once it overflowed.
+    mantissa: Option<u64>,
+    /// Digits after the decimal point.
+    decimals: usize,
+}
+
+impl Digits {
+    fn push(&mut self, digit: u8, after_point: bool) {
+        let m = if self.count == 0 {
+            Some(0)
+        } else {
+            self.mantissa
+        };
+        self.mantissa = m
+            .and_then(|m| m.checked_mul(10))
+            .and_then(|m| m.checked_add(u64::from(digit)));
+        self.count += 1;
+        self.decimals += usize::from(after_point);
+    }
+
+    /// The number's magnitude when it can be had exactly the quick way: with at most 2⁵³ as
+    /// the integer of its digits and at most 22 decimals, the digits and the power of ten are
+    /// both exact `f64`s, so their one correctly rounded quotient is the correctly rounded
+    /// value (Clinger, "How to read floating point numbers accurately", 1990). `None` sends the
+    /// number to the general parser.
+    fn exact_value(&self) -> Option<f64> {
+        let m = self.mantissa.filter(|&m| m <= 1 << 53)?;
+        Some(m as f64 / *POW10.get(self.decimals)?)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -450,6 +493,37 @@ mod tests {
             eval("-."),
             Err((ErrorKind::BadNumberFormat("-.".into()), 0))
         );
+    }
+
+    /// Numbers read bit for bit as the general (correctly rounded) parser reads them, on the
+    /// quick path and off it.
+    #[test]
+    fn numbers_match_the_general_parser() {
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..200_000 {
+            let int = next() % 10u64.pow((next() % 20) as u32);
+            let decimals = (next() % 25) as usize;
+            let frac = next() % 10u64.pow(decimals.min(19) as u32);
+            let sign = ["", "-", "+"][(next() % 3) as usize];
+            let text = if decimals == 0 {
+                format!("{sign}{int}.")
+            } else {
+                format!("{sign}{int}.{frac:0decimals$}")
+            };
+            let general: f64 = text.parse().unwrap();
+            assert_eq!(
+                eval(&text).map(f64::to_bits),
+                Ok(general.to_bits()),
+                "{text}"
+            );
+        }
+        assert_eq!(eval("-0.0").map(f64::to_bits), Ok((-0.0f64).to_bits()));
     }
 
     #[test]

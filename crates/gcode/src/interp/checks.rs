@@ -131,20 +131,29 @@ fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<()
     Ok(())
 }
 
+/// Letters whose use `check_other_words` restricts to certain codes.
+const RULED_LETTERS: [u8; 10] = [b'd', b'e', b'h', b'i', b'j', b'k', b'l', b'p', b'q', b'r'];
+
 fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckError> {
     let mode0 = block.g(ggroup::NON_MODAL);
     let g10 = mode0 == Some(100);
     let arc = matches!(motion, Some(20 | 30));
     let cycle = motion.is_some_and(is_canned_cycle);
     let m = |group| block.m(group);
-    for (letter, kind) in [
-        (b'a', ErrorKind::AInCannedCycle),
-        (b'b', ErrorKind::BInCannedCycle),
-        (b'c', ErrorKind::CInCannedCycle),
-    ] {
-        if cycle && block.has(letter) {
-            return Err((kind, block.word(letter).map_or(0, |w| w.at)));
+    if cycle {
+        for (letter, kind) in [
+            (b'a', ErrorKind::AInCannedCycle),
+            (b'b', ErrorKind::BInCannedCycle),
+            (b'c', ErrorKind::CInCannedCycle),
+        ] {
+            if let Some(w) = block.word(letter) {
+                return Err((kind, w.at));
+            }
         }
+    }
+    // Most blocks (`G1 X… Y… Z…`) carry none of the words below: no rule to check then.
+    if !RULED_LETTERS.iter().any(|&c| block.has(c)) {
+        return Ok(());
     }
     let rule = |letter: u8, allowed: bool, kind: ErrorKind| -> Result<(), CheckError> {
         match block.word(letter) {

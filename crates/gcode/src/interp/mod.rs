@@ -67,7 +67,9 @@ pub struct Interpreter {
     state: State,
     params: Params,
     norm: NormLine,
-    block: Block,
+    /// The block buffer, reused from line to line. Boxed so that lending it out while the
+    /// block executes moves a pointer, not the block.
+    block: Option<Box<Block>>,
     percent: Percent,
     ended: bool,
     /// Source line being executed, for the canonical calls' origin.
@@ -98,7 +100,7 @@ impl Interpreter {
             state: State::default(),
             params,
             norm: NormLine::default(),
-            block: Block::default(),
+            block: Some(Box::default()),
             percent: Percent::Unknown,
             ended: false,
             origin: Origin::default(),
@@ -175,6 +177,21 @@ impl Interpreter {
         if self.ended {
             return Ok(Flow::End);
         }
+        let mut block = self.block.take().unwrap_or_default();
+        let result = self.read_and_execute(&mut block, line, sink);
+        self.block = Some(block);
+        result
+    }
+
+    fn read_and_execute(
+        &mut self,
+        block: &mut Block,
+        line: LineRef,
+        sink: &mut impl CanonSink,
+    ) -> Result<Flow, GcodeError> {
+        self.norm
+            .lex(line.text)
+            .map_err(|(kind, byte)| GcodeError::new(kind, line.span(byte)))?;
         if let Some(flow) = self.percent_line(line)? {
             if flow == Flow::End {
                 sink.call(Origin::default(), Canon::Finish);
@@ -184,14 +201,7 @@ impl Interpreter {
         // Programs read the current point from #5420…#5425 (program coordinates).
         self.params
             .set6(crate::params::CURRENT_POSITION, self.state.pos.0);
-        let Self {
-            norm,
-            block,
-            params,
-            ..
-        } = self;
-        norm.lex(line.text)
-            .map_err(|(kind, byte)| GcodeError::new(kind, line.span(byte)))?;
+        let Self { norm, params, .. } = self;
         let to_span = |norm: &NormLine, idx: usize| {
             let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
             line.span(byte)
@@ -204,19 +214,17 @@ impl Interpreter {
         }
         self.origin = Origin {
             line: line.number,
-            n: self.block.n,
+            n: block.n,
         };
-        let block = std::mem::take(&mut self.block);
-        let result = self.execute_block(&block, line, sink);
-        self.block = block;
-        result
+        self.execute_block(block, line, sink)
     }
 
-    /// Handle `%` lines. `Some(flow)` when the line was a percent line.
+    /// Handle `%` lines (after lexing, which finds the `%`). `Some(flow)` when the line was
+    /// a percent line.
     fn percent_line(&mut self, line: LineRef) -> Result<Option<Flow>, GcodeError> {
-        let is_percent = line.text.trim() == "%";
-        let first = self.percent == Percent::Unknown;
-        if first {
+        let percent_at = self.norm.percent;
+        let is_percent = percent_at.is_some() && line.text.trim() == "%";
+        if self.percent == Percent::Unknown {
             self.percent = if is_percent {
                 Percent::Open
             } else {
@@ -229,14 +237,11 @@ impl Interpreter {
             self.ended = true;
             return Ok(Some(Flow::End));
         }
-        if let Some(at) = line.text.find('%') {
-            // A `%` anywhere else is not G-code.
-            let before = &line.text[..at];
-            if !before.contains('(') && !before.contains(';') {
-                return Err(GcodeError::new(ErrorKind::BadCharacter('%'), line.span(at)));
-            }
+        match percent_at {
+            // A `%` anywhere else, outside comments, is not G-code.
+            Some(at) => Err(GcodeError::new(ErrorKind::BadCharacter('%'), line.span(at))),
+            None => Ok(None),
         }
-        Ok(None)
     }
 
     /// Apply a block's parameter assignments (after the whole line was read, as LinuxCNC).
@@ -307,7 +312,7 @@ pub fn lines(program: &str) -> impl Iterator<Item = LineRef<'_>> {
 }
 
 fn memchr_newline(s: &[u8]) -> usize {
-    s.iter().position(|&b| b == b'\n').unwrap_or(s.len())
+    memchr::memchr(b'\n', s).unwrap_or(s.len())
 }
 
 /// Pre-flight: interpret the whole program and collect every error instead of stopping at the

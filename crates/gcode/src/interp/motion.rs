@@ -182,12 +182,14 @@ impl Interpreter {
                     c[k] = if self.state.ijk_incremental {
                         s2[k] + v.unwrap_or(0.0)
                     } else {
-                        v.ok_or((
-                            ErrorKind::ArcAbsoluteCenterMissing(
-                                (letter as char).to_ascii_uppercase(),
-                            ),
-                            at,
-                        ))?
+                        v.ok_or_else(|| {
+                            (
+                                ErrorKind::ArcAbsoluteCenterMissing(
+                                    (letter as char).to_ascii_uppercase(),
+                                ),
+                                at,
+                            )
+                        })?
                     };
                 }
                 center_from_offset(s2, e2, c, tol, letters)
