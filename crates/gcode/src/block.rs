@@ -203,7 +203,7 @@ impl Block {
             return Err((ErrorKind::NegativeGCode, start));
         }
         let code = code as u32;
-        let group = g_group(code).ok_or_else(|| (ErrorKind::UnknownGCode, start))?;
+        let group = g_group(code).ok_or((ErrorKind::UnknownGCode, start))?;
         if self.g[group].is_some() {
             return Err((ErrorKind::TwoGCodesSameGroup, start));
         }
@@ -221,7 +221,7 @@ impl Block {
         if value > 199 {
             return Err((ErrorKind::MCodeTooBig(value), start));
         }
-        let group = m_group(value).ok_or_else(|| (ErrorKind::UnknownMCode(value), start))?;
+        let group = m_group(value).ok_or((ErrorKind::UnknownMCode(value), start))?;
         if self.m[group].is_some() {
             return Err((ErrorKind::TwoMCodesSameGroup, start));
         }

@@ -214,7 +214,7 @@ impl<'a> Reader<'a> {
     pub fn integer_value(&mut self) -> ReadResult<i64> {
         let start = self.pos;
         let v = self.real_value()?;
-        integer_of(v).ok_or_else(|| (ErrorKind::NonIntegerValue, start))
+        integer_of(v).ok_or((ErrorKind::NonIntegerValue, start))
     }
 
     /// A literal number: signs, then digits and dots, read exactly as C++ streams read them.

@@ -311,7 +311,7 @@ impl Interpreter {
                 None | Some(0) => self.state.spindle_tool_offset,
                 Some(h) => self
                     .table_offset(h)
-                    .ok_or_else(|| (ErrorKind::ToolNotFound(h), at))?,
+                    .ok_or((ErrorKind::ToolNotFound(h), at))?,
             },
             // Axes it does not name keep their offsets.
             431 => block.axes_over(self.state.tool_offset),
