@@ -34,6 +34,80 @@ pub struct Assignment {
     pub at: u32,
 }
 
+/// The label of an O-word: `o100` or `o<name>` (lower case, blanks removed).
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub enum OLabel {
+    Number(i64),
+    Name(String),
+}
+
+impl std::fmt::Display for OLabel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            OLabel::Number(n) => write!(f, "{n}"),
+            OLabel::Name(s) => write!(f, "<{s}>"),
+        }
+    }
+}
+
+/// What an O-word line does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OKeyword {
+    Sub,
+    EndSub,
+    Call,
+    Return,
+    Do,
+    While,
+    EndWhile,
+    If,
+    ElseIf,
+    Else,
+    EndIf,
+    Break,
+    Continue,
+    Repeat,
+    EndRepeat,
+}
+
+impl OKeyword {
+    const NAMES: [(&'static [u8], OKeyword); 15] = [
+        (b"sub", OKeyword::Sub),
+        (b"endsub", OKeyword::EndSub),
+        (b"call", OKeyword::Call),
+        (b"return", OKeyword::Return),
+        (b"do", OKeyword::Do),
+        (b"while", OKeyword::While),
+        (b"endwhile", OKeyword::EndWhile),
+        (b"if", OKeyword::If),
+        (b"elseif", OKeyword::ElseIf),
+        (b"else", OKeyword::Else),
+        (b"endif", OKeyword::EndIf),
+        (b"break", OKeyword::Break),
+        (b"continue", OKeyword::Continue),
+        (b"repeat", OKeyword::Repeat),
+        (b"endrepeat", OKeyword::EndRepeat),
+    ];
+
+    pub fn name(self) -> &'static str {
+        let (name, _) = Self::NAMES
+            .iter()
+            .find(|(_, k)| *k == self)
+            .expect("every keyword is named");
+        std::str::from_utf8(name).unwrap_or("?")
+    }
+}
+
+/// An O-word: label, keyword and the bracketed values that follow (call arguments, the
+/// condition of `if`/`elseif`/`while`, the count of `repeat`, the value of `return`/`endsub`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct OWord {
+    pub label: OLabel,
+    pub keyword: OKeyword,
+    pub args: Vec<f64>,
+    pub at: u32,
+}
+
 /// One block. Letters other than G, M, N and O are kept by their position in the alphabet.
 #[derive(Debug, Clone, Default)]
 pub struct Block {
@@ -46,6 +120,8 @@ pub struct Block {
     /// Index into the line's comments of the comment that counts (the last one, as LinuxCNC).
     pub comment: Option<usize>,
     pub assignments: Vec<Assignment>,
+    /// The O-word, on a control-flow line (which holds nothing else but comments).
+    pub o: Option<OWord>,
 }
 
 /// Letters of the six axes, in [`Pose`] order.
@@ -134,6 +210,7 @@ impl Block {
         self.m_count = 0;
         self.comment = None;
         self.assignments.clear();
+        self.o = None;
     }
 
     /// Read the normalised line `line` into `self`. `Ok(false)` means the line is deleted by
@@ -152,6 +229,15 @@ impl Block {
                 return Err((ErrorKind::BadLineNumber, 1));
             }
             self.n = Some(v.trunc() as i64);
+        }
+        if text.get(r.pos) == Some(&b'o') {
+            let at = line.at[r.pos];
+            self.o = Some(read_o_word(&mut r, at, true)?);
+            // Only comments may follow (they are not executed on control lines).
+            if let Some(i) = text[r.pos..].iter().position(|&c| c != COMMENT_MARK) {
+                return Err((ErrorKind::WordsAfterOWord, r.pos + i));
+            }
+            return Ok(true);
         }
         let mut comment_index = 0;
         while r.pos < text.len() {
@@ -259,6 +345,84 @@ impl Block {
         }
         self.words[slot] = Some(Word { value, at });
         Ok(())
+    }
+}
+
+/// Read an O-word from `r` (at its `o`): label, keyword and, when `evaluate`, the bracketed
+/// values after it (control flow that is being skipped reads only label and keyword).
+pub fn read_o_word(r: &mut Reader, at: u32, evaluate: bool) -> ReadResult<OWord> {
+    let start = r.pos;
+    r.pos += 1;
+    let label = match r.text.get(r.pos) {
+        Some(b'<') => {
+            let close = r.text[r.pos..]
+                .iter()
+                .position(|&c| c == b'>')
+                .ok_or((ErrorKind::NamedParameterNotTerminated, r.pos))?;
+            let name = String::from_utf8_lossy(&r.text[r.pos + 1..r.pos + close]).into_owned();
+            r.pos += close + 1;
+            OLabel::Name(name)
+        }
+        Some(c) if c.is_ascii_digit() || matches!(c, b'[' | b'#' | b'+' | b'.') => {
+            OLabel::Number(r.integer_value()?)
+        }
+        _ => return Err((ErrorKind::OLabelMissing, start)),
+    };
+    let word_start = r.pos;
+    let letters = r.text[r.pos..]
+        .iter()
+        .take_while(|c| c.is_ascii_lowercase())
+        .count();
+    let word = &r.text[r.pos..r.pos + letters];
+    let keyword = OKeyword::NAMES
+        .iter()
+        .find(|(name, _)| *name == word)
+        .map(|&(_, k)| k)
+        .ok_or_else(|| {
+            let text = String::from_utf8_lossy(word).into_owned();
+            (ErrorKind::UnknownOKeyword(text), word_start)
+        })?;
+    r.pos += letters;
+    let mut args = Vec::new();
+    // Values in brackets, with comments allowed between them.
+    loop {
+        let comments = r.text[r.pos..]
+            .iter()
+            .take_while(|&&c| c == COMMENT_MARK)
+            .count();
+        if r.text.get(r.pos + comments) != Some(&b'[') {
+            break;
+        }
+        r.pos += comments;
+        if evaluate {
+            args.push(r.expression()?);
+        } else {
+            skip_brackets(r);
+        }
+    }
+    Ok(OWord {
+        label,
+        keyword,
+        args,
+        at,
+    })
+}
+
+/// Move past one bracketed expression without evaluating it.
+fn skip_brackets(r: &mut Reader) {
+    let mut depth = 0usize;
+    while let Some(&c) = r.text.get(r.pos) {
+        r.pos += 1;
+        match c {
+            b'[' => depth += 1,
+            b']' => {
+                depth = depth.saturating_sub(1);
+                if depth == 0 {
+                    return;
+                }
+            }
+            _ => {}
+        }
     }
 }
 

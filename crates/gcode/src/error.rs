@@ -220,6 +220,28 @@ pub enum ErrorKind {
     #[error("Cannot use g53 incremental")]
     G53Incremental,
 
+    // --- O-words ---
+    #[error("Unknown control word after O-word: {0}")]
+    UnknownOKeyword(String),
+    #[error("O-word label missing")]
+    OLabelMissing,
+    #[error("Words other than comments on an O-word line")]
+    WordsAfterOWord,
+    #[error("Nested subroutine definition")]
+    NestedSubroutine,
+    #[error("Unable to find subroutine o{0}")]
+    SubroutineNotFound(String),
+    #[error("{0} o{1} without a matching start")]
+    UnmatchedOWord(&'static str, String),
+    #[error("End of file while looking for o{0} {1}")]
+    OWordTargetMissing(String, &'static str),
+    #[error("Loop o{0} ran more than {1} times")]
+    RunawayLoop(String, u64),
+    #[error("Subroutine calls nested deeper than {0}")]
+    CallsTooDeep(usize),
+    #[error("{0} needs a [value]")]
+    OWordNeedsValue(&'static str),
+
     // --- G10 and offsets ---
     #[error("Line with G10 does not have L0, L1, L10, L11, L2, or L20")]
     G10MissingL,

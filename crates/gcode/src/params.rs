@@ -2,7 +2,9 @@
 //!
 //! Numbered parameters that were never set read as zero, as in LinuxCNC. The interpreter keeps
 //! its offsets in the reserved numbers (`#5221…` for G54, `#5211…` for G92, `#5161…` for G28,
-//! …) so that a program can read them.
+//! …) so that a program can read them. Named parameters are local to the subroutine call that
+//! sets them unless their name starts with `_` (global); the interpreter's own read-only
+//! values (`#<_x>`, `#<_metric>`, `#<_line>`, …) are `system` values it refreshes per line.
 
 use std::collections::HashMap;
 
@@ -22,25 +24,116 @@ pub const COORD_SYSTEM: usize = 5220;
 pub const G54_OFFSET: usize = 5221;
 /// Current position X…C in program coordinates (read-only for programs).
 pub const CURRENT_POSITION: usize = 5420;
+/// Current position X…C in machine coordinates, as G53 names it (read-only for programs).
+pub const MACHINE_POSITION: usize = 5021;
 
 /// The first parameter of work-coordinate system `n` (1 = G54 … 9 = G59.3).
 pub fn coord_system_base(n: usize) -> usize {
     G54_OFFSET + 20 * (n - 1)
 }
 
+/// Parameters a subroutine call gets from its arguments (`#1`…`#30`), restored on return.
+pub const CALL_PARAMETERS: usize = 30;
+
 /// Numbered and named parameters.
 #[derive(Debug, Clone)]
 pub struct Params {
     numbered: Vec<f64>,
-    named: HashMap<String, f64>,
+    /// `#<_name>` parameters, shared by the whole program.
+    globals: HashMap<String, f64>,
+    /// `#<name>` parameters of each active call level; the main program is level 0.
+    locals: Vec<HashMap<String, f64>>,
+    /// Read-only values the interpreter publishes (`#<_x>`, `#<_feed>`, …).
+    pub system: SystemValues,
 }
 
 impl Default for Params {
     fn default() -> Self {
         Params {
             numbered: vec![0.0; MAX_PARAMETERS],
-            named: HashMap::new(),
+            globals: HashMap::new(),
+            locals: vec![HashMap::new()],
+            system: SystemValues::default(),
         }
+    }
+}
+
+/// The interpreter's state as LinuxCNC's predefined named parameters show it. Lengths are in
+/// program units, angles in degrees, flags 1 or 0.
+#[derive(Debug, Clone, Default)]
+pub struct SystemValues {
+    /// `#<_line>`: the line being executed (1-based).
+    pub line: f64,
+    /// `#<_x>` … `#<_c>`: the current point in program coordinates.
+    pub position: [f64; 6],
+    /// `#<_abs_x>` … `#<_abs_c>`: the current point in machine coordinates.
+    pub machine_position: [f64; 6],
+    pub motion_mode: f64,
+    pub plane: f64,
+    pub metric: f64,
+    pub absolute: f64,
+    pub ijk_absolute: f64,
+    pub inverse_time: f64,
+    pub units_per_minute: f64,
+    pub units_per_rev: f64,
+    pub coord_system: f64,
+    pub tool_offset: f64,
+    pub feed: f64,
+    pub rpm: f64,
+    pub spindle_on: f64,
+    pub spindle_cw: f64,
+    pub mist: f64,
+    pub flood: f64,
+    pub selected_tool: f64,
+    pub call_level: f64,
+    pub value: f64,
+    pub value_returned: f64,
+}
+
+impl SystemValues {
+    /// The value of predefined parameter `name` (lower case, with its `_`), if it is one.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        let axis = |prefix: &str| {
+            let letter = name.strip_prefix(prefix)?;
+            let i = ["x", "y", "z", "a", "b", "c"]
+                .iter()
+                .position(|&l| l == letter)?;
+            Some(i)
+        };
+        if let Some(i) = axis("_abs_") {
+            return Some(self.machine_position[i]);
+        }
+        if let Some(i) = axis("_") {
+            return Some(self.position[i]);
+        }
+        Some(match name {
+            "_line" => self.line,
+            "_motion_mode" => self.motion_mode,
+            "_plane" => self.plane,
+            "_metric" => self.metric,
+            "_imperial" => 1.0 - self.metric,
+            "_absolute" => self.absolute,
+            "_incremental" => 1.0 - self.absolute,
+            "_ijk_absolute_mode" => self.ijk_absolute,
+            "_inverse_time" => self.inverse_time,
+            "_units_per_minute" => self.units_per_minute,
+            "_units_per_rev" => self.units_per_rev,
+            "_coord_system" => self.coord_system,
+            "_tool_offset" => self.tool_offset,
+            "_feed" => self.feed,
+            "_rpm" => self.rpm,
+            "_spindle_on" => self.spindle_on,
+            "_spindle_cw" => self.spindle_cw,
+            "_mist" => self.mist,
+            "_flood" => self.flood,
+            "_selected_tool" => self.selected_tool,
+            "_call_level" => self.call_level,
+            "_value" => self.value,
+            "_value_returned" => self.value_returned,
+            "_vmajor" => 2.0,
+            "_vminor" => 9.0,
+            _ => return None,
+        })
     }
 }
 
@@ -68,15 +161,51 @@ impl Params {
         self.numbered[base..base + 6].copy_from_slice(&v);
     }
 
+    /// The value of `#<name>`: a predefined value, a global, or a local of the current call.
     pub fn named(&self, name: &str) -> Option<f64> {
-        self.named.get(name).copied()
+        if name.starts_with('_') {
+            return self
+                .system
+                .get(name)
+                .or_else(|| self.globals.get(name).copied());
+        }
+        self.locals.last()?.get(name).copied()
     }
 
     pub fn set_named(&mut self, name: &str, v: f64) {
-        if let Some(slot) = self.named.get_mut(name) {
+        let map = if name.starts_with('_') {
+            &mut self.globals
+        } else {
+            match self.locals.last_mut() {
+                Some(map) => map,
+                None => return,
+            }
+        };
+        if let Some(slot) = map.get_mut(name) {
             *slot = v;
         } else {
-            self.named.insert(name.to_string(), v);
+            map.insert(name.to_string(), v);
         }
+    }
+
+    /// Enter a subroutine: a fresh set of locals and `#1`…`#30` from `args` (the rest zero).
+    /// Returns the caller's `#1`…`#30`, to be given back to [`Self::leave_call`].
+    pub fn enter_call(&mut self, args: &[f64]) -> [f64; CALL_PARAMETERS] {
+        let saved = std::array::from_fn(|i| self.numbered[i + 1]);
+        for i in 0..CALL_PARAMETERS {
+            self.numbered[i + 1] = args.get(i).copied().unwrap_or(0.0);
+        }
+        self.locals.push(HashMap::new());
+        self.system.call_level = (self.locals.len() - 1) as f64;
+        saved
+    }
+
+    /// Leave a subroutine: drop its locals and restore the caller's `#1`…`#30`.
+    pub fn leave_call(&mut self, saved: [f64; CALL_PARAMETERS]) {
+        self.numbered[1..=CALL_PARAMETERS].copy_from_slice(&saved);
+        if self.locals.len() > 1 {
+            self.locals.pop();
+        }
+        self.system.call_level = (self.locals.len() - 1) as f64;
     }
 }

@@ -403,15 +403,23 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// `exists[#<name>]`: 1 if the named parameter is defined (numbered ones always exist).
+    /// `exists[#<name>]`: 1 if the named parameter is defined (numbered ones exist when their
+    /// number is in range).
     fn exists(&mut self) -> ReadResult<f64> {
         self.pos += 1; // '['
         if self.peek() != Some(b'#') {
             return self.err(ErrorKind::ExpectedHash);
         }
-        let found = match self.parameter_ref()? {
-            ParamRef::Numbered(_) => true,
-            ParamRef::Named(name) => self.params.named(&name).is_some(),
+        // A numbered parameter exists when its number is in range (an out-of-range number is
+        // an error only where it is read, as in `EXISTS[###2]`).
+        let found = if self.text.get(self.pos + 1) == Some(&b'<') {
+            match self.parameter_ref()? {
+                ParamRef::Named(name) => self.params.named(&name).is_some(),
+                ParamRef::Numbered(_) => true,
+            }
+        } else {
+            self.pos += 1;
+            Params::in_range(self.integer_value()?)
         };
         if self.peek() != Some(b']') {
             return self.err(ErrorKind::ExpectedCloseBracket);

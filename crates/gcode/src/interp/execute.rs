@@ -539,9 +539,8 @@ impl Interpreter {
             self.emit(sink, Canon::PalletShuttle);
         }
         self.emit(sink, Canon::ProgramEnd);
-        if self.percent == super::Percent::Open {
-            self.comment_call(sink, "percent sign missing from end of file".into());
-        }
+        // In a `%` program, LinuxCNC looks past M2/M30 for the closing `%`.
+        self.closing_percent_sought = self.percent == super::Percent::Open;
         self.state.motion = Some(10);
         self.ended = true;
     }

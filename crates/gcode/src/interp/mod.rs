@@ -7,11 +7,14 @@
 
 mod arc;
 mod checks;
+mod control;
 mod execute;
 mod motion;
 mod state;
+mod system;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
+pub use control::{ControlLimits, LinePos};
 pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
@@ -32,6 +35,8 @@ pub struct Config {
     /// the offsets and home points kept in parameters (`#5161…`, `#5211…`, `#5221…`) are in
     /// these, whatever G20/G21 is in force. LinuxCNC's standalone `rs274` uses inches.
     pub machine_units: Units,
+    /// Guards against runaway loops and recursion.
+    pub limits: ControlLimits,
 }
 
 impl Config {
@@ -40,6 +45,7 @@ impl Config {
         Config {
             tool_table,
             machine_units: Units::Inches,
+            limits: ControlLimits::default(),
         }
     }
 }
@@ -50,6 +56,8 @@ pub enum Flow {
     Continue,
     /// M2/M30 or the closing `%`: nothing after this line is read.
     End,
+    /// Control flow goes on at another line (a loop, a call, a return).
+    Jump(LinePos),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -74,18 +82,39 @@ pub struct Interpreter {
     ended: bool,
     /// Source line being executed, for the canonical calls' origin.
     origin: Origin,
+    control: control::Control,
+    /// M2/M30 ended a `%` program: the rest of the text should hold the closing `%`.
+    closing_percent_sought: bool,
 }
 
 /// Where in the source a line sits, for error spans.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct LineRef<'a> {
     pub number: u32,
     pub text: &'a str,
     /// Byte offset of the line in the whole program.
     pub start: usize,
+    /// Byte offset of the next line.
+    pub end: usize,
 }
 
 impl LineRef<'_> {
+    /// Where this line starts.
+    pub fn pos(&self) -> LinePos {
+        LinePos {
+            start: self.start,
+            number: self.number,
+        }
+    }
+
+    /// Where the line after this one starts.
+    pub fn next(&self) -> LinePos {
+        LinePos {
+            start: self.end,
+            number: self.number + 1,
+        }
+    }
+
     pub fn span(&self, byte: usize) -> Span {
         Span::in_line(self.number, self.text, self.start, byte)
     }
@@ -104,6 +133,8 @@ impl Interpreter {
             percent: Percent::Unknown,
             ended: false,
             origin: Origin::default(),
+            control: control::Control::default(),
+            closing_percent_sought: false,
         }
     }
 
@@ -141,24 +172,51 @@ impl Interpreter {
     /// Interpret a whole program; stops at the first error. Calls [`Self::start`] first.
     pub fn run(&mut self, program: &str, sink: &mut impl CanonSink) -> Result<(), GcodeError> {
         self.start(sink);
-        let mut last = LineRef {
-            number: 0,
-            text: "",
-            start: 0,
-        };
-        for line in lines(program) {
+        let mut at = LinePos::FIRST;
+        let mut last = LineRef::default();
+        while let Some(line) = line_at(program, at) {
             last = line;
-            if self.execute_line(line, sink)? == Flow::End {
-                return Ok(());
+            at = line.next();
+            match self.execute_line(line, sink)? {
+                Flow::Continue => {}
+                Flow::End => {
+                    self.seek_closing_percent(program, at, sink);
+                    return Ok(());
+                }
+                Flow::Jump(to) => at = to,
             }
         }
         self.finish(last)
+    }
+
+    /// After M2/M30 in a `%` program: note it when no line from `after` on starts with `%`
+    /// (LinuxCNC's comment, made after `PROGRAM_END`).
+    pub fn seek_closing_percent(
+        &mut self,
+        program: &str,
+        after: LinePos,
+        sink: &mut impl CanonSink,
+    ) {
+        if !std::mem::take(&mut self.closing_percent_sought) {
+            return;
+        }
+        let mut at = after;
+        while let Some(line) = line_at(program, at) {
+            if line.text.trim_start().starts_with('%') {
+                return;
+            }
+            at = line.next();
+        }
+        self.comment_call(sink, "percent sign missing from end of file".into());
     }
 
     /// The end of the text was reached without M2/M30 or closing `%`: an error, as in LinuxCNC.
     pub fn finish(&mut self, last: LineRef) -> Result<(), GcodeError> {
         if self.ended {
             return Ok(());
+        }
+        if let Some(kind) = self.control.unfinished() {
+            return Err(GcodeError::new(kind, last.span(last.text.len())));
         }
         let kind = if self.percent == Percent::Open || last.number == 0 {
             ErrorKind::NoClosingPercent
@@ -198,9 +256,10 @@ impl Interpreter {
             }
             return Ok(flow);
         }
-        // Programs read the current point from #5420…#5425 (program coordinates).
-        self.params
-            .set6(crate::params::CURRENT_POSITION, self.state.pos.0);
+        if self.control.skipping() {
+            return self.skipped_line(line, sink);
+        }
+        self.publish_system_values(line.number);
         let Self { norm, params, .. } = self;
         let to_span = |norm: &NormLine, idx: usize| {
             let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
@@ -216,6 +275,12 @@ impl Interpreter {
             line: line.number,
             n: block.n,
         };
+        if let Some(o) = block.o.take() {
+            let at = o.at as usize;
+            return self
+                .o_word(&o, line, sink)
+                .map_err(|(kind, _)| GcodeError::new(kind, line.span(at)));
+        }
         self.execute_block(block, line, sink)
     }
 
@@ -289,25 +354,25 @@ impl Interpreter {
 
 /// Split a program into lines with their numbers and byte offsets (`\n`, `\r\n` or `\r`).
 pub fn lines(program: &str) -> impl Iterator<Item = LineRef<'_>> {
-    let mut start = 0;
-    let mut number = 0;
-    let bytes = program.as_bytes();
+    let mut at = LinePos::FIRST;
     std::iter::from_fn(move || {
-        if start >= bytes.len() {
-            return None;
-        }
-        let rest = &bytes[start..];
-        let len = memchr_newline(rest);
-        let text = &program[start..start + len];
-        let text = text.strip_suffix('\r').unwrap_or(text);
-        number += 1;
-        let line = LineRef {
-            number,
-            text,
-            start,
-        };
-        start += (len + 1).min(rest.len());
+        let line = line_at(program, at)?;
+        at = line.next();
         Some(line)
+    })
+}
+
+/// The line that starts at `at`, if the program goes on that far.
+pub fn line_at(program: &str, at: LinePos) -> Option<LineRef<'_>> {
+    let start = at.start;
+    let rest = program.as_bytes().get(start..).filter(|r| !r.is_empty())?;
+    let len = memchr_newline(rest);
+    let text = &program[start..start + len];
+    Some(LineRef {
+        number: at.number,
+        text: text.strip_suffix('\r').unwrap_or(text),
+        start,
+        end: start + (len + 1).min(rest.len()),
     })
 }
 
@@ -327,16 +392,18 @@ pub fn check_into(program: &str, cfg: Config, sink: &mut impl CanonSink) -> Vec<
     let mut interp = Interpreter::new(cfg);
     interp.start(sink);
     let mut errors = Vec::new();
-    let mut last = LineRef {
-        number: 0,
-        text: "",
-        start: 0,
-    };
-    for line in lines(program) {
+    let mut at = LinePos::FIRST;
+    let mut last = LineRef::default();
+    while let Some(line) = line_at(program, at) {
         last = line;
+        at = line.next();
         match interp.execute_line(line, sink) {
-            Ok(Flow::End) => return errors,
+            Ok(Flow::End) => {
+                interp.seek_closing_percent(program, at, sink);
+                return errors;
+            }
             Ok(Flow::Continue) => {}
+            Ok(Flow::Jump(to)) => at = to,
             Err(e) => errors.push(e),
         }
     }
