@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Ruckig's one-axis time-optimal duration for a batch of forward moves (the oracle of
+crates/motion/tests/ruckig_oracle.rs).
+
+stdin:  one case per line, "L v0 v1 V A J" (distance, start and end speed, limits), blank
+        lines ignored; zero acceleration at both ends, start position 0, target position L.
+stdout: one line per case, "duration vmin": Ruckig's optimal duration and the lowest speed
+        along its trajectory (negative = it drives backward), both repr() floats; "nan nan" when
+        Ruckig reports an error. One process for the whole batch.
+"""
+import sys
+
+from ruckig import InputParameter, Result, Ruckig, Trajectory
+
+
+def min_speed(traj):
+    """Lowest velocity over the 7 constant-jerk phases, at phase ends or where a = 0 inside."""
+    prof = traj.profiles[0][0]
+    t, j, a, v = list(prof.t), list(prof.j), list(prof.a), list(prof.v)
+    vmin = v[0]
+    for k in range(7):
+        if t[k] <= 0.0:
+            continue  # a skipped phase's knot values are not meaningful
+        vmin = min(vmin, v[k + 1])
+        if j[k] != 0.0:
+            tau = -a[k] / j[k]
+            if 0.0 < tau < t[k]:
+                vmin = min(vmin, v[k] + a[k] * tau + 0.5 * j[k] * tau * tau)
+    return vmin
+
+
+def main():
+    otg = Ruckig(1)
+    inp = InputParameter(1)
+    traj = Trajectory(1)
+    out = []
+    for line in sys.stdin:
+        f = line.split()
+        if not f:
+            continue
+        dist, v0, v1, vmax, amax, jmax = map(float, f)
+        inp.current_position = [0.0]
+        inp.current_velocity = [v0]
+        inp.current_acceleration = [0.0]
+        inp.target_position = [dist]
+        inp.target_velocity = [v1]
+        inp.target_acceleration = [0.0]
+        inp.max_velocity = [vmax]
+        inp.max_acceleration = [amax]
+        inp.max_jerk = [jmax]
+        try:
+            res = otg.calculate(inp, traj)
+        except Exception:  # RuckigError on invalid input
+            res = None
+        if res not in (Result.Working, Result.Finished):
+            out.append("nan nan")
+            continue
+        out.append(f"{traj.duration!r} {min_speed(traj)!r}")
+    sys.stdout.write("\n".join(out))
+    sys.stdout.write("\n")
+
+
+if __name__ == "__main__":
+    main()

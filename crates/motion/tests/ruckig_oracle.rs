@@ -1,0 +1,293 @@
+//! The profile solver against Ruckig (pantor/ruckig, Python binding), the reference for the
+//! one-axis time-optimal jerk-limited motion with zero end accelerations.
+//!
+//! 150 000 seeded random forward moves (distance, start/end speed, limits) go to one Python
+//! process (tests/oracle/ruckig_batch.py) run with `$TEZGAH_PYTHON`; the test is skipped, with a
+//! message, when that is unset or cannot `import ruckig` (`.ci/install-ruckig` prints a python
+//! that can). For each case:
+//! * Ruckig's trajectory never drives backward ⇒ ours succeeds with the same duration (1e-6
+//!   relative);
+//! * Ruckig needs backward motion (its lowest speed < 0) ⇒ ours reports the end speed as
+//!   unreachable (a path cannot be driven backward), with a reachable speed that `solve` accepts;
+//! * ours holds the limits at ≥ 20 sample times and at every phase knot (|v| ≤ V, |a| ≤ A,
+//!   |j| ≤ J, v ≥ 0, each within 1e-9 relative for rounding) and reaches the end state
+//!   (s = L, v = v1, a = 0 within 1e-9 relative).
+//!
+//! At L = 0 with v0 = v1 ours must not move (duration 0); Ruckig is not compared there.
+//! Ruckig's optimum with its lowest speed within 1e-7·V of 0 sits on the forward/backward
+//! boundary; there either answer is accepted (a success must still match the duration).
+
+use std::io::{BufRead, BufReader, Write};
+use std::process::{Command, Stdio};
+
+use tezgah_motion::profile::{solve, speed_change_distance, Limits, Profile, ProfileError};
+
+const CASES: usize = 150_000;
+const SEED: u64 = 0x7e29_a4c1_5eed_0005;
+
+/// xorshift64* (Vigna 2016): enough for spreading test cases, and reproducible everywhere.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + self.unit() * (hi.ln() - lo.ln())).exp()
+    }
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Case {
+    distance: f64,
+    v0: f64,
+    v1: f64,
+    vmax: f64,
+    amax: f64,
+    jmax: f64,
+}
+
+/// A speed in [0, V]: often exactly 0 or V (the ends of look-ahead segments), else uniform.
+fn speed(rng: &mut Rng, vmax: f64) -> f64 {
+    match rng.unit() {
+        p if p < 0.15 => 0.0,
+        p if p < 0.25 => vmax,
+        _ => rng.unit() * vmax,
+    }
+}
+
+fn cases() -> Vec<Case> {
+    let mut rng = Rng(SEED);
+    (0..CASES)
+        .map(|_| {
+            let vmax = rng.log_uniform(0.5, 1000.0);
+            let amax = rng.log_uniform(5.0, 2e4);
+            let jmax = rng.log_uniform(50.0, 1e6);
+            let v0 = speed(&mut rng, vmax);
+            let v1 = if rng.unit() < 0.1 {
+                v0
+            } else {
+                speed(&mut rng, vmax)
+            };
+            let limits = Limits::new(vmax, amax, jmax).unwrap();
+            // Distances around the scale of the move, so that every regime appears: end speed
+            // out of reach, slow-down-then-speed-up, peaks below V with and without plateaus,
+            // cruise at V.
+            let direct = speed_change_distance(v0, v1, &limits).unwrap();
+            let stop_go = speed_change_distance(v0, 0.0, &limits).unwrap()
+                + speed_change_distance(0.0, v1, &limits).unwrap();
+            let scale = direct + speed_change_distance(0.0, vmax, &limits).unwrap();
+            let distance = match rng.unit() {
+                p if p < 0.02 => 0.0,
+                // Between a stop-and-go and a single ramp: only slowing down first can meet v1.
+                p if p < 0.2 && stop_go < direct => stop_go + rng.unit() * (direct - stop_go),
+                // Mostly long enough for v1 (about a quarter not), down to very short moves.
+                p if p < 0.25 => scale * 10f64.powf(rng.unit() * 2.5 - 3.0),
+                _ => scale * 10f64.powf(rng.unit() * 2.0 - 0.3),
+            };
+            Case {
+                distance,
+                v0,
+                v1,
+                vmax,
+                amax,
+                jmax,
+            }
+        })
+        .collect()
+}
+
+/// Ruckig's (duration, lowest speed) per case, or `None` when the oracle is unavailable.
+fn ruckig(cases: &[Case]) -> Option<Vec<(f64, f64)>> {
+    let Some(python) = std::env::var_os("TEZGAH_PYTHON") else {
+        println!("skipped: TEZGAH_PYTHON is not set (see .ci/install-ruckig)");
+        return None;
+    };
+    let probe = Command::new(&python).args(["-c", "import ruckig"]).output();
+    if !probe.is_ok_and(|o| o.status.success()) {
+        println!("skipped: {python:?} cannot import ruckig (see .ci/install-ruckig)");
+        return None;
+    }
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/oracle/ruckig_batch.py");
+    let mut child = Command::new(&python)
+        .arg(script)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("start the Ruckig batch");
+    let mut stdin = child.stdin.take().unwrap();
+    let input: String = cases
+        .iter()
+        .map(|c| {
+            format!(
+                "{:?} {:?} {:?} {:?} {:?} {:?}\n",
+                c.distance, c.v0, c.v1, c.vmax, c.amax, c.jmax
+            )
+        })
+        .collect();
+    // Write from a thread: the script answers while it reads, and the pipes are finite.
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let stdout = BufReader::new(child.stdout.take().unwrap());
+    let answers: Vec<(f64, f64)> = stdout
+        .lines()
+        .map(|l| {
+            let l = l.expect("read the Ruckig batch");
+            let mut f = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
+            (f.next().unwrap(), f.next().unwrap())
+        })
+        .collect();
+    writer.join().unwrap().expect("write the Ruckig batch");
+    assert!(child.wait().unwrap().success(), "Ruckig batch failed");
+    assert_eq!(answers.len(), cases.len(), "one answer per case");
+    Some(answers)
+}
+
+/// Limits held at 24 uniform samples and at every knot; end state reached.
+fn check_profile(c: &Case, p: &Profile) -> Result<(), String> {
+    let t_end = p.duration();
+    let times = (0..24)
+        .map(|i| t_end * i as f64 / 23.0)
+        .chain(p.knots().iter().map(|k| k.0));
+    for t in times {
+        let x = p.state_at(t);
+        let ok = x.v <= c.vmax * (1.0 + 1e-9)
+            && x.v >= -1e-9 * c.vmax
+            && x.a.abs() <= c.amax * (1.0 + 1e-9)
+            && x.j.abs() <= c.jmax * (1.0 + 1e-9);
+        if !ok {
+            return Err(format!("limit broken at t = {t}: {x:?}"));
+        }
+    }
+    let e = p.state_at(t_end);
+    if (e.s - c.distance).abs() > 1e-9 * c.distance
+        || (e.v - c.v1).abs() > 1e-9 * c.vmax
+        || e.a.abs() > 1e-9 * c.amax
+    {
+        return Err(format!(
+            "end state {e:?} misses s = {}, v = {}",
+            c.distance, c.v1
+        ));
+    }
+    Ok(())
+}
+
+#[test]
+fn durations_match_ruckig() {
+    let cases = cases();
+    let Some(oracle) = ruckig(&cases) else {
+        return;
+    };
+    let (mut forward, mut backward, mut ruckig_errors) = (0, 0, 0);
+    let (mut borderline, mut borderline_ok) = (0, 0);
+    let (mut cruise, mut dip, mut plain, mut trivial) = (0, 0, 0, 0);
+    let mut worst = (0.0f64, 0usize);
+    let mut failures = Vec::new();
+    for (i, (c, &(t_r, vmin_r))) in cases.iter().zip(&oracle).enumerate() {
+        let limits = Limits::new(c.vmax, c.amax, c.jmax).unwrap();
+        let ours = solve(c.distance, c.v0, c.v1, &limits);
+        if t_r.is_nan() {
+            ruckig_errors += 1;
+            continue;
+        }
+        if c.distance == 0.0 && c.v0 == c.v1 {
+            // Already at the target: the optimum is no motion. Ruckig returns a detour through
+            // negative speeds instead when v0 > 0 (NOTES-profile.md, errata).
+            trivial += 1;
+            match ours {
+                Ok(p) if p.duration() == 0.0 && p.end().s == 0.0 => {}
+                other => failures.push(format!("#{i} {c:?}: at target, got {other:?}")),
+            }
+            continue;
+        }
+        let near_zero = vmin_r < 0.0 && vmin_r >= -1e-7 * c.vmax;
+        let goes_back = vmin_r < -1e-7 * c.vmax;
+        if near_zero {
+            borderline += 1;
+            if ours.is_ok() {
+                borderline_ok += 1;
+            }
+        }
+        match ours {
+            Ok(p) => {
+                if goes_back {
+                    failures.push(format!(
+                        "#{i} {c:?}: Ruckig goes backward (vmin {vmin_r}), ours succeeded in {}",
+                        p.duration()
+                    ));
+                    continue;
+                }
+                forward += 1;
+                let diff = (p.duration() - t_r).abs() / t_r.max(1e-300);
+                let diff = if t_r == 0.0 && p.duration() <= 1e-12 {
+                    0.0
+                } else {
+                    diff
+                };
+                if diff > worst.0 {
+                    worst = (diff, i);
+                }
+                if diff > 1e-6 {
+                    failures.push(format!(
+                        "#{i} {c:?}: duration {} vs Ruckig {t_r}",
+                        p.duration()
+                    ));
+                }
+                if let Err(e) = check_profile(c, &p) {
+                    failures.push(format!("#{i} {c:?}: {e}"));
+                }
+                if p.durations()[3] > 0.0 {
+                    cruise += 1;
+                } else if p.jerks()[0] < 0.0 && p.durations()[0] > 0.0 {
+                    dip += 1;
+                } else {
+                    plain += 1;
+                }
+            }
+            Err(ProfileError::EndSpeedUnreachable { reachable, .. }) => {
+                if !(goes_back || near_zero) {
+                    failures.push(format!(
+                        "#{i} {c:?}: ours unreachable, Ruckig forward in {t_r} (vmin {vmin_r})"
+                    ));
+                    continue;
+                }
+                backward += 1;
+                let side_ok = if c.v1 > c.v0 {
+                    (c.v0..c.v1).contains(&reachable)
+                } else {
+                    reachable > c.v1 && reachable <= c.v0
+                };
+                if !side_ok || solve(c.distance, c.v0, reachable, &limits).is_err() {
+                    failures.push(format!("#{i} {c:?}: bad reachable end speed {reachable}"));
+                }
+            }
+            Err(e) => failures.push(format!("#{i} {c:?}: unexpected {e}")),
+        }
+    }
+    println!(
+        "Ruckig oracle: {} cases: {forward} forward (cruise {cruise}, slow-down-then-up {dip}, \
+         other {plain}), {backward} end speed unreachable (Ruckig backward), {borderline} on the \
+         forward/backward boundary ({borderline_ok} of them solved by ours), {trivial} already at the target (L = 0, v0 = v1), \
+         {ruckig_errors} Ruckig errors; max relative duration \
+         difference {:.3e} (case #{})",
+        cases.len(),
+        worst.0,
+        worst.1
+    );
+    for f in failures.iter().take(20) {
+        println!("{f}");
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases fail",
+        failures.len(),
+        cases.len()
+    );
+    assert_eq!(ruckig_errors, 0, "Ruckig failed on valid input");
+}
