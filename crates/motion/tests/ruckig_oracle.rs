@@ -14,6 +14,8 @@
 //!   (s = L, v = v1, a = 0 within 1e-9 relative).
 //!
 //! At L = 0 with v0 = v1 ours must not move (duration 0); Ruckig is not compared there.
+//! Where Ruckig's own end position misses L by more than 1e-9·L (it accepts ~1e-8 absolute)
+//! or Ruckig fails, the duration is not compared; such cases are listed and must stay rare.
 //! Ruckig's optimum with its lowest speed within 1e-7·V of 0 sits on the forward/backward
 //! boundary; there either answer is accepted (a success must still match the duration).
 
@@ -63,9 +65,12 @@ fn speed(rng: &mut Rng, vmax: f64) -> f64 {
     }
 }
 
+/// `TEZGAH_ORACLE_CASES` and `TEZGAH_ORACLE_SEED` override the count and seed for longer runs.
 fn cases() -> Vec<Case> {
-    let mut rng = Rng(SEED);
-    (0..CASES)
+    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u64>().ok());
+    let n = env("TEZGAH_ORACLE_CASES").map_or(CASES, |n| n as usize);
+    let mut rng = Rng(env("TEZGAH_ORACLE_SEED").unwrap_or(SEED) | 1);
+    (0..n)
         .map(|_| {
             let vmax = rng.log_uniform(0.5, 1000.0);
             let amax = rng.log_uniform(5.0, 2e4);
@@ -104,8 +109,18 @@ fn cases() -> Vec<Case> {
         .collect()
 }
 
-/// Ruckig's (duration, lowest speed) per case, or `None` when the oracle is unavailable.
-fn ruckig(cases: &[Case]) -> Option<Vec<(f64, f64)>> {
+/// Ruckig's answer for one case.
+#[derive(Debug, Clone, Copy)]
+struct Answer {
+    duration: f64,
+    /// Lowest speed along Ruckig's trajectory.
+    vmin: f64,
+    /// |end position − L| of Ruckig's trajectory.
+    miss: f64,
+}
+
+/// Ruckig's answer per case, or `None` when the oracle is unavailable.
+fn ruckig(cases: &[Case]) -> Option<Vec<Answer>> {
     let Some(python) = std::env::var_os("TEZGAH_PYTHON") else {
         println!("skipped: TEZGAH_PYTHON is not set (see .ci/install-ruckig)");
         return None;
@@ -135,12 +150,17 @@ fn ruckig(cases: &[Case]) -> Option<Vec<(f64, f64)>> {
     // Write from a thread: the script answers while it reads, and the pipes are finite.
     let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
     let stdout = BufReader::new(child.stdout.take().unwrap());
-    let answers: Vec<(f64, f64)> = stdout
+    let answers: Vec<Answer> = stdout
         .lines()
         .map(|l| {
             let l = l.expect("read the Ruckig batch");
             let mut f = l.split_whitespace().map(|x| x.parse::<f64>().unwrap());
-            (f.next().unwrap(), f.next().unwrap())
+            let mut next = || f.next().expect("three numbers per line");
+            Answer {
+                duration: next(),
+                vmin: next(),
+                miss: next(),
+            }
         })
         .collect();
     writer.join().unwrap().expect("write the Ruckig batch");
@@ -186,16 +206,23 @@ fn durations_match_ruckig() {
     };
     let (mut forward, mut backward, mut ruckig_errors) = (0, 0, 0);
     let (mut borderline, mut borderline_ok) = (0, 0);
+    let mut inexact = Vec::new();
     let (mut cruise, mut dip, mut plain, mut trivial) = (0, 0, 0, 0);
     let mut worst = (0.0f64, 0usize);
     let mut failures = Vec::new();
-    for (i, (c, &(t_r, vmin_r))) in cases.iter().zip(&oracle).enumerate() {
+    for (i, (c, r)) in cases.iter().zip(&oracle).enumerate() {
+        let (t_r, vmin_r) = (r.duration, r.vmin);
         let limits = Limits::new(c.vmax, c.amax, c.jmax).unwrap();
         let ours = solve(c.distance, c.v0, c.v1, &limits);
         if t_r.is_nan() {
             ruckig_errors += 1;
+            println!(
+                "#{i} {c:?}: Ruckig error (ours: {:?})",
+                ours.map(|p| p.duration())
+            );
             continue;
         }
+        let ruckig_inexact = r.miss > 1e-9 * c.distance;
         if c.distance == 0.0 && c.v0 == c.v1 {
             // Already at the target: the optimum is no motion. Ruckig returns a detour through
             // negative speeds instead when v0 > 0 (NOTES-profile.md, errata).
@@ -230,10 +257,19 @@ fn durations_match_ruckig() {
                 } else {
                     diff
                 };
-                if diff > worst.0 {
+                if diff > worst.0 && !ruckig_inexact {
                     worst = (diff, i);
                 }
-                if diff > 1e-6 {
+                if ruckig_inexact {
+                    // Ruckig's end position misses L by more than we allow ourselves; its duration
+                    // is for a slightly different move, and near L = d(v0→v1) the optimum is
+                    // very sensitive to L. Only our own checks apply.
+                    inexact.push(format!(
+                        "#{i} {c:?}: ours {} vs Ruckig {t_r}, Ruckig misses L by {:.3e}",
+                        p.duration(),
+                        r.miss
+                    ));
+                } else if diff > 1e-6 {
                     failures.push(format!(
                         "#{i} {c:?}: duration {} vs Ruckig {t_r}",
                         p.duration()
@@ -274,13 +310,15 @@ fn durations_match_ruckig() {
         "Ruckig oracle: {} cases: {forward} forward (cruise {cruise}, slow-down-then-up {dip}, \
          other {plain}), {backward} end speed unreachable (Ruckig backward), {borderline} on the \
          forward/backward boundary ({borderline_ok} of them solved by ours), {trivial} already at the target (L = 0, v0 = v1), \
-         {ruckig_errors} Ruckig errors; max relative duration \
+         {ruckig_errors} Ruckig errors, \
+         {} Ruckig end position off by > 1e-9·L (duration not compared); max relative duration \
          difference {:.3e} (case #{})",
         cases.len(),
+        inexact.len(),
         worst.0,
         worst.1
     );
-    for f in failures.iter().take(20) {
+    for f in inexact.iter().take(5).chain(failures.iter().take(20)) {
         println!("{f}");
     }
     assert!(
@@ -289,5 +327,9 @@ fn durations_match_ruckig() {
         failures.len(),
         cases.len()
     );
-    assert_eq!(ruckig_errors, 0, "Ruckig failed on valid input");
+    // Ruckig itself is not under test: its rare failures and inexact ends are listed above.
+    assert!(
+        ruckig_errors + inexact.len() <= cases.len() / 10_000,
+        "Ruckig failed or missed the target too often"
+    );
 }
