@@ -13,11 +13,15 @@
 //!   |j| ≤ J, v ≥ 0, each within 1e-9 relative for rounding) and reaches the end state
 //!   (s = L, v = v1, a = 0 within 1e-9 relative).
 //!
-//! At L = 0 with v0 = v1 ours must not move (duration 0); Ruckig is not compared there.
-//! Where Ruckig's own end position misses L by more than 1e-9·L (it accepts ~1e-8 absolute)
-//! or Ruckig fails, the duration is not compared; such cases are listed and must stay rare.
-//! Ruckig's optimum with its lowest speed within 1e-7·V of 0 sits on the forward/backward
-//! boundary; there either answer is accepted (a success must still match the duration).
+//! At L = 0 with v0 = v1 ours must not move (duration 0); Ruckig is not compared there (it
+//! returns a detour). Ruckig's optimum with its lowest speed within 1e-12·V of 0 sits on the
+//! forward/backward boundary; there either answer is accepted (a success must still match).
+//!
+//! Ruckig ends within ~1e-8 of the target position, not exactly at it, and the optimal duration
+//! jumps where the shape changes (just below L = d(v0→v1) a slow-down-then-speed-up takes over
+//! from a single ramp). So where ours disagrees with Ruckig for L, ours is solved again for the
+//! position Ruckig actually reaches; agreement there is counted as "explained by Ruckig's end
+//! position" and listed. Such cases, and Ruckig failures, must stay rare (≤ 1e-4 of all).
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
@@ -115,8 +119,8 @@ struct Answer {
     duration: f64,
     /// Lowest speed along Ruckig's trajectory.
     vmin: f64,
-    /// |end position − L| of Ruckig's trajectory.
-    miss: f64,
+    /// Where Ruckig's trajectory ends (L up to its tolerance).
+    end: f64,
 }
 
 /// Ruckig's answer per case, or `None` when the oracle is unavailable.
@@ -159,7 +163,7 @@ fn ruckig(cases: &[Case]) -> Option<Vec<Answer>> {
             Answer {
                 duration: next(),
                 vmin: next(),
-                miss: next(),
+                end: next(),
             }
         })
         .collect();
@@ -198,31 +202,56 @@ fn check_profile(c: &Case, p: &Profile) -> Result<(), String> {
     Ok(())
 }
 
+/// How ours compares with Ruckig for one case solved for `distance`.
+enum Verdict {
+    /// Both forward, durations agree (relative difference).
+    Same(f64),
+    /// Ruckig drives backward (or sits on the boundary) and ours reports the end speed unreachable.
+    Unreachable,
+}
+
+fn judge(c: &Case, distance: f64, r: &Answer, limits: &Limits) -> Result<Verdict, String> {
+    let goes_back = r.vmin < -1e-12 * c.vmax;
+    let on_boundary = !goes_back && r.vmin < 0.0;
+    match solve(distance, c.v0, c.v1, limits) {
+        Ok(p) if goes_back => Err(format!(
+            "Ruckig goes backward (vmin {}), ours forward in {}",
+            r.vmin,
+            p.duration()
+        )),
+        Ok(p) => {
+            let diff = (p.duration() - r.duration).abs() / r.duration.max(1e-300);
+            if diff <= 1e-6 {
+                Ok(Verdict::Same(diff))
+            } else {
+                Err(format!(
+                    "duration {} vs Ruckig {}",
+                    p.duration(),
+                    r.duration
+                ))
+            }
+        }
+        Err(ProfileError::EndSpeedUnreachable { .. }) if goes_back || on_boundary => {
+            Ok(Verdict::Unreachable)
+        }
+        Err(e) => Err(format!("ours: {e}; Ruckig forward in {}", r.duration)),
+    }
+}
+
 #[test]
 fn durations_match_ruckig() {
     let cases = cases();
     let Some(oracle) = ruckig(&cases) else {
         return;
     };
-    let (mut forward, mut backward, mut ruckig_errors) = (0, 0, 0);
-    let (mut borderline, mut borderline_ok) = (0, 0);
-    let mut inexact = Vec::new();
-    let (mut cruise, mut dip, mut plateau, mut plain, mut trivial) = (0, 0, 0, 0, 0);
+    let (mut forward, mut backward, mut ruckig_errors, mut trivial) = (0, 0, 0, 0);
+    let (mut cruise, mut dip, mut plateau, mut plain) = (0, 0, 0, 0);
+    let (mut borderline, mut deepest) = (0, 0.0f64);
     let mut worst = (0.0f64, 0usize);
-    let mut failures = Vec::new();
+    let (mut explained, mut failures) = (Vec::new(), Vec::new());
     for (i, (c, r)) in cases.iter().zip(&oracle).enumerate() {
-        let (t_r, vmin_r) = (r.duration, r.vmin);
         let limits = Limits::new(c.vmax, c.amax, c.jmax).unwrap();
         let ours = solve(c.distance, c.v0, c.v1, &limits);
-        if t_r.is_nan() {
-            ruckig_errors += 1;
-            println!(
-                "#{i} {c:?}: Ruckig error (ours: {:?})",
-                ours.map(|p| p.duration())
-            );
-            continue;
-        }
-        let ruckig_inexact = r.miss > 1e-9 * c.distance;
         if c.distance == 0.0 && c.v0 == c.v1 {
             // Already at the target: the optimum is no motion. Ruckig returns a detour through
             // negative speeds instead when v0 > 0 (NOTES-profile.md, errata).
@@ -233,48 +262,38 @@ fn durations_match_ruckig() {
             }
             continue;
         }
-        let near_zero = vmin_r < 0.0 && vmin_r >= -1e-7 * c.vmax;
-        let goes_back = vmin_r < -1e-7 * c.vmax;
-        if near_zero {
-            borderline += 1;
-            if ours.is_ok() {
-                borderline_ok += 1;
-            }
+        if r.duration.is_nan() {
+            ruckig_errors += 1;
+            explained.push(format!(
+                "#{i} {c:?}: Ruckig error (ours: {:?})",
+                ours.map(|p| p.duration())
+            ));
+            continue;
         }
-        match ours {
-            Ok(p) => {
-                if goes_back {
-                    failures.push(format!(
-                        "#{i} {c:?}: Ruckig goes backward (vmin {vmin_r}), ours succeeded in {}",
-                        p.duration()
-                    ));
-                    continue;
-                }
-                forward += 1;
-                let diff = (p.duration() - t_r).abs() / t_r.max(1e-300);
-                let diff = if t_r == 0.0 && p.duration() <= 1e-12 {
-                    0.0
-                } else {
-                    diff
-                };
-                if diff > worst.0 && !ruckig_inexact {
+        if r.vmin < 0.0 && r.vmin >= -1e-12 * c.vmax {
+            borderline += 1;
+            deepest = deepest.min(r.vmin / c.vmax);
+        }
+        match judge(c, c.distance, r, &limits) {
+            Ok(Verdict::Same(diff)) => {
+                if diff > worst.0 {
                     worst = (diff, i);
                 }
-                if ruckig_inexact {
-                    // Ruckig's end position misses L by more than we allow ourselves; its duration
-                    // is for a slightly different move, and near L = d(v0→v1) the optimum is
-                    // very sensitive to L. Only our own checks apply.
-                    inexact.push(format!(
-                        "#{i} {c:?}: ours {} vs Ruckig {t_r}, Ruckig misses L by {:.3e}",
-                        p.duration(),
-                        r.miss
-                    ));
-                } else if diff > 1e-6 {
-                    failures.push(format!(
-                        "#{i} {c:?}: duration {} vs Ruckig {t_r}",
-                        p.duration()
-                    ));
-                }
+            }
+            Ok(Verdict::Unreachable) => {}
+            Err(e) => match judge(c, r.end, r, &limits) {
+                Ok(_) => explained.push(format!(
+                    "#{i} {c:?}: {e}; Ruckig ends at {} (off by {:.1e}), ours for that agrees",
+                    r.end,
+                    r.end - c.distance
+                )),
+                Err(_) => failures.push(format!("#{i} {c:?}: {e}")),
+            },
+        }
+        // Our own answer, checked on its own terms.
+        match ours {
+            Ok(p) => {
+                forward += 1;
                 if let Err(e) = check_profile(c, &p) {
                     failures.push(format!("#{i} {c:?}: {e}"));
                 }
@@ -290,12 +309,6 @@ fn durations_match_ruckig() {
                 }
             }
             Err(ProfileError::EndSpeedUnreachable { reachable, .. }) => {
-                if !(goes_back || near_zero) {
-                    failures.push(format!(
-                        "#{i} {c:?}: ours unreachable, Ruckig forward in {t_r} (vmin {vmin_r})"
-                    ));
-                    continue;
-                }
                 backward += 1;
                 let side_ok = if c.v1 > c.v0 {
                     (c.v0..c.v1).contains(&reachable)
@@ -310,19 +323,18 @@ fn durations_match_ruckig() {
         }
     }
     println!(
-        "Ruckig oracle: {} cases: {forward} forward (with cruise {cruise}; \
-         slow down, then up {dip}; peak below V with an acceleration plateau {plateau}, without \
-         {plain}), {backward} end speed unreachable (Ruckig backward), {borderline} on the \
-         forward/backward boundary ({borderline_ok} of them solved by ours), {trivial} already at the target (L = 0, v0 = v1), \
-         {ruckig_errors} Ruckig errors, \
-         {} Ruckig end position off by > 1e-9·L (duration not compared); max relative duration \
-         difference {:.3e} (case #{})",
+        "Ruckig oracle: {} cases: {forward} solved (with cruise {cruise}; slow down, then up \
+         {dip}; peak below V with an acceleration plateau {plateau}, without {plain}), \
+         {backward} end speed unreachable, {trivial} already at the target (L = 0, v0 = v1); \
+         {borderline} with Ruckig's lowest speed in [{deepest:.1e}·V, 0) (boundary); \
+         {ruckig_errors} Ruckig errors; {} disagreements explained by Ruckig's end position \
+         or errors; max relative duration difference {:.3e} (case #{})",
         cases.len(),
-        inexact.len(),
+        explained.len(),
         worst.0,
         worst.1
     );
-    for f in inexact.iter().take(5).chain(failures.iter().take(20)) {
+    for f in explained.iter().take(5).chain(failures.iter().take(20)) {
         println!("{f}");
     }
     assert!(
@@ -333,7 +345,7 @@ fn durations_match_ruckig() {
     );
     // Ruckig itself is not under test: its rare failures and inexact ends are listed above.
     assert!(
-        ruckig_errors + inexact.len() <= cases.len() / 10_000,
+        explained.len() <= cases.len() / 10_000,
         "Ruckig failed or missed the target too often"
     );
 }
