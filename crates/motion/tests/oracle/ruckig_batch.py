@@ -2,12 +2,14 @@
 """Ruckig's one-axis time-optimal duration for a batch of forward moves (the oracle of
 crates/motion/tests/ruckig_oracle.rs).
 
-stdin:  one case per line, "L v0 v1 V A J" (distance, start and end speed, limits), blank
-        lines ignored; zero acceleration at both ends, start position 0, target position L.
+stdin:  one case per line, "L v0 v1 V A J [n]" (distance, start and end speed, limits, and
+        optionally a number of samples), blank lines ignored; zero acceleration at both ends,
+        start position 0, target position L.
 stdout: one line per case, "duration vmin end": Ruckig's optimal duration, the lowest speed
         along its trajectory (negative = it drives backward) and the position where it ends
         (L up to Ruckig's tolerance, ~1e-8 absolute), as repr() floats; "nan nan nan" when
-        Ruckig reports an error. One process for the whole batch.
+        Ruckig reports an error. With n samples, the line goes on with "p v a" at the n times
+        duration·k/(n−1), k = 0 … n−1. One process for the whole batch.
 """
 import sys
 
@@ -39,7 +41,8 @@ def main():
         f = line.split()
         if not f:
             continue
-        dist, v0, v1, vmax, amax, jmax = map(float, f)
+        dist, v0, v1, vmax, amax, jmax = map(float, f[:6])
+        samples = int(f[6]) if len(f) > 6 else 0
         inp.current_position = [0.0]
         inp.current_velocity = [v0]
         inp.current_acceleration = [0.0]
@@ -57,7 +60,11 @@ def main():
             out.append("nan nan nan")
             continue
         end = traj.at_time(traj.duration)[0][0]
-        out.append(f"{traj.duration!r} {min_speed(traj)!r} {end!r}")
+        fields = [traj.duration, min_speed(traj), end]
+        for k in range(samples):
+            p, v, a = traj.at_time(traj.duration * k / (samples - 1))
+            fields += [p[0], v[0], a[0]]
+        out.append(" ".join(repr(x) for x in fields))
     sys.stdout.write("\n".join(out))
     sys.stdout.write("\n")
 
