@@ -4,16 +4,19 @@
 //! Every candidate is two time-optimal ramps ([`Ramp`]) through a middle speed vm plus a cruise
 //! at vm; its distance is F(vm) = ½(v0+vm)·T(|vm−v0|) + ½(vm+v1)·T(|v1−vm|) (eq. R3) + vm·t_c.
 //! Let d = F(v0 → v1 directly), the distance of the single ramp between the two speeds.
-//! * L ≥ d: speed up then slow down. F is increasing in vm ≥ max(v0, v1), so vm is the root of
-//!   F(vm) = L, or vm = V with the rest as cruise when F(V) ≤ L (eq. S1).
-//! * L < d: slow down then speed up (going further would take longer, not less distance).
-//!   F is concave in vm ≤ min(v0, v1) (each ramp's distance is concave in its speed change:
-//!   √δ pieces and a downward parabola, joined C¹), and F(min) = d > L, so {F ≤ L} is a ray
-//!   and vm is its largest point (eq. S2). If even vm = 0 gives F > L, the optimum would drive
-//!   backward (Ruckig returns exactly that); for a path that is [`ProfileError::EndSpeedUnreachable`].
+//! * L ≥ d: speed up then slow down (the most distance in a given time). F is increasing in
+//!   vm ≥ max(v0, v1), so vm is the root of F(vm) = L, or vm = V with the rest as cruise when
+//!   F(V) ≤ L (eq. S1).
+//! * L < d: the single ramp already goes too far, and the least distance in a given time is
+//!   covered by slowing down below min(v0, v1) first, then speeding up. F is concave in
+//!   vm ≤ min(v0, v1) (each ramp's distance is concave in its speed change: √δ pieces and a
+//!   downward parabola, joined C¹), and F(min) = d > L, so {F ≤ L} is a ray and vm is its
+//!   largest point (eq. S2). F first rises as vm drops, so the duration jumps as L falls below
+//!   d. If even vm = 0 gives F > L, the optimum would drive backward (Ruckig returns exactly
+//!   that); for a path that is [`ProfileError::EndSpeedUnreachable`].
 //!
-//! These are the extremal ("bang-bang jerk") profiles whose durations Ruckig's step 1
-//! enumerates for one axis with zero end accelerations (Berscheid & Kröger 2021, §III).
+//! These are the extremal ("bang-bang jerk") profiles that Ruckig enumerates for one axis with
+//! zero end accelerations (Berscheid & Kröger 2021); tests/ruckig_oracle.rs checks the match.
 //! vm is solved for as an offset x ≥ 0 from max(v0, v1) or min(v0, v1), so that small speed
 //! changes keep full relative precision; in x = u², F is smooth in u. Closed forms: cruise
 //! (S1 at V), both ramps at the acceleration limit (F quadratic in x), and equal end speeds
