@@ -1,4 +1,9 @@
 //! tezgah-motion: path building, jerk-limited feed planning and interpolation.
 //!
-//! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. It grows
-//! with the path and feed-planning issues; for now it holds nothing.
+//! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. So far it
+//! holds the time-optimal jerk-limited 1-D [`profile`] along a path; look-ahead, interpolation
+//! and the run loop build on it.
+
+pub mod profile;
+
+pub use profile::{solve, Limits, Profile, ProfileError, State};

@@ -1,0 +1,191 @@
+//! [`Profile`]: the single truth for one timed motion along the path — a start state and seven
+//! constant-jerk phases (Ruckig's `Profile`). Everything else (state at any time, duration,
+//! distance) is evaluated from it analytically, so any plan can be replayed and checked.
+//!
+//! Phase layout: jerk +σ₁J, 0, −σ₁J (speed change v0 → vm, σ₁ = ±1), cruise at vm (jerk 0),
+//! jerk +σ₂J, 0, −σ₂J (vm → v1). σ₁ = +1, σ₂ = −1 is the usual speed-up-then-slow-down; the
+//! other signs give slow-down-then-speed-up and monotone shapes. Within a phase of jerk j, from
+//! (s, v, a): v(τ) = v + aτ + jτ²/2, s(τ) = s + vτ + aτ²/2 + jτ³/6 (exact for constant jerk).
+
+use super::ramp::Ramp;
+
+/// Position, velocity, acceleration and jerk at one instant (mm, mm/s, mm/s², mm/s³).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct State {
+    pub s: f64,
+    pub v: f64,
+    pub a: f64,
+    pub j: f64,
+}
+
+/// A timed 1-D motion of seven constant-jerk phases (see the module comment).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Profile {
+    durations: [f64; 7],
+    jerks: [f64; 7],
+    /// Time and (s, v, a) at the start of each phase and at the end (index 7), integrated once
+    /// from the start state; the jerk field holds the phase's jerk (0 at index 7).
+    knots: [(f64, State); 8],
+}
+
+impl Profile {
+    /// Integrates the phases from `start` (its jerk field is ignored). Durations must be ≥ 0;
+    /// the solver guarantees it, so this is not public.
+    pub(crate) fn from_phases(start: State, durations: [f64; 7], jerks: [f64; 7]) -> Profile {
+        let mut knots = [(0.0, State::default()); 8];
+        let (mut t, mut x) = (0.0, State { j: 0.0, ..start });
+        for k in 0..7 {
+            let (dt, j) = (durations[k], jerks[k]);
+            knots[k] = (t, State { j, ..x });
+            x = advance(x, j, dt);
+            t += dt;
+        }
+        knots[7] = (t, State { j: 0.0, ..x });
+        Profile {
+            durations,
+            jerks,
+            knots,
+        }
+    }
+
+    /// Two ramps around a cruise: `first` takes the speed from v0 in direction `sign1` (±1),
+    /// `cruise` seconds at the reached speed, then `second` in direction `sign2`.
+    pub(crate) fn from_ramps(
+        v0: f64,
+        first: Ramp,
+        sign1: f64,
+        cruise: f64,
+        second: Ramp,
+        sign2: f64,
+        jerk: f64,
+    ) -> Profile {
+        let (j1, j2) = (sign1 * jerk, sign2 * jerk);
+        Profile::from_phases(
+            State {
+                s: 0.0,
+                v: v0,
+                a: 0.0,
+                j: 0.0,
+            },
+            [
+                first.jerk_time,
+                first.accel_time,
+                first.jerk_time,
+                cruise,
+                second.jerk_time,
+                second.accel_time,
+                second.jerk_time,
+            ],
+            [j1, 0.0, -j1, 0.0, j2, 0.0, -j2],
+        )
+    }
+
+    /// The seven phase durations (s).
+    pub fn durations(&self) -> [f64; 7] {
+        self.durations
+    }
+
+    /// The seven phase jerks (mm/s³).
+    pub fn jerks(&self) -> [f64; 7] {
+        self.jerks
+    }
+
+    /// The state at t = 0.
+    pub fn start(&self) -> State {
+        self.knots[0].1
+    }
+
+    /// The state at t = duration (jerk 0).
+    pub fn end(&self) -> State {
+        self.knots[7].1
+    }
+
+    /// Time and state at the start of each phase, and at the end (index 7).
+    pub fn knots(&self) -> &[(f64, State); 8] {
+        &self.knots
+    }
+
+    pub fn duration(&self) -> f64 {
+        self.knots[7].0
+    }
+
+    /// Distance travelled from start to end.
+    pub fn distance(&self) -> f64 {
+        self.knots[7].1.s - self.knots[0].1.s
+    }
+
+    /// The state at time `t`, exactly (one cubic per phase). Before 0 this is the start state;
+    /// after the end the motion continues at the end speed (zero acceleration and jerk), as
+    /// Ruckig's trajectories do. NaN gives the start state.
+    pub fn state_at(&self, t: f64) -> State {
+        if t >= self.duration() {
+            let (t_end, x) = self.knots[7];
+            return State {
+                s: x.s + x.v * (t - t_end),
+                ..x
+            };
+        }
+        if t.is_nan() || t <= 0.0 {
+            let first_j = self
+                .durations
+                .iter()
+                .zip(self.jerks)
+                .find(|(d, _)| **d > 0.0)
+                .map_or(0.0, |(_, j)| j);
+            return State {
+                j: first_j,
+                ..self.knots[0].1
+            };
+        }
+        // Last phase that starts at or before t (phases of zero duration are skipped over).
+        let k = (0..7).rev().find(|&k| self.knots[k].0 <= t).unwrap_or(0);
+        let (t0, x) = self.knots[k];
+        State {
+            j: x.j,
+            ..advance(x, x.j, t - t0)
+        }
+    }
+}
+
+/// Integrates a constant-jerk phase of length `dt` (the module comment's cubic).
+fn advance(x: State, j: f64, dt: f64) -> State {
+    State {
+        s: x.s + dt * (x.v + dt * (0.5 * x.a + dt * j / 6.0)),
+        v: x.v + dt * (x.a + 0.5 * dt * j),
+        a: x.a + dt * j,
+        j,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn state_at_is_continuous_and_matches_knots() {
+        let p = Profile::from_phases(
+            State {
+                s: 0.0,
+                v: 1.0,
+                a: 0.0,
+                j: 0.0,
+            },
+            [0.1, 0.2, 0.1, 0.5, 0.1, 0.2, 0.1],
+            [10.0, 0.0, -10.0, 0.0, -10.0, 0.0, 10.0],
+        );
+        assert!((p.duration() - 1.3).abs() < 1e-15);
+        for &(t, x) in p.knots() {
+            let left = p.state_at(t - 1e-12);
+            let right = p.state_at(t);
+            assert!((left.s - x.s).abs() < 1e-10 && (right.s - x.s).abs() < 1e-12);
+            assert!((left.v - x.v).abs() < 1e-10 && (right.v - x.v).abs() < 1e-12);
+            assert!((left.a - x.a).abs() < 1e-9 && (right.a - x.a).abs() < 1e-12);
+        }
+        let e = p.end();
+        assert!(e.a.abs() < 1e-14 && (e.v - 1.0).abs() < 1e-14);
+        let after = p.state_at(p.duration() + 2.0);
+        assert!((after.s - (e.s + 2.0)).abs() < 1e-12 && after.j == 0.0);
+        assert_eq!(p.state_at(f64::NAN).s, 0.0);
+        assert_eq!(p.state_at(-1.0).j, 10.0);
+    }
+}
