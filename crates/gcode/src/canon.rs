@@ -64,6 +64,8 @@ pub enum Canon {
     SetSpindleSpeed(f64),
     StartSpindle(SpindleDir),
     StopSpindle,
+    /// Stop the spindle at orientation 0 (G87), turning the given way before.
+    OrientSpindle(SpindleDir),
     SetSpindleMode(f64),
     StraightTraverse(Pose),
     StraightFeed(Pose),
@@ -163,6 +165,15 @@ impl fmt::Display for Canon {
                 f.write_str("START_SPINDLE_COUNTERCLOCKWISE(0)")
             }
             StopSpindle => f.write_str("STOP_SPINDLE_TURNING(0)"),
+            // LinuxCNC's CANON_DIRECTION: 2 clockwise, 3 counterclockwise.
+            OrientSpindle(dir) => write!(
+                f,
+                "ORIENT_SPINDLE(0, 0.0000, {})",
+                match dir {
+                    SpindleDir::Clockwise => 2,
+                    SpindleDir::CounterClockwise => 3,
+                }
+            ),
             SetSpindleMode(v) => write!(f, "SET_SPINDLE_MODE(0 {v:.4})"),
             StraightTraverse(p) => write!(f, "STRAIGHT_TRAVERSE({})", Six(p)),
             StraightFeed(p) => write!(f, "STRAIGHT_FEED({})", Six(p)),

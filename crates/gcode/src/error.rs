@@ -220,6 +220,32 @@ pub enum ErrorKind {
     #[error("Cannot use g53 incremental")]
     G53Incremental,
 
+    // --- canned cycles ---
+    #[error("Cannot feed with zero feed rate")]
+    CycleZeroFeed,
+    #[error("R clearance plane unspecified in cycle")]
+    CycleRMissing,
+    #[error("Cannot do zero repeats of cycle")]
+    CycleZeroRepeats,
+    #[error("{0} value unspecified in {1} plane canned cycle")]
+    CycleNormalMissing(char, &'static str),
+    #[error("R less than {0} in cycle in {1} plane")]
+    CycleRBelowBottom(char, &'static str),
+    #[error("Dwell time p word missing with g{0}")]
+    CycleDwellMissing(u32),
+    #[error("Q word missing with g{0}")]
+    CycleQMissing(u32),
+    #[error("Negative or zero q value used")]
+    CycleQNotPositive,
+    #[error("{0} word missing with g87")]
+    CycleG87WordMissing(char),
+    #[error("Spindle not turning in G{0}")]
+    CycleSpindleStopped(u32),
+    #[error("Spindle turning {which} in G{0}", which = if *.1 { "counterclockwise" } else { "clockwise" })]
+    CycleSpindleWrongWay(u32, bool),
+    #[error("Spindle not turning in g{0}")]
+    CycleSpindleNeeded(u32),
+
     // --- O-words ---
     #[error("Unknown control word after O-word: {0}")]
     UnknownOKeyword(String),

@@ -171,6 +171,7 @@ impl Interpreter {
             }
         }
         if let Some(g) = block.g(ggroup::RETRACT) {
+            self.state.retract_r_plane = g == 990;
             let what = if g == 980 { "old_z" } else { "r_plane" };
             self.comment_call(sink, format!("retract mode set to {what}"));
         }
@@ -395,6 +396,7 @@ impl Interpreter {
         self.emit(sink, Canon::SetMotionControlMode(mode));
         if let ControlMode::Continuous(p) = mode {
             let q = block.get(b'q').unwrap_or(p);
+            self.state.naivecam_tolerance = q;
             self.emit(sink, Canon::SetNaivecamTolerance(q));
         }
     }

@@ -8,6 +8,7 @@
 mod arc;
 mod checks;
 mod control;
+mod cycles;
 mod execute;
 mod motion;
 mod state;

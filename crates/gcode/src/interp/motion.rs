@@ -22,6 +22,7 @@ impl Interpreter {
             0 | 10 => self.straight(block, g == 0, at, sink)?,
             20 | 30 => self.arc(block, g == 20, at, sink)?,
             800 => self.comment_call(sink, "motion mode set to none".into()),
+            730 | 740 | 810..=890 => self.cycle(block, g, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);

@@ -40,6 +40,12 @@ pub struct State {
     pub mist: bool,
     pub flood: bool,
     pub lathe_diameter: bool,
+    /// G99 (retract to the R plane, LinuxCNC's default) or G98 (to the height before).
+    pub retract_r_plane: bool,
+    /// Canned-cycle words in force.
+    pub cycle: super::cycles::CycleMemory,
+    /// Tolerance of G64 Q (naive CAM detector), program units.
+    pub naivecam_tolerance: f64,
 }
 
 impl Default for State {
@@ -66,6 +72,9 @@ impl Default for State {
             mist: false,
             flood: false,
             lathe_diameter: false,
+            retract_r_plane: true,
+            cycle: Default::default(),
+            naivecam_tolerance: 0.0,
         }
     }
 }

@@ -1,0 +1,361 @@
+//! Canned cycles (G73, G74, G81–G89) expanded into ordinary moves exactly as LinuxCNC's
+//! `convert_cycle` does: in any plane, absolute or incremental, with L repeats and the G98/G99
+//! retract, under exact-path mode for the cycle's duration.
+//!
+//! The cycle is written for the plane's first, second and normal axes (LinuxCNC's aa, bb, cc):
+//! G17 is X Y Z, G18 is Z X Y, G19 is Y Z X.
+
+use tezgah_geom::{Plane, Pose};
+
+use crate::block::{Block, AXIS_LETTERS};
+use crate::canon::{Canon, CanonSink, ControlMode, SpindleDir, Units};
+use crate::error::ErrorKind;
+
+use super::execute::Exec;
+use super::Interpreter;
+
+/// How far G73 and G83 back off above the last peck, in inches (LinuxCNC's G83_RAPID_DELTA).
+const PECK_CLEARANCE_INCH: f64 = 0.010;
+
+/// The words of a cycle that stay in force from block to block (LinuxCNC's `cycle_*`).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct CycleMemory {
+    /// R as last programmed (an increment under G91).
+    pub r: f64,
+    /// The normal-axis word (Z in G17) as last programmed.
+    pub bottom: f64,
+    pub p: f64,
+    pub q: f64,
+    /// I J K of G87, in X Y Z order.
+    pub ijk: [f64; 3],
+}
+
+/// One cycle's geometry on the plane's axes.
+struct Hole {
+    plane: (usize, usize, usize),
+    /// The point in the plane.
+    a: f64,
+    b: f64,
+    /// R plane, bottom and retract height along the normal.
+    r: f64,
+    bottom: f64,
+    clear: f64,
+}
+
+impl Interpreter {
+    /// G73, G74 and G81–G89.
+    pub(super) fn cycle(
+        &mut self,
+        block: &Block,
+        g: u32,
+        at: u32,
+        sink: &mut impl CanonSink,
+    ) -> Exec {
+        let err = |kind| Err((kind, at));
+        if self.state.feed_rate == 0.0 {
+            return err(ErrorKind::CycleZeroFeed);
+        }
+        let Some(plane) = self.state.plane else {
+            return err(ErrorKind::Unsupported(
+                "canned cycles in the U V W planes".into(),
+            ));
+        };
+        let same_cycle = self.state.motion == Some(g);
+        let r_word = match block.get(b'r') {
+            Some(r) => r,
+            None if same_cycle => self.state.cycle.r,
+            None => return err(ErrorKind::CycleRMissing),
+        };
+        let repeats = match block.get(b'l') {
+            Some(l) if l == 0.0 => return err(ErrorKind::CycleZeroRepeats),
+            Some(l) => l as u32,
+            None => 1,
+        };
+        let (first, second, normal) = plane.axes();
+        let (plane_name, normal_letter) = match plane {
+            Plane::XY => ("xy", 'z'),
+            Plane::ZX => ("xz", 'y'),
+            Plane::YZ => ("yz", 'x'),
+        };
+        let normal_word = block.get(AXIS_LETTERS[normal]);
+        if !same_cycle && normal_word.is_none() {
+            let letter = normal_letter.to_ascii_uppercase();
+            return err(ErrorKind::CycleNormalMissing(letter, plane_name));
+        }
+        let bottom_word = normal_word.unwrap_or(self.state.cycle.bottom);
+        let pos = self.state.pos;
+        let mut old = pos.0[normal];
+        let (mut a, mut b, step, r, bottom) = if self.state.incremental {
+            let step = (
+                block.get(AXIS_LETTERS[first]).unwrap_or(0.0),
+                block.get(AXIS_LETTERS[second]).unwrap_or(0.0),
+            );
+            let r = r_word + old;
+            (pos.0[first], pos.0[second], step, r, r + bottom_word)
+        } else {
+            (
+                block.get(AXIS_LETTERS[first]).unwrap_or(pos.0[first]),
+                block.get(AXIS_LETTERS[second]).unwrap_or(pos.0[second]),
+                (0.0, 0.0),
+                r_word,
+                bottom_word,
+            )
+        };
+        if r < bottom {
+            return err(ErrorKind::CycleRBelowBottom(normal_letter, plane_name));
+        }
+        if old < r {
+            let mut p = pos;
+            p.0[normal] = r;
+            self.traverse(p, sink);
+            old = r;
+        }
+        let clear = if self.state.retract_r_plane { r } else { old };
+        let saved = self.state.control;
+        if saved != ControlMode::ExactPath {
+            self.emit(sink, Canon::SetMotionControlMode(ControlMode::ExactPath));
+        }
+        let words = self.cycle_words(block, g, same_cycle, at)?;
+        for _ in 0..repeats {
+            a += step.0;
+            b += step.1;
+            let hole = Hole {
+                plane: (first, second, normal),
+                a,
+                b,
+                r,
+                bottom,
+                clear,
+            };
+            self.cycle_move(&hole, old, false, sink);
+            if old != r {
+                self.cycle_move(&hole, r, false, sink);
+            }
+            self.cycle_body(g, &hole, &words, at, sink)?;
+            old = clear;
+        }
+        self.state.pos.0[first] = a;
+        self.state.pos.0[second] = b;
+        self.state.pos.0[normal] = clear;
+        self.state.cycle.r = r_word;
+        self.state.cycle.bottom = bottom_word;
+        if saved != ControlMode::ExactPath {
+            self.emit(sink, Canon::SetMotionControlMode(saved));
+            if let ControlMode::Continuous(_) = saved {
+                self.emit(
+                    sink,
+                    Canon::SetNaivecamTolerance(self.state.naivecam_tolerance),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// The P, Q and I J K a cycle needs, from the block or, for the same cycle again, from
+    /// memory. LinuxCNC takes a word of −1 for a missing one; so does tezgah.
+    fn cycle_words(&mut self, block: &Block, g: u32, same: bool, at: u32) -> Exec<CycleMemory> {
+        let given = |c: u8| block.get(c).filter(|&v| v != -1.0);
+        let mut m = self.state.cycle;
+        match g {
+            820 | 860 | 880 | 890 => {
+                m.p = match given(b'p') {
+                    Some(p) => p,
+                    None if same => m.p,
+                    None => return Err((ErrorKind::CycleDwellMissing(g / 10), at)),
+                };
+            }
+            730 | 830 => {
+                m.q = match given(b'q') {
+                    Some(q) => q,
+                    None if same => m.q,
+                    None => return Err((ErrorKind::CycleQMissing(g / 10), at)),
+                };
+            }
+            870 => {
+                for (k, letter) in [b'i', b'j', b'k'].into_iter().enumerate() {
+                    m.ijk[k] = match block.get(letter) {
+                        Some(v) => v,
+                        None if same => m.ijk[k],
+                        None => {
+                            let c = (letter as char).to_ascii_uppercase();
+                            return Err((ErrorKind::CycleG87WordMissing(c), at));
+                        }
+                    };
+                }
+            }
+            // G74/G84 dwell at the bottom for P seconds when P is given.
+            740 | 840 => m.p = block.get(b'p').unwrap_or(0.0),
+            _ => {}
+        }
+        self.state.cycle.p = m.p;
+        self.state.cycle.q = m.q;
+        self.state.cycle.ijk = m.ijk;
+        Ok(m)
+    }
+
+    /// What a cycle does once the tool stands at the R plane over the hole.
+    fn cycle_body(
+        &mut self,
+        g: u32,
+        h: &Hole,
+        w: &CycleMemory,
+        at: u32,
+        sink: &mut impl CanonSink,
+    ) -> Exec {
+        match g {
+            810 => {
+                self.cycle_move(h, h.bottom, true, sink);
+                self.cycle_move(h, h.clear, false, sink);
+            }
+            820 => {
+                self.cycle_move(h, h.bottom, true, sink);
+                self.emit(sink, Canon::Dwell(w.p));
+                self.cycle_move(h, h.clear, false, sink);
+            }
+            730 | 830 => self.peck(g == 830, h, w.q, at, sink)?,
+            740 | 840 => self.tap(g, h, w.p, at, sink)?,
+            850 => {
+                self.cycle_move(h, h.bottom, true, sink);
+                self.cycle_move(h, h.clear, true, sink);
+            }
+            860 => {
+                let dir = self.cycle_spindle(86, at)?;
+                self.cycle_move(h, h.bottom, true, sink);
+                self.emit(sink, Canon::Dwell(w.p));
+                self.emit(sink, Canon::StopSpindle);
+                self.cycle_move(h, h.clear, false, sink);
+                self.emit(sink, Canon::StartSpindle(dir));
+            }
+            870 => self.back_bore(h, w, at, sink)?,
+            880 => {
+                let dir = self.cycle_spindle(88, at)?;
+                self.cycle_move(h, h.bottom, true, sink);
+                self.emit(sink, Canon::Dwell(w.p));
+                self.emit(sink, Canon::StopSpindle);
+                self.emit(sink, Canon::ProgramStop);
+                self.emit(sink, Canon::StartSpindle(dir));
+            }
+            890 => {
+                self.cycle_move(h, h.bottom, true, sink);
+                self.emit(sink, Canon::Dwell(w.p));
+                self.cycle_move(h, h.clear, true, sink);
+            }
+            _ => return Err(super::execute::unsupported(g, at)),
+        }
+        Ok(())
+    }
+
+    /// G83 (full retract between pecks) and G73 (chip break: a short back-off).
+    fn peck(&mut self, full: bool, h: &Hole, q: f64, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if q <= 0.0 {
+            return Err((ErrorKind::CycleQNotPositive, at));
+        }
+        let back_off = match self.state.units {
+            Units::Inches => PECK_CLEARANCE_INCH,
+            Units::Millimeters => PECK_CLEARANCE_INCH * 25.4,
+        };
+        let mut depth = h.r - q;
+        while depth > h.bottom {
+            self.cycle_move(h, depth, true, sink);
+            if full {
+                self.cycle_move(h, h.clear, false, sink);
+            }
+            self.cycle_move(h, depth + back_off, false, sink);
+            depth -= q;
+        }
+        self.cycle_move(h, h.bottom, true, sink);
+        self.cycle_move(h, h.clear, false, sink);
+        Ok(())
+    }
+
+    /// G84 (right-hand) and G74 (left-hand) tapping: overrides off, feed in, reverse, dwell,
+    /// feed out, restore.
+    fn tap(&mut self, g: u32, h: &Hole, dwell: f64, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let (cutting, code) = if g == 840 {
+            (SpindleDir::Clockwise, 84)
+        } else {
+            (SpindleDir::CounterClockwise, 74)
+        };
+        match self.state.spindle {
+            None => return Err((ErrorKind::CycleSpindleStopped(code), at)),
+            Some(dir) if dir != cutting => {
+                return Err((ErrorKind::CycleSpindleWrongWay(code, g == 840), at));
+            }
+            Some(_) => {}
+        }
+        let reverse = match cutting {
+            SpindleDir::Clockwise => SpindleDir::CounterClockwise,
+            SpindleDir::CounterClockwise => SpindleDir::Clockwise,
+        };
+        self.emit(sink, Canon::DisableFeedOverride);
+        self.emit(sink, Canon::DisableSpeedOverride);
+        self.cycle_move(h, h.bottom, true, sink);
+        self.emit(sink, Canon::StopSpindle);
+        self.emit(sink, Canon::StartSpindle(reverse));
+        self.emit(sink, Canon::Dwell(dwell));
+        self.cycle_move(h, h.clear, true, sink);
+        self.emit(sink, Canon::StopSpindle);
+        self.emit(sink, Canon::StartSpindle(cutting));
+        self.emit(sink, Canon::EnableFeedOverride);
+        self.emit(sink, Canon::EnableSpeedOverride);
+        Ok(())
+    }
+
+    /// G87 back boring: in beside the hole with the spindle oriented, under the part, feed up
+    /// to the counterbore's top and back, and out the same way.
+    fn back_bore(&mut self, h: &Hole, w: &CycleMemory, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let dir = self.cycle_spindle(87, at)?;
+        let (first, second, normal) = h.plane;
+        let offset = Hole {
+            a: h.a + w.ijk[first],
+            b: h.b + w.ijk[second],
+            ..*h
+        };
+        let mut middle = w.ijk[normal];
+        if self.state.incremental {
+            middle += h.bottom;
+        }
+        self.cycle_move(&offset, h.r, false, sink);
+        self.emit(sink, Canon::StopSpindle);
+        self.emit(sink, Canon::OrientSpindle(dir));
+        self.cycle_move(&offset, h.bottom, false, sink);
+        self.cycle_move(h, h.bottom, false, sink);
+        self.emit(sink, Canon::StartSpindle(dir));
+        self.cycle_move(h, middle, true, sink);
+        self.cycle_move(h, h.bottom, true, sink);
+        self.emit(sink, Canon::StopSpindle);
+        self.emit(sink, Canon::OrientSpindle(dir));
+        self.cycle_move(&offset, h.bottom, false, sink);
+        self.cycle_move(&offset, h.clear, false, sink);
+        self.cycle_move(h, h.clear, false, sink);
+        self.emit(sink, Canon::StartSpindle(dir));
+        Ok(())
+    }
+
+    /// The spindle's sense of turning, which G86, G87 and G88 need.
+    fn cycle_spindle(&self, code: u32, at: u32) -> Exec<SpindleDir> {
+        self.state
+            .spindle
+            .ok_or((ErrorKind::CycleSpindleNeeded(code), at))
+    }
+
+    /// A move of a cycle to height `height` over the hole: feed or traverse.
+    fn cycle_move(&mut self, h: &Hole, height: f64, feed: bool, sink: &mut impl CanonSink) {
+        let (first, second, normal) = h.plane;
+        let mut p: Pose = self.state.pos;
+        p.0[first] = h.a;
+        p.0[second] = h.b;
+        p.0[normal] = height;
+        if feed {
+            self.emit(sink, Canon::StraightFeed(p));
+            self.state.pos = p;
+        } else {
+            self.traverse(p, sink);
+        }
+    }
+
+    fn traverse(&mut self, p: Pose, sink: &mut impl CanonSink) {
+        self.emit(sink, Canon::StraightTraverse(p));
+        self.state.pos = p;
+    }
+}
