@@ -67,7 +67,7 @@ impl Interpreter {
             None => return err(ErrorKind::CycleRMissing),
         };
         let repeats = match block.get(b'l') {
-            Some(l) if l == 0.0 => return err(ErrorKind::CycleZeroRepeats),
+            Some(0.0) => return err(ErrorKind::CycleZeroRepeats),
             Some(l) => l as u32,
             None => 1,
         };
