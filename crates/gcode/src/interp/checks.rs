@@ -183,7 +183,10 @@ fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckErro
     )?;
     rule(
         b'l',
-        g10 || cycle || matches!(motion, Some(52 | 760)) || matches!(m(mgroup::IO), Some(66)),
+        // G74 takes no L, unlike the other cycles (LinuxCNC's rule).
+        g10 || (cycle && motion != Some(740))
+            || matches!(motion, Some(52 | 760))
+            || matches!(m(mgroup::IO), Some(66)),
         ErrorKind::LWordUnused,
     )?;
     let p_user = arc

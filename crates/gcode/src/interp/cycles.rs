@@ -84,7 +84,11 @@ impl Interpreter {
         }
         let bottom_word = normal_word.unwrap_or(self.state.cycle.bottom);
         let pos = self.state.pos;
-        let mut old = pos.0[normal];
+        // Where the tool stands along the normal.
+        let mut height = pos.0[normal];
+        // The initial level: the height when the series of cycles began (LinuxCNC 2.9's
+        // `cycle_il`). G98 retracts to it (or to R, if higher) and incremental R counts from it.
+        let mut old = *self.state.cycle_initial_level.get_or_insert(height);
         let (mut a, mut b, step, r, bottom) = if self.state.incremental {
             let step = (
                 block.get(AXIS_LETTERS[first]).unwrap_or(0.0),
@@ -109,6 +113,7 @@ impl Interpreter {
             p.0[normal] = r;
             self.traverse(p, sink);
             old = r;
+            height = r;
         }
         let clear = if self.state.retract_r_plane { r } else { old };
         let saved = self.state.control;
@@ -116,7 +121,7 @@ impl Interpreter {
             self.emit(sink, Canon::SetMotionControlMode(ControlMode::ExactPath));
         }
         let words = self.cycle_words(block, g, same_cycle, at)?;
-        for _ in 0..repeats {
+        for repeat in 0..repeats {
             a += step.0;
             b += step.1;
             let hole = Hole {
@@ -127,12 +132,18 @@ impl Interpreter {
                 bottom,
                 clear,
             };
-            self.cycle_move(&hole, old, false, sink);
-            if old != r {
+            // Over the first hole at the height the tool stands at, if above R; over the
+            // others (and when already down at R) at the retract height.
+            if repeat == 0 && height > r {
+                self.cycle_move(&hole, height, false, sink);
                 self.cycle_move(&hole, r, false, sink);
+            } else {
+                self.cycle_move(&hole, clear, false, sink);
+                if clear > r {
+                    self.cycle_move(&hole, r, false, sink);
+                }
             }
             self.cycle_body(g, &hole, &words, at, sink)?;
-            old = clear;
         }
         self.state.pos.0[first] = a;
         self.state.pos.0[second] = b;
@@ -183,8 +194,8 @@ impl Interpreter {
                     };
                 }
             }
-            // G74/G84 dwell at the bottom for P seconds when P is given.
-            740 | 840 => m.p = block.get(b'p').unwrap_or(0.0),
+            // G74/G84 dwell at the bottom for P seconds, P being optional.
+            740 | 840 => m.p = given(b'p').unwrap_or(m.p),
             _ => {}
         }
         self.state.cycle.p = m.p;
@@ -214,9 +225,11 @@ impl Interpreter {
             }
             730 | 830 => self.peck(g == 830, h, w.q, at, sink)?,
             740 | 840 => self.tap(g, h, w.p, at, sink)?,
+            // G85 feeds back out to R, then rapids to the retract height.
             850 => {
                 self.cycle_move(h, h.bottom, true, sink);
-                self.cycle_move(h, h.clear, true, sink);
+                self.cycle_move(h, h.r, true, sink);
+                self.cycle_move(h, h.clear, false, sink);
             }
             860 => {
                 let dir = self.cycle_spindle(86, at)?;
@@ -258,7 +271,8 @@ impl Interpreter {
         while depth > h.bottom {
             self.cycle_move(h, depth, true, sink);
             if full {
-                self.cycle_move(h, h.clear, false, sink);
+                // Out of the hole to R to clear the chips, then back down.
+                self.cycle_move(h, h.r, false, sink);
             }
             self.cycle_move(h, depth + back_off, false, sink);
             depth -= q;

@@ -18,6 +18,9 @@ use super::Interpreter;
 impl Interpreter {
     pub(super) fn motion(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) -> Exec {
         let at = block.g[ggroup::MOTION].map_or(0, |c| c.at);
+        if !matches!(g, 730 | 740 | 810..=890) {
+            self.state.cycle_initial_level = None;
+        }
         match g {
             0 | 10 => self.straight(block, g == 0, at, sink)?,
             20 | 30 => self.arc(block, g == 20, at, sink)?,

@@ -44,6 +44,8 @@ pub struct State {
     pub retract_r_plane: bool,
     /// Canned-cycle words in force.
     pub cycle: super::cycles::CycleMemory,
+    /// Height along the plane's normal when the current series of cycles began.
+    pub cycle_initial_level: Option<f64>,
     /// Tolerance of G64 Q (naive CAM detector), program units.
     pub naivecam_tolerance: f64,
 }
@@ -74,6 +76,7 @@ impl Default for State {
             lathe_diameter: false,
             retract_r_plane: true,
             cycle: Default::default(),
+            cycle_initial_level: None,
             naivecam_tolerance: 0.0,
         }
     }
