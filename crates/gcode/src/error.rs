@@ -223,6 +223,8 @@ pub enum ErrorKind {
     // --- canned cycles ---
     #[error("Cannot feed with zero feed rate")]
     CycleZeroFeed,
+    #[error("Cannot use inverse time feed with canned cycles")]
+    CycleInverseTime,
     #[error("R clearance plane unspecified in cycle")]
     CycleRMissing,
     #[error("Cannot do zero repeats of cycle")]

@@ -194,6 +194,17 @@ enum Item {
         change: u8,
     },
     ToolLength(ToolLength),
+    /// A canned cycle: G98/G99, the cycle, X Y Z, R, L, P, Q (and I J K for G87).
+    Cycle {
+        retract: Option<bool>,
+        code: usize,
+        xyz: [Option<f64>; 3],
+        r: Option<f64>,
+        l: Option<u8>,
+        p: Option<f64>,
+        q: Option<f64>,
+        ijk: [f64; 3],
+    },
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
@@ -248,6 +259,8 @@ struct Writer {
     inches: bool,
     /// Current point in program coordinates, axis by axis while known.
     pos: [Option<f64>; 6],
+    /// A G10 gave an XY rotation: M6 is no longer generated.
+    rotation_used: bool,
     /// An M6 was written: tool length words are no longer generated.
     changed_tool: bool,
     /// A G43 or G43.1 is in force (not cancelled by G49).
@@ -269,6 +282,7 @@ impl Writer {
             changed_tool: false,
             tool_offset: false,
             tool_length_used: false,
+            rotation_used: false,
         }
     }
 
@@ -558,6 +572,8 @@ impl Writer {
                 self.forget();
             }
             Item::G10 { l20, p, axes, r } => {
+                let r = if self.changed_tool { &None } else { r };
+                self.rotation_used |= r.is_some();
                 let l = if *l20 { 20 } else { 2 };
                 let r = r.map_or(String::new(), |r| format!(" R{}", num(r)));
                 self.block(deco, &format!("G10 L{l} P{p}{}{r}", axis_words(axes)));
@@ -609,7 +625,13 @@ impl Writer {
                 // G49 / T1 M6 / G53 G1 X1` ends at Z-12.9794 in rs274 and Z0 in tezgah. tezgah
                 // does not copy that: a program has tool length words or M6, not both (no M6
                 // after G43/G43.1/G49 here, no G43/G43.1/G49 after M6 below).
-                let change = if self.tool_length_used { &0 } else { change };
+                // The same re-read loses an XY rotation's effect on the point, so no M6 once a
+                // G10 has given a rotation either (and no rotation after M6, below).
+                let change = if self.tool_length_used || self.rotation_used {
+                    &0
+                } else {
+                    change
+                };
                 match change {
                     0 => self.block(deco, &format!("T{t}")),
                     1 => self.block(deco, &format!("T{t} M6")),
@@ -645,6 +667,45 @@ impl Writer {
                 };
                 self.block(deco, &words);
                 self.tool_offset = !matches!(tl, ToolLength::Cancel);
+                self.forget();
+            }
+            Item::Cycle {
+                retract,
+                code,
+                xyz,
+                r,
+                l,
+                p,
+                q,
+                ijk,
+            } => {
+                // LinuxCNC 2.9 feeds G74/G84 along the wrong axes outside G17 (see linuxcnc.rs).
+                let code = match CYCLES[*code] {
+                    "G74" | "G84" if self.plane != 0 => "G81",
+                    c => c,
+                };
+                let mut words = Self::extra(deco);
+                if let Some(old) = retract {
+                    words.push_str(if *old { "G98 " } else { "G99 " });
+                }
+                words.push_str(code);
+                for (letter, v) in ["X", "Y", "Z"].iter().zip(xyz) {
+                    if let Some(v) = v {
+                        words.push_str(&format!(" {letter}{}", num(*v)));
+                    }
+                }
+                let extra = [("R", *r), ("L", l.map(f64::from)), ("P", *p), ("Q", *q)];
+                for (letter, v) in extra {
+                    if let Some(v) = v {
+                        words.push_str(&format!(" {letter}{}", num(v)));
+                    }
+                }
+                if code == "G87" {
+                    for (letter, v) in ["I", "J", "K"].iter().zip(ijk) {
+                        words.push_str(&format!(" {letter}{}", num(*v)));
+                    }
+                }
+                self.block(deco, &words);
                 self.forget();
             }
             Item::Comment(c) => self.block(deco, COMMENTS[*c]),
@@ -689,6 +750,35 @@ fn axes() -> impl Strategy<Value = Axes> {
 }
 
 /// Axis words that may all be missing (G28/G30).
+/// The canned cycles the generator writes.
+const CYCLES: [&str; 11] = [
+    "G81", "G82", "G83", "G73", "G85", "G89", "G86", "G88", "G87", "G84", "G74",
+];
+
+fn cycle() -> impl Strategy<Value = Item> {
+    let word = |max: f64| proptest::option::weighted(0.8, value(max));
+    (
+        proptest::option::of(any::<bool>()),
+        0..CYCLES.len(),
+        [word(20.0), word(20.0), word(20.0)],
+        proptest::option::weighted(0.9, value(20.0)),
+        proptest::option::weighted(0.2, 1u8..=3),
+        proptest::option::weighted(0.5, positive(0.0, 2.0)),
+        proptest::option::weighted(0.5, positive(0.1, 5.0)),
+        [value(3.0), value(3.0), value(10.0)],
+    )
+        .prop_map(|(retract, code, xyz, r, l, p, q, ijk)| Item::Cycle {
+            retract,
+            code,
+            xyz,
+            r,
+            l,
+            p,
+            q,
+            ijk,
+        })
+}
+
 fn maybe_axes() -> impl Strategy<Value = Axes> {
     prop_oneof![Just([None; 6]), axes()]
 }
@@ -821,6 +911,7 @@ fn item() -> impl Strategy<Value = Item> {
         1 => prop_oneof![Just(7u8), Just(8), Just(9)].prop_map(Item::Coolant),
         1 => (1u8..=3, 0u8..3).prop_map(|(t, change)| Item::Tool { t, change }),
         2 => tool_length.prop_map(Item::ToolLength),
+        2 => cycle(),
         1 => (0..COMMENTS.len()).prop_map(Item::Comment),
     ];
     // About one program in twelve ends early on an error.

@@ -192,7 +192,10 @@ fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckErro
     let p_user = arc
         || matches!(mode0, Some(40 | 100))
         || block.g(ggroup::PATH_CONTROL) == Some(640)
-        || matches!(motion, Some(50 | 52 | 760 | 820 | 860 | 880 | 890))
+        || matches!(
+            motion,
+            Some(50 | 52 | 740 | 760 | 820 | 840 | 860 | 880 | 890)
+        )
         || matches!(m(mgroup::OVERRIDE), Some(50..=53))
         || matches!(m(mgroup::IO), Some(62..=66))
         || m(mgroup::USER).is_some();

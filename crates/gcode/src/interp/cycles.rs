@@ -5,7 +5,7 @@
 //! The cycle is written for the plane's first, second and normal axes (LinuxCNC's aa, bb, cc):
 //! G17 is X Y Z, G18 is Z X Y, G19 is Y Z X.
 
-use tezgah_geom::{Plane, Pose};
+use tezgah_geom::{FeedMode, Plane, Pose};
 
 use crate::block::{Block, AXIS_LETTERS};
 use crate::canon::{Canon, CanonSink, ControlMode, SpindleDir, Units};
@@ -54,6 +54,9 @@ impl Interpreter {
         let err = |kind| Err((kind, at));
         if self.state.feed_rate == 0.0 {
             return err(ErrorKind::CycleZeroFeed);
+        }
+        if self.state.feed_mode == FeedMode::InverseTime {
+            return err(ErrorKind::CycleInverseTime);
         }
         let Some(plane) = self.state.plane else {
             return err(ErrorKind::Unsupported(

@@ -87,12 +87,18 @@ impl Interpreter {
         } else {
             if let Some(f) = self.feed_for_move(block, false, at)? {
                 let length = straight_length(end - self.state.pos);
-                self.emit(sink, Canon::SetFeedRate(inverse_time_rate(f, length)));
+                self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
             }
             self.emit(sink, Canon::StraightFeed(end));
         }
         self.state.pos = end;
         Ok(())
+    }
+
+    /// An inverse-time move's rate becomes the feed rate in force, as in LinuxCNC.
+    fn set_inverse_time_rate(&mut self, rate: f64, sink: &mut impl CanonSink) {
+        self.state.feed_rate = rate;
+        self.emit(sink, Canon::SetFeedRate(rate));
     }
 
     /// G28/G30: rapid to the point the axis words give, then to the stored home position of
@@ -204,7 +210,7 @@ impl Interpreter {
             let radius = (s2[0] - center[0]).hypot(s2[1] - center[1]);
             let planar = radius * sweep(s2, e2, center, sense, turns as u32);
             let length = planar.hypot(end.0[normal] - start.0[normal]);
-            self.emit(sink, Canon::SetFeedRate(inverse_time_rate(f, length)));
+            self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
         }
         self.emit(
             sink,
