@@ -1,0 +1,253 @@
+//! Linear delta (3-PSS, reference 002): three vertical towers whose carriages carry rods of
+//! length L to a platform that only translates. Joints are carriage heights, as LinuxCNC's
+//! lineardeltakins: `q_i = z + √(L² − (x − x_i)² − (y − y_i)²) − offset_i` (DESIGN.md).
+//!
+//! The forward map is the closed-form trilateration of reference 002 §2.3 *as corrected
+//! there* (the thesis's printed eqs 3.6–3.15 do not invert eq. 3.5), written for any tower
+//! angles: subtracting closure equations gives x, y linear in z; the smaller root of the
+//! remaining quadratic is the platform below the carriages.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::KinematicsError;
+use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
+use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+
+/// Geometry of a linear delta.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeltaGeometry {
+    /// Effective radius r = R_base − R_platform, mm (centre to tower, less platform joint radius).
+    pub radius: f64,
+    /// Rod length L, mm.
+    pub rod_length: f64,
+    /// Tower angles from +X, rad (DESIGN.md default 90°, 210°, 330°).
+    pub tower_angles: [f64; 3],
+    /// Subtracted from each carriage height, mm: joint = height − offset. Reference 002 uses
+    /// √(L² − r²) = 311.28765 so the platform at the origin reads joints (0, 0, 0).
+    pub carriage_offsets: [f64; 3],
+    /// Smallest angle between a rod and the platform plane, rad (reference 002 uses 5°):
+    /// the rate q̇ = J·ṗ blows up as a rod becomes horizontal.
+    pub min_rod_angle: f64,
+}
+
+/// The linear-delta model: joints `[tower 1, tower 2, tower 3]` carriage heights, mm.
+#[derive(Clone, Debug)]
+pub struct LinearDelta {
+    geometry: DeltaGeometry,
+    towers: [(f64, f64); 3],
+    rod2: f64,
+    max_d2: f64,
+    limits: Vec<JointLimit>,
+    axis_sin: f64,
+}
+
+impl LinearDelta {
+    /// A delta; `limits` holds the three carriage joints.
+    pub fn new(
+        geometry: DeltaGeometry,
+        limits: Vec<JointLimit>,
+        tolerances: Tolerances,
+    ) -> Result<Self, KinematicsError> {
+        if limits.len() != 3 {
+            return Err(KinematicsError::BadInput {
+                reason: format!("linear-delta has 3 joints, got {}", limits.len()),
+            });
+        }
+        let g = &geometry;
+        if !(g.radius > 0.0
+            && g.rod_length > 0.0
+            && g.radius.is_finite()
+            && g.rod_length.is_finite())
+        {
+            return Err(KinematicsError::BadInput {
+                reason: "radius and rod_length must be positive".into(),
+            });
+        }
+        let towers = g
+            .tower_angles
+            .map(|a| (g.radius * a.cos(), g.radius * a.sin()));
+        // The trilateration divides by this determinant: towers must not be collinear.
+        let det = (towers[1].0 - towers[0].0) * (towers[2].1 - towers[0].1)
+            - (towers[2].0 - towers[0].0) * (towers[1].1 - towers[0].1);
+        if det.abs() < 1e-9 * g.radius * g.radius {
+            return Err(KinematicsError::BadInput {
+                reason: "tower angles put the towers on one line".into(),
+            });
+        }
+        let max_d = g.rod_length * g.min_rod_angle.cos();
+        Ok(Self {
+            towers,
+            rod2: g.rod_length * g.rod_length,
+            max_d2: max_d * max_d,
+            limits,
+            axis_sin: tolerances.axis_rad.sin(),
+            geometry,
+        })
+    }
+
+    /// The geometry.
+    pub fn geometry(&self) -> &DeltaGeometry {
+        &self.geometry
+    }
+
+    /// Tower positions (x_i, y_i), mm.
+    pub fn towers(&self) -> [(f64, f64); 3] {
+        self.towers
+    }
+
+    /// Joints for a platform point (tool length already removed), checked against the rod
+    /// angle; the hot path of the 1 ms loop (three square roots).
+    #[inline]
+    pub fn inverse_platform(&self, p: &Vector3<f64>) -> Result<[f64; 3], KinematicsError> {
+        let mut q = [0.0; 3];
+        for i in 0..3 {
+            let dx = p.x - self.towers[i].0;
+            let dy = p.y - self.towers[i].1;
+            let d2 = dx * dx + dy * dy;
+            if d2 > self.max_d2 {
+                return Err(self.rod_error(i, d2));
+            }
+            q[i] = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
+        }
+        Ok(q)
+    }
+
+    #[cold]
+    fn rod_error(&self, i: usize, d2: f64) -> KinematicsError {
+        KinematicsError::Unreachable {
+            reason: format!(
+                "tower {} rod would be {:.3}° from the platform plane (minimum {:.3}°)",
+                i + 1,
+                (d2.sqrt() / self.geometry.rod_length)
+                    .min(1.0)
+                    .acos()
+                    .to_degrees(),
+                self.geometry.min_rod_angle.to_degrees()
+            ),
+        }
+    }
+
+    /// Platform point for joints: corrected closed form (reference 002 §2.3), any tower angles.
+    pub fn forward_platform(&self, q: &[f64; 3]) -> Result<Vector3<f64>, KinematicsError> {
+        let o = &self.geometry.carriage_offsets;
+        // Work relative to carriage 1's height to keep the numbers small.
+        let h1 = q[0] + o[0];
+        let h = [0.0, q[1] + o[1] - h1, q[2] + o[2] - h1];
+        let [(a1, b1), (a2, b2), (a3, b3)] = self.towers;
+        let w = |a: f64, b: f64, hz: f64| a * a + b * b + hz * hz;
+        // (a_i − a_1)·x + (b_i − b_1)·y = g_i − h_i·z  for i = 2, 3 (z relative to h1)
+        let g2 = 0.5 * (w(a2, b2, h[1]) - w(a1, b1, 0.0));
+        let g3 = 0.5 * (w(a3, b3, h[2]) - w(a1, b1, 0.0));
+        let (m11, m12, m21, m22) = (a2 - a1, b2 - b1, a3 - a1, b3 - b1);
+        let det = m11 * m22 - m12 * m21;
+        // x = ex + fx·z, y = ey + fy·z (Cramer's rule)
+        let ex = (m22 * g2 - m12 * g3) / det;
+        let fx = (-m22 * h[1] + m12 * h[2]) / det;
+        let ey = (m11 * g3 - m21 * g2) / det;
+        let fy = (-m11 * h[2] + m21 * h[1]) / det;
+        // Closure of tower 1: (x − a1)² + (y − b1)² + z² = L²  →  F z² + 2 G z + H = 0
+        let (dx, dy) = (ex - a1, ey - b1);
+        let f = fx * fx + fy * fy + 1.0;
+        let gq = fx * dx + fy * dy;
+        let hq = dx * dx + dy * dy - self.rod2;
+        let disc = gq * gq - f * hq;
+        if !(disc >= 0.0) {
+            return Err(KinematicsError::Unreachable {
+                reason: format!(
+                    "carriage heights {:.4}, {:.4}, {:.4} admit no assembly (rods too short)",
+                    q[0], q[1], q[2]
+                ),
+            });
+        }
+        // Smaller root: the platform hangs below the carriages.
+        let z = (-gq - disc.sqrt()) / f;
+        Ok(Vector3::new(ex + fx * z, ey + fy * z, z + h1))
+    }
+
+    /// ∂q/∂p at a platform point (reference 002 §6.2 item 2): rows (−Δx/hᵢ, −Δy/hᵢ, 1).
+    pub fn inverse_jacobian(&self, p: &Vector3<f64>) -> Result<Matrix3<f64>, KinematicsError> {
+        let mut m = Matrix3::zeros();
+        for i in 0..3 {
+            let dx = p.x - self.towers[i].0;
+            let dy = p.y - self.towers[i].1;
+            let hi = (self.rod2 - dx * dx - dy * dy).sqrt();
+            if !(hi > 0.0) {
+                return Err(KinematicsError::Singular {
+                    reason: format!("tower {} rod horizontal", i + 1),
+                });
+            }
+            m[(i, 0)] = -dx / hi;
+            m[(i, 1)] = -dy / hi;
+            m[(i, 2)] = 1.0;
+        }
+        Ok(m)
+    }
+
+    fn check_axis(&self, pose: &ToolPose) -> Result<(), KinematicsError> {
+        if pose.axis.z <= 0.0 || pose.axis.x.hypot(pose.axis.y) > self.axis_sin {
+            return Err(KinematicsError::AxisUnreachable {
+                reason: "a linear delta only translates; the tool axis is +Z".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Kinematics for LinearDelta {
+    fn joint_limits(&self) -> &[JointLimit] {
+        &self.limits
+    }
+
+    fn forward(&self, q: &Joints, tool: &Tool) -> Result<ToolPose, KinematicsError> {
+        check_input(q, 3)?;
+        let p = self.forward_platform(&[q[0], q[1], q[2]])?;
+        Ok(ToolPose::vertical(Vector3::new(
+            p.x,
+            p.y,
+            p.z - tool.length,
+        )))
+    }
+
+    fn inverse(
+        &self,
+        pose: &ToolPose,
+        tool: &Tool,
+        _previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_pose(pose)?;
+        self.check_axis(pose)?;
+        let p = Vector3::new(pose.tip.x, pose.tip.y, pose.tip.z + tool.length);
+        let q = Joints::new(self.inverse_platform(&p)?);
+        check_limits(&q, &self.limits)?;
+        Ok(q)
+    }
+
+    fn tcp_angles(&self, _q: &Joints) -> Joints {
+        Joints::zeros(0)
+    }
+
+    fn tcp_inverse(
+        &self,
+        tip: &Vector3<f64>,
+        angles: &Joints,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_input(angles, 0)?;
+        self.inverse(&ToolPose::vertical(*tip), tool, previous)
+    }
+
+    fn jacobian(&self, q: &Joints, _tool: &Tool) -> Result<Jacobian, KinematicsError> {
+        check_input(q, 3)?;
+        let p = self.forward_platform(&[q[0], q[1], q[2]])?;
+        let inv =
+            self.inverse_jacobian(&p)?
+                .try_inverse()
+                .ok_or_else(|| KinematicsError::Singular {
+                    reason: "delta Jacobian not invertible".into(),
+                })?;
+        let mut j = Jacobian::zeros(3);
+        j.fixed_view_mut::<3, 3>(0, 0).copy_from(&inv);
+        Ok(j)
+    }
+}

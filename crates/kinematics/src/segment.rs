@@ -1,0 +1,1 @@
+//! Segmentation by deviation (placeholder).

@@ -1,0 +1,225 @@
+//! Four-axis Y-Z-C-A machine of reference 000 §2.9 (thesis §5.3.1): Y and Z move the tool,
+//! A tilts the tool about X, C is an endless rotary table under the part. Joints
+//! `[y, z, c, a]` (mm, rad); planning happens in the part frame and this maps it to joints.
+//!
+//! Conventions (fixing the thesis's C-sign erratum, reference 000 §5 item 16):
+//! * the Y slide moves the tool along the table's radial line, which is the part's +X
+//!   direction when C = 0;
+//! * C > 0 turns the table counter-clockwise seen from +Z (right-handed about +Z), so a tool
+//!   at radius r sees the part polar angle −C: `x_w = r·cos C`, `y_w = −r·sin C` (eq. 5.2);
+//! * A > 0 tilts the tool tip toward +Y (right-handed about +X): `r = y + l·sin A`,
+//!   `z_w = z − l·cos A`, tool axis `(−sin A·cos C, sin A·sin C, cos A)`;
+//! * `l` = pivot-to-gauge distance + tool length; the inverse is C = −atan2(y_w, x_w)
+//!   (not the printed eq. 5.4, which gives +45° where −45° is meant), unwrapped.
+
+use nalgebra::Vector3;
+
+use crate::angle::{unwrap_near, unwrap_within};
+use crate::error::KinematicsError;
+use crate::kinematics::{
+    check_input, check_pose, choose_nearest, Jacobian, Kinematics, Tolerances,
+};
+use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+
+const Y: usize = 0;
+const Z: usize = 1;
+const C: usize = 2;
+const A: usize = 3;
+
+/// The Y-Z-C-A machine.
+#[derive(Clone, Debug)]
+pub struct Yzca {
+    pivot_to_gauge: f64,
+    limits: Vec<JointLimit>,
+    tolerances: Tolerances,
+    axis_sin: f64,
+    pole_sin: f64,
+}
+
+impl Yzca {
+    /// A Y-Z-C-A machine; `pivot_to_gauge` (mm) is the distance from the A pivot to the
+    /// spindle gauge point along the tool; `limits` holds four joints `[y, z, c, a]`.
+    pub fn new(
+        pivot_to_gauge: f64,
+        limits: Vec<JointLimit>,
+        tolerances: Tolerances,
+    ) -> Result<Self, KinematicsError> {
+        if limits.len() != 4 {
+            return Err(KinematicsError::BadInput {
+                reason: format!("yzca has 4 joints (y z c a), got {}", limits.len()),
+            });
+        }
+        Ok(Self {
+            pivot_to_gauge,
+            limits,
+            tolerances,
+            axis_sin: tolerances.axis_rad.sin(),
+            pole_sin: tolerances.pole_cone_rad.sin(),
+        })
+    }
+
+    #[inline]
+    fn lever(&self, tool: &Tool) -> f64 {
+        self.pivot_to_gauge + tool.length
+    }
+
+    /// The joint set for table angle `c` (radial direction (cos C, −sin C)) and tilt `a`.
+    #[inline]
+    fn joints_at(&self, tip: &Vector3<f64>, c: f64, a: f64, l: f64) -> Joints {
+        let (sc, cc) = c.sin_cos();
+        let r = tip.x * cc - tip.y * sc;
+        let (sa, ca) = a.sin_cos();
+        Joints::new([r - l * sa, tip.z + l * ca, c, a])
+    }
+
+    /// Direction of the radial plane (as a C value) for a tip, falling back to the axis's
+    /// horizontal part and then to `previous_c` when both are on the C axis.
+    #[inline]
+    fn radial_c(&self, tip: &Vector3<f64>, axis: Option<&Vector3<f64>>, previous_c: f64) -> f64 {
+        if tip.x.hypot(tip.y) > self.tolerances.centre_mm {
+            (-tip.y).atan2(tip.x)
+        } else if let Some(k) = axis.filter(|k| k.x.hypot(k.y) > self.pole_sin) {
+            // Horizontal axis part is −sin A·(cos C, −sin C); this is the A > 0 branch.
+            k.y.atan2(-k.x)
+        } else {
+            previous_c
+        }
+    }
+}
+
+/// The two tilts that put the tool normal to a path direction (Δy, Δz) in the Y-Z plane,
+/// "inside" and "outside" the curve (reference 000 eq. 5.6). Geometry cannot choose between
+/// them; [`choose_tilt`] uses the programmed A. Returns `None` for a zero direction.
+///
+/// With this file's A sign the tool axis (−sin A, cos A) ⟂ (Δy, Δz) gives A = atan2(Δz, Δy)
+/// and A + π. (The printed eq. 5.6 table is not self-consistent: rows 1 and 3 give an axis
+/// that is not normal to the path; see NOTES-kinematics.md.)
+pub fn normal_tilts(dy: f64, dz: f64) -> Option<[f64; 2]> {
+    if dy == 0.0 && dz == 0.0 {
+        return None;
+    }
+    let a = dz.atan2(dy);
+    Some([a, crate::angle::wrap_pi(a + std::f64::consts::PI)])
+}
+
+/// Of the candidate tilts, the one nearest the programmed A (each unwrapped next to it).
+pub fn choose_tilt(candidates: &[f64; 2], programmed_a: f64) -> f64 {
+    let c0 = unwrap_near(candidates[0], programmed_a);
+    let c1 = unwrap_near(candidates[1], programmed_a);
+    if (c0 - programmed_a).abs() <= (c1 - programmed_a).abs() {
+        c0
+    } else {
+        c1
+    }
+}
+
+impl Kinematics for Yzca {
+    fn joint_limits(&self) -> &[JointLimit] {
+        &self.limits
+    }
+
+    fn forward(&self, q: &Joints, tool: &Tool) -> Result<ToolPose, KinematicsError> {
+        check_input(q, 4)?;
+        let l = self.lever(tool);
+        let (sa, ca) = q[A].sin_cos();
+        let (sc, cc) = q[C].sin_cos();
+        // Reference 000 eq. 5.2, cleaned: r = y + l·sin A, z_w = z − l·cos A.
+        let r = q[Y] + l * sa;
+        let tip = Vector3::new(r * cc, -r * sc, q[Z] - l * ca);
+        Ok(ToolPose::new(tip, Vector3::new(-sa * cc, sa * sc, ca)))
+    }
+
+    fn inverse(
+        &self,
+        pose: &ToolPose,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_pose(pose)?;
+        check_input(previous, 4)?;
+        let k = pose.axis.into_inner();
+        let l = self.lever(tool);
+        let phi = self.radial_c(&pose.tip, Some(&k), previous[C]);
+        let mut cands = [None, None];
+        let mut err = None;
+        for (slot, c_raw) in cands.iter_mut().zip([phi, phi + std::f64::consts::PI]) {
+            let (sc, cc) = c_raw.sin_cos();
+            // Axis components along the radial (cos C, −sin C) and tangential (sin C, cos C)
+            // directions: a 4-axis machine can only tilt in the radial plane.
+            let u = k.x * cc - k.y * sc;
+            let t = k.x * sc + k.y * cc;
+            if t.abs() > self.axis_sin {
+                err = Some(KinematicsError::AxisUnreachable {
+                    reason: format!(
+                        "Y-Z-C-A tilts only in the radial plane; axis is {:.3e} rad out of it",
+                        t.asin()
+                    ),
+                });
+                continue;
+            }
+            let a_raw = (-u).atan2(k.z);
+            let (lc, la) = (&self.limits[C], &self.limits[A]);
+            let Some(c) = unwrap_within(c_raw, previous[C], lc.min, lc.max) else {
+                err.get_or_insert(lc.violation(C, unwrap_near(c_raw, previous[C])));
+                continue;
+            };
+            let Some(a) = unwrap_within(a_raw, previous[A], la.min, la.max) else {
+                err.get_or_insert(la.violation(A, a_raw));
+                continue;
+            };
+            *slot = Some(self.joints_at(&pose.tip, c, a, l));
+        }
+        choose_nearest(&cands, err, previous, &[C, A], &self.limits)
+    }
+
+    fn tcp_angles(&self, q: &Joints) -> Joints {
+        Joints::new([q[C], q[A]])
+    }
+
+    /// Program: tip and (C, A). A is taken as programmed (this is how the programmed A picks
+    /// the tilt solution); C follows from the tip's polar angle, the branch and turn nearest
+    /// the programmed C (the tool cannot reach a tip off the radial plane otherwise).
+    fn tcp_inverse(
+        &self,
+        tip: &Vector3<f64>,
+        angles: &Joints,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_input(previous, 4)?;
+        check_input(angles, 2)?;
+        let (c_prog, a) = (angles[0], angles[1]);
+        let phi = self.radial_c(tip, None, c_prog);
+        let lc = &self.limits[C];
+        let cands = [phi, phi + std::f64::consts::PI].map(|c| {
+            unwrap_within(c, c_prog, lc.min, lc.max)
+                .map(|c| self.joints_at(tip, c, a, self.lever(tool)))
+        });
+        let err = Some(lc.violation(C, unwrap_near(phi, c_prog)));
+        let mut reference = *previous;
+        reference[C] = c_prog;
+        let q = choose_nearest(&cands, err, &reference, &[C], &self.limits)?;
+        check_limits(&q, &self.limits)?;
+        Ok(q)
+    }
+
+    fn jacobian(&self, q: &Joints, tool: &Tool) -> Result<Jacobian, KinematicsError> {
+        check_input(q, 4)?;
+        let l = self.lever(tool);
+        let (sa, ca) = q[A].sin_cos();
+        let (sc, cc) = q[C].sin_cos();
+        let r = q[Y] + l * sa;
+        #[rustfmt::skip]
+        let j = Jacobian::from_column_slice(&[
+            // ∂/∂y
+            cc, -sc, 0.0, 0.0, 0.0, 0.0,
+            // ∂/∂z
+            0.0, 0.0, 1.0, 0.0, 0.0, 0.0,
+            // ∂/∂C
+            -r * sc, -r * cc, 0.0, sa * sc, sa * cc, 0.0,
+            // ∂/∂A
+            l * ca * cc, -l * ca * sc, l * sa, -ca * cc, ca * sc, -sa,
+        ]);
+        Ok(j)
+    }
+}
