@@ -114,6 +114,16 @@ impl LinearDelta {
 
     #[cold]
     fn rod_error(&self, i: usize, d2: f64) -> KinematicsError {
+        let d = d2.sqrt();
+        if d >= self.geometry.rod_length {
+            return KinematicsError::Unreachable {
+                reason: format!(
+                    "tower {} is {d:.3} mm away horizontally, beyond the rod length {}",
+                    i + 1,
+                    self.geometry.rod_length
+                ),
+            };
+        }
         KinematicsError::Unreachable {
             reason: format!(
                 "tower {} rod would be {:.3}° from the platform plane (minimum {:.3}°)",
