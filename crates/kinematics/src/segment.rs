@@ -169,7 +169,8 @@ type Target<'a> =
 
 /// Walks to the end in a few steps so the end joints continue the path (a C table that turns
 /// more than half a turn during the move must not be unwrapped the short way), then halves
-/// pieces until each meets the tolerance.
+/// the move until each piece meets the tolerance. Midpoints are solved with the joint-space
+/// midpoint as the continuity reference, so they stay on the same branch and turn.
 fn split<K: Kinematics + ?Sized>(
     kinematics: &K,
     tool: &Tool,
@@ -181,30 +182,29 @@ fn split<K: Kinematics + ?Sized>(
 ) -> Result<Segmented, KinematicsError> {
     const WALK: usize = 8;
     let (q_start, _) = target(0.0, previous)?;
+    let mut q_end = q_start;
+    let mut ax_end = None;
+    for k in 1..=WALK {
+        let (q, ax) = target(k as f64 / WALK as f64, &q_end)?;
+        q_end = q;
+        ax_end = Some(ax);
+    }
+    let ax_end = ax_end.unwrap_or_else(Vector3::z_axis);
     let mut points = vec![(0.0, q_start)];
     let mut max_dev: f64 = 0.0;
-    let mut q0 = q_start;
-    for k in 1..=WALK {
-        let s0 = (k - 1) as f64 / WALK as f64;
-        let s1 = k as f64 / WALK as f64;
-        let (q1, ax1) = target(s1, &q0)?;
-        refine(
-            kinematics,
-            tool,
-            a,
-            b,
-            options,
-            target,
-            (s0, q0),
-            (s1, q1, ax1),
-            0,
-            &mut points,
-            &mut max_dev,
-        )?;
-        q0 = q1;
-    }
-    // Merge walk points that turned out unnecessary: keep it simple and exact by returning
-    // all waypoints; at most WALK − 1 of them are extra.
+    refine(
+        kinematics,
+        tool,
+        a,
+        b,
+        options,
+        target,
+        (0.0, q_start),
+        (1.0, q_end, ax_end),
+        0,
+        &mut points,
+        &mut max_dev,
+    )?;
     Ok(Segmented {
         points,
         max_deviation_mm: max_dev,
@@ -236,7 +236,7 @@ fn refine<K: Kinematics + ?Sized>(
         worst = worst.max(distance_to_segment(&pose.tip, a, b).0);
         if let Some(tol) = options.axis_tolerance_rad {
             let s = s0 + (s1 - s0) * t;
-            let (_, want) = target(s, &q0)?;
+            let (_, want) = target(s, &q0.lerp(&q1, t))?;
             let ang = pose.axis.cross(&want).norm().atan2(pose.axis.dot(&want));
             axis_ok &= ang <= tol;
         }
@@ -255,7 +255,7 @@ fn refine<K: Kinematics + ?Sized>(
         });
     }
     let sm = 0.5 * (s0 + s1);
-    let (qm, axm) = target(sm, &q0)?;
+    let (qm, axm) = target(sm, &q0.lerp(&q1, 0.5))?;
     refine(
         kinematics,
         tool,

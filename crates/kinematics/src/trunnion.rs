@@ -190,7 +190,8 @@ impl Kinematics for Trunnion {
     }
 
     fn tcp_angles(&self, q: &Joints) -> Joints {
-        Joints::new([q[TILT], q[C]])
+        let v = q.as_slice();
+        Joints::new([v.get(TILT), v.get(C)].map(|x| x.copied().unwrap_or(f64::NAN)))
     }
 
     fn tcp_inverse(

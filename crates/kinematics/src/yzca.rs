@@ -173,7 +173,8 @@ impl Kinematics for Yzca {
     }
 
     fn tcp_angles(&self, q: &Joints) -> Joints {
-        Joints::new([q[C], q[A]])
+        let v = q.as_slice();
+        Joints::new([v.get(C), v.get(A)].map(|x| x.copied().unwrap_or(f64::NAN)))
     }
 
     /// Program: tip and (C, A). A is taken as programmed (this is how the programmed A picks
