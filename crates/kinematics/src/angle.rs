@@ -21,7 +21,13 @@ pub fn wrap_pi(a: f64) -> f64 {
 /// 355° followed by 5° gives 365°.
 #[inline]
 pub fn unwrap_near(a: f64, previous: f64) -> f64 {
-    previous + wrap_pi(a - previous)
+    let d = a - previous;
+    // Fast path (the 1 ms loop): already the nearest turn, keep `a` bit for bit.
+    if d.abs() <= PI {
+        a
+    } else {
+        previous + wrap_pi(d)
+    }
 }
 
 /// The value congruent to `a` nearest to `previous` that lies inside `[min, max]`, or `None`.

@@ -12,7 +12,7 @@ use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 #[derive(Clone, Debug)]
 pub struct Cartesian {
     limits: Vec<JointLimit>,
-    tolerances: Tolerances,
+    axis_sin: f64,
 }
 
 impl Cartesian {
@@ -24,7 +24,10 @@ impl Cartesian {
                 reason: format!("cartesian needs 3 to 6 joints, got {}", limits.len()),
             });
         }
-        Ok(Self { limits, tolerances })
+        Ok(Self {
+            limits,
+            axis_sin: tolerances.axis_rad.sin(),
+        })
     }
 }
 
@@ -52,8 +55,8 @@ impl Kinematics for Cartesian {
         check_input(previous, self.limits.len())?;
         // The only axis this machine makes is +Z; the sine of the angle to it is the
         // horizontal part of the unit axis.
-        let horizontal = pose.axis.x.hypot(pose.axis.y);
-        if pose.axis.z <= 0.0 || horizontal > self.tolerances.axis_rad.sin() {
+        let horizontal = (pose.axis.x * pose.axis.x + pose.axis.y * pose.axis.y).sqrt();
+        if pose.axis.z <= 0.0 || horizontal > self.axis_sin {
             return Err(KinematicsError::AxisUnreachable {
                 reason: format!(
                     "a Cartesian machine's tool axis is +Z; requested ({:.6}, {:.6}, {:.6})",

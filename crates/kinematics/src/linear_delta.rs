@@ -100,14 +100,14 @@ impl LinearDelta {
     #[inline]
     pub fn inverse_platform(&self, p: &Vector3<f64>) -> Result<[f64; 3], KinematicsError> {
         let mut q = [0.0; 3];
-        for i in 0..3 {
-            let dx = p.x - self.towers[i].0;
-            let dy = p.y - self.towers[i].1;
+        for (i, (qi, (tx, ty))) in q.iter_mut().zip(self.towers).enumerate() {
+            let dx = p.x - tx;
+            let dy = p.y - ty;
             let d2 = dx * dx + dy * dy;
             if d2 > self.max_d2 {
                 return Err(self.rod_error(i, d2));
             }
-            q[i] = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
+            *qi = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
         }
         Ok(q)
     }
@@ -161,7 +161,7 @@ impl LinearDelta {
         let gq = fx * dx + fy * dy;
         let hq = dx * dx + dy * dy - self.rod2;
         let disc = gq * gq - f * hq;
-        if !(disc >= 0.0) {
+        if disc.is_nan() || disc < 0.0 {
             return Err(KinematicsError::Unreachable {
                 reason: format!(
                     "carriage heights {:.4}, {:.4}, {:.4} admit no assembly (rods too short)",
@@ -181,7 +181,7 @@ impl LinearDelta {
             let dx = p.x - self.towers[i].0;
             let dy = p.y - self.towers[i].1;
             let hi = (self.rod2 - dx * dx - dy * dy).sqrt();
-            if !(hi > 0.0) {
+            if hi.is_nan() || hi <= 0.0 {
                 return Err(KinematicsError::Singular {
                     reason: format!("tower {} rod horizontal", i + 1),
                 });
@@ -194,7 +194,9 @@ impl LinearDelta {
     }
 
     fn check_axis(&self, pose: &ToolPose) -> Result<(), KinematicsError> {
-        if pose.axis.z <= 0.0 || pose.axis.x.hypot(pose.axis.y) > self.axis_sin {
+        if pose.axis.z <= 0.0
+            || (pose.axis.x * pose.axis.x + pose.axis.y * pose.axis.y).sqrt() > self.axis_sin
+        {
             return Err(KinematicsError::AxisUnreachable {
                 reason: "a linear delta only translates; the tool axis is +Z".into(),
             });

@@ -6,9 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::angle::unwrap_within;
 use crate::error::KinematicsError;
-use crate::kinematics::{
-    check_input, check_pose, choose_nearest, Jacobian, Kinematics, Tolerances,
-};
+use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 use crate::{table_ac, table_bc};
 
@@ -86,30 +84,69 @@ impl Trunnion {
         }
     }
 
-    /// Joints for a part-frame tip at fixed table angles: the TCP map of the linear axes.
+    /// Gauge-point joints for a part-frame tip at fixed table angles: the TCP map of the
+    /// linear axes.
     #[inline]
     fn linear_for(&self, tip: &Vector3<f64>, tilt: f64, c: f64, tool: &Tool) -> Vector3<f64> {
-        let m = self.pivot + self.r_tilt(tilt) * (self.c_offset + rz(c) * tip);
-        Vector3::new(m.x, m.y, m.z + tool.length)
+        let (st, ct) = tilt.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        self.linear_sc(tip, st, ct, sc, cc, tool)
     }
 
-    /// One candidate joint set for raw angles (tilt, C): turns chosen nearest `previous`
-    /// within limits; `None` if no turn fits.
+    /// As [`Self::linear_for`] from the sines and cosines, which the inverse already has from
+    /// the tool axis (no trigonometry in the 1 ms loop beyond two `atan2`).
     #[inline]
-    fn candidate(
+    fn linear_sc(
         &self,
         tip: &Vector3<f64>,
-        tilt: f64,
-        c: f64,
+        st: f64,
+        ct: f64,
+        sc: f64,
+        cc: f64,
         tool: &Tool,
-        previous: &Joints,
-    ) -> Option<Joints> {
+    ) -> Vector3<f64> {
+        // c_offset + Rz(C)·p, then R_tilt, then pivot; the gauge point is the tool length above.
+        let v =
+            Vector3::new(cc * tip.x - sc * tip.y, sc * tip.x + cc * tip.y, tip.z) + self.c_offset;
+        let w = match self.tilt {
+            TiltAxis::X => Vector3::new(v.x, ct * v.y - st * v.z, st * v.y + ct * v.z),
+            TiltAxis::Y => Vector3::new(ct * v.x + st * v.z, v.y, -st * v.x + ct * v.z),
+        };
+        self.pivot + w + Vector3::new(0.0, 0.0, tool.length)
+    }
+
+    /// Turns of (tilt, C) nearest `previous` within the rotary limits, or `None`.
+    #[inline]
+    fn turns(&self, tilt: f64, c: f64, previous: &Joints) -> Option<(f64, f64)> {
         let lt = &self.limits[TILT];
         let lc = &self.limits[C];
-        let t = unwrap_within(tilt, previous[TILT], lt.min, lt.max)?;
-        let c = unwrap_within(c, previous[C], lc.min, lc.max)?;
-        let m = self.linear_for(tip, t, c, tool);
-        Some(Joints::new([m.x, m.y, m.z, t, c]))
+        Some((
+            unwrap_within(tilt, previous[TILT], lt.min, lt.max)?,
+            unwrap_within(c, previous[C], lc.min, lc.max)?,
+        ))
+    }
+
+    /// The pole: C is undefined, keep it (no jump) and tilt as little as needed.
+    #[cold]
+    fn inverse_at_pole(
+        &self,
+        pose: &ToolPose,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        let k = pose.axis.into_inner();
+        let c = previous[C];
+        let t = match self.tilt {
+            TiltAxis::X => table_ac::tilt_keeping_c(&k, c),
+            TiltAxis::Y => table_bc::tilt_keeping_c(&k, c),
+        };
+        let (t, c) = self
+            .turns(t, c, previous)
+            .ok_or_else(|| self.limits[TILT].violation(TILT, t))?;
+        let m = self.linear_for(&pose.tip, t, c, tool);
+        let q = Joints::new([m.x, m.y, m.z, t, c]);
+        check_limits(&q, &self.limits)?;
+        Ok(q)
     }
 }
 
@@ -146,47 +183,53 @@ impl Kinematics for Trunnion {
         check_pose(pose)?;
         check_input(previous, 5)?;
         let k = pose.axis.into_inner();
-        if k.x.hypot(k.y) <= self.pole_sin {
-            // The pole: C is undefined, keep it (no jump) and tilt as little as needed.
-            let c = previous[C];
-            let t = match self.tilt {
-                TiltAxis::X => table_ac::tilt_keeping_c(&k, c),
-                TiltAxis::Y => table_bc::tilt_keeping_c(&k, c),
-            };
-            return match self.candidate(&pose.tip, t, c, tool, previous) {
-                Some(q) => check_limits(&q, &self.limits).map(|_| q),
-                None => Err(self.limits[TILT].violation(TILT, t)),
-            };
+        let h = (k.x * k.x + k.y * k.y).sqrt();
+        if h <= self.pole_sin {
+            return self.inverse_at_pole(pose, tool, previous);
         }
-        let sols = match self.tilt {
-            TiltAxis::X => table_ac::solutions(&k),
-            TiltAxis::Y => table_bc::solutions(&k),
+        // Branch 1 (tilt ≥ 0) from the axis (table_ac/table_bc `solutions`), with its sines
+        // and cosines read off the unit axis; branch 2 is (−tilt, C + π).
+        let t1 = h.atan2(k.z);
+        let (c1, sc, cc) = match self.tilt {
+            TiltAxis::X => (k.x.atan2(k.y), k.x / h, k.y / h),
+            TiltAxis::Y => (k.y.atan2(-k.x), k.y / h, -k.x / h),
         };
-        let cands = [
-            self.candidate(&pose.tip, sols[0].0, sols[0].1, tool, previous),
-            self.candidate(&pose.tip, sols[1].0, sols[1].1, tool, previous),
-        ];
-        let err = if cands.iter().all(Option::is_none) {
-            // Report the tilt (or C) that no turn could bring inside its limits.
-            let (t, c) = sols[0];
-            Some(
-                if unwrap_within(
-                    t,
-                    previous[TILT],
-                    self.limits[TILT].min,
-                    self.limits[TILT].max,
-                )
-                .is_none()
-                {
-                    self.limits[TILT].violation(TILT, t)
-                } else {
-                    self.limits[C].violation(C, c)
-                },
-            )
+        let b1 = self.turns(t1, c1, previous);
+        let b2 = self.turns(-t1, c1 + std::f64::consts::PI, previous);
+        let cost = |b: &Option<(f64, f64)>| {
+            b.map_or(f64::INFINITY, |(t, c)| {
+                (t - previous[TILT]).abs() + (c - previous[C]).abs()
+            })
+        };
+        let first_is_1 = cost(&b1) <= cost(&b2);
+        let order = if first_is_1 {
+            [(b1, 1.0), (b2, -1.0)]
         } else {
-            None
+            [(b2, -1.0), (b1, 1.0)]
         };
-        choose_nearest(&cands, err, previous, &[TILT, C], &self.limits)
+        let mut err = None;
+        for (b, sign) in order {
+            let Some((t, c)) = b else { continue };
+            let m = self.linear_sc(&pose.tip, sign * h, k.z, sign * sc, sign * cc, tool);
+            let q = Joints::new([m.x, m.y, m.z, t, c]);
+            match check_limits(&q, &self.limits) {
+                Ok(()) => return Ok(q),
+                Err(e) => {
+                    err.get_or_insert(e);
+                }
+            }
+        }
+        Err(err.unwrap_or_else(|| {
+            // No turn of either branch fits the rotary limits: name the tilt if that is why.
+            let lt = &self.limits[TILT];
+            if unwrap_within(t1, previous[TILT], lt.min, lt.max).is_none()
+                && unwrap_within(-t1, previous[TILT], lt.min, lt.max).is_none()
+            {
+                lt.violation(TILT, t1)
+            } else {
+                self.limits[C].violation(C, c1)
+            }
+        }))
     }
 
     fn tcp_angles(&self, q: &Joints) -> Joints {

@@ -138,37 +138,61 @@ impl Kinematics for Yzca {
         check_pose(pose)?;
         check_input(previous, 4)?;
         let k = pose.axis.into_inner();
+        let p = &pose.tip;
         let l = self.lever(tool);
-        let phi = self.radial_c(&pose.tip, Some(&k), previous[C]);
-        let mut cands = [None, None];
-        let mut err = None;
-        for (slot, c_raw) in cands.iter_mut().zip([phi, phi + std::f64::consts::PI]) {
-            let (sc, cc) = c_raw.sin_cos();
-            // Axis components along the radial (cos C, −sin C) and tangential (sin C, cos C)
-            // directions: a 4-axis machine can only tilt in the radial plane.
-            let u = k.x * cc - k.y * sc;
-            let t = k.x * sc + k.y * cc;
-            if t.abs() > self.axis_sin {
-                err = Some(KinematicsError::AxisUnreachable {
-                    reason: format!(
-                        "Y-Z-C-A tilts only in the radial plane; axis is {:.3e} rad out of it",
-                        t.asin()
-                    ),
-                });
-                continue;
-            }
-            let a_raw = (-u).atan2(k.z);
-            let (lc, la) = (&self.limits[C], &self.limits[A]);
-            let Some(c) = unwrap_within(c_raw, previous[C], lc.min, lc.max) else {
-                err.get_or_insert(lc.violation(C, unwrap_near(c_raw, previous[C])));
-                continue;
-            };
-            let Some(a) = unwrap_within(a_raw, previous[A], la.min, la.max) else {
-                err.get_or_insert(la.violation(A, a_raw));
-                continue;
-            };
-            *slot = Some(self.joints_at(&pose.tip, c, a, l));
+        // The radial plane (cos C, −sin C): from the tip, else from the axis, else keep C.
+        let rho = (p.x * p.x + p.y * p.y).sqrt();
+        let hk = (k.x * k.x + k.y * k.y).sqrt();
+        let (c1, sc, cc) = if rho > self.tolerances.centre_mm {
+            ((-p.y).atan2(p.x), -p.y / rho, p.x / rho)
+        } else if hk > self.pole_sin {
+            // horizontal axis part is −sin A·(cos C, −sin C); this is the A > 0 branch
+            (k.y.atan2(-k.x), k.y / hk, -k.x / hk)
+        } else {
+            let c = previous[C];
+            let (s, co) = c.sin_cos();
+            (c, s, co)
+        };
+        // Axis components along the radial and tangential (sin C, cos C) directions: a
+        // 4-axis machine tilts only in the radial plane.
+        let u = k.x * cc - k.y * sc;
+        let t = k.x * sc + k.y * cc;
+        if t.abs() > self.axis_sin {
+            return Err(KinematicsError::AxisUnreachable {
+                reason: format!(
+                    "Y-Z-C-A tilts only in the radial plane; the axis is {:.3e} rad out of it",
+                    t.clamp(-1.0, 1.0).asin()
+                ),
+            });
         }
+        let r = p.x * cc - p.y * sc;
+        let a1 = (-u).atan2(k.z);
+        let n = (u * u + k.z * k.z).sqrt();
+        let y1 = r + l * u / n; // r − l·sin A with sin A = −u/n
+        let z1 = p.z + l * k.z / n;
+        // Branch 2 turns the table half a turn and tilts the other way: (−y, z, C + π, −A).
+        let (lc, la) = (&self.limits[C], &self.limits[A]);
+        let turns = |c: f64, a: f64| {
+            Some((
+                unwrap_within(c, previous[C], lc.min, lc.max)?,
+                unwrap_within(a, previous[A], la.min, la.max)?,
+            ))
+        };
+        let cands = [
+            turns(c1, a1).map(|(c, a)| Joints::new([y1, z1, c, a])),
+            turns(c1 + std::f64::consts::PI, -a1).map(|(c, a)| Joints::new([-y1, z1, c, a])),
+        ];
+        let err = if cands.iter().all(Option::is_none) {
+            Some(
+                if unwrap_within(a1, previous[A], la.min, la.max).is_none() {
+                    la.violation(A, a1)
+                } else {
+                    lc.violation(C, unwrap_near(c1, previous[C]))
+                },
+            )
+        } else {
+            None
+        };
         choose_nearest(&cands, err, previous, &[C, A], &self.limits)
     }
 

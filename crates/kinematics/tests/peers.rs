@@ -51,13 +51,10 @@ impl Lcnc {
     }
     fn inverse(&self, p: Vector3<f64>) -> [f64; 3] {
         let l2 = self.l * self.l;
-        let mut q = [0.0; 3];
-        for i in 0..3 {
-            q[i] = p.z
-                + (l2 - (self.t[i].0 - p.x).powi(2) - (self.t[i].1 - p.y).powi(2)).sqrt()
-                + self.joff[i];
-        }
-        q
+        [0, 1, 2].map(|i| {
+            p.z + (l2 - (self.t[i].0 - p.x).powi(2) - (self.t[i].1 - p.y).powi(2)).sqrt()
+                + self.joff[i]
+        })
     }
     fn forward(&self, j: [f64; 3]) -> Option<Vector3<f64>> {
         let [(_, ay), (bx, by), (cx, cy)] = self.t;
