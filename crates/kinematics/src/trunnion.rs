@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::angle::unwrap_within;
+use crate::angle::{atan2, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
@@ -116,7 +116,7 @@ impl Trunnion {
     }
 
     /// Turns of (tilt, C) nearest `previous` within the rotary limits, or `None`.
-    #[inline]
+    #[inline(always)]
     fn turns(&self, tilt: f64, c: f64, previous: &Joints) -> Option<(f64, f64)> {
         let lt = &self.limits[TILT];
         let lc = &self.limits[C];
@@ -189,10 +189,10 @@ impl Kinematics for Trunnion {
         }
         // Branch 1 (tilt ≥ 0) from the axis (table_ac/table_bc `solutions`), with its sines
         // and cosines read off the unit axis; branch 2 is (−tilt, C + π).
-        let t1 = h.atan2(k.z);
+        let t1 = atan2(h, k.z);
         let (c1, sc, cc) = match self.tilt {
-            TiltAxis::X => (k.x.atan2(k.y), k.x / h, k.y / h),
-            TiltAxis::Y => (k.y.atan2(-k.x), k.y / h, -k.x / h),
+            TiltAxis::X => (atan2(k.x, k.y), k.x / h, k.y / h),
+            TiltAxis::Y => (atan2(k.y, -k.x), k.y / h, -k.x / h),
         };
         let b1 = self.turns(t1, c1, previous);
         let b2 = self.turns(-t1, c1 + std::f64::consts::PI, previous);

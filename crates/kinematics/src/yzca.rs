@@ -14,7 +14,7 @@
 
 use nalgebra::Vector3;
 
-use crate::angle::{unwrap_near, unwrap_within};
+use crate::angle::{atan2, unwrap_near, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{
     check_input, check_pose, choose_nearest, Jacobian, Kinematics, Tolerances,
@@ -144,10 +144,10 @@ impl Kinematics for Yzca {
         let rho = (p.x * p.x + p.y * p.y).sqrt();
         let hk = (k.x * k.x + k.y * k.y).sqrt();
         let (c1, sc, cc) = if rho > self.tolerances.centre_mm {
-            ((-p.y).atan2(p.x), -p.y / rho, p.x / rho)
+            (atan2(-p.y, p.x), -p.y / rho, p.x / rho)
         } else if hk > self.pole_sin {
             // horizontal axis part is −sin A·(cos C, −sin C); this is the A > 0 branch
-            (k.y.atan2(-k.x), k.y / hk, -k.x / hk)
+            (atan2(k.y, -k.x), k.y / hk, -k.x / hk)
         } else {
             let c = previous[C];
             let (s, co) = c.sin_cos();
@@ -166,7 +166,7 @@ impl Kinematics for Yzca {
             });
         }
         let r = p.x * cc - p.y * sc;
-        let a1 = (-u).atan2(k.z);
+        let a1 = atan2(-u, k.z);
         let n = (u * u + k.z * k.z).sqrt();
         let y1 = r + l * u / n; // r − l·sin A with sin A = −u/n
         let z1 = p.z + l * k.z / n;
