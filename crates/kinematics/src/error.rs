@@ -48,3 +48,22 @@ pub enum KinematicsError {
         reason: String,
     },
 }
+
+/// A kinematic error attached to the program line that caused it, for pre-flight `check`:
+/// every unreachable pose or joint-limit violation is reported with its line before motion.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("line {line}: {error}")]
+pub struct AtLine {
+    /// 1-based source line of the block.
+    pub line: usize,
+    /// What went wrong there.
+    #[source]
+    pub error: KinematicsError,
+}
+
+impl KinematicsError {
+    /// This error at a program line.
+    pub fn at_line(self, line: usize) -> AtLine {
+        AtLine { line, error: self }
+    }
+}

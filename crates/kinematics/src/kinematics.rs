@@ -162,6 +162,7 @@ pub(crate) fn choose_nearest(
 }
 
 /// Checks the joint-set size and finiteness at the API boundary.
+#[inline]
 pub(crate) fn check_input(q: &Joints, n: usize) -> Result<(), KinematicsError> {
     if q.len() != n {
         return Err(KinematicsError::BadInput {
@@ -177,6 +178,7 @@ pub(crate) fn check_input(q: &Joints, n: usize) -> Result<(), KinematicsError> {
 }
 
 /// Checks a pose is finite.
+#[inline]
 pub(crate) fn check_pose(p: &ToolPose) -> Result<(), KinematicsError> {
     let (t, a) = (&p.tip, &p.axis);
     if t.x.is_finite()

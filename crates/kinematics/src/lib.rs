@@ -33,7 +33,7 @@ pub mod tcp;
 pub mod trunnion;
 pub mod yzca;
 
-pub use error::KinematicsError;
+pub use error::{AtLine, KinematicsError};
 pub use kinematics::{Jacobian, Kinematics, Tolerances};
 pub use machine::{builtin_names, Machine, MachineError, Model};
 pub use pose::{JointKind, JointLimit, Joints, Tool, ToolPose};

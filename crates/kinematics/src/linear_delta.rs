@@ -224,9 +224,11 @@ impl Kinematics for LinearDelta {
         &self,
         pose: &ToolPose,
         tool: &Tool,
-        _previous: &Joints,
+        previous: &Joints,
     ) -> Result<Joints, KinematicsError> {
         check_pose(pose)?;
+        // A delta has one solution; `previous` is only checked, for a uniform API.
+        check_input(previous, 3)?;
         self.check_axis(pose)?;
         let p = Vector3::new(pose.tip.x, pose.tip.y, pose.tip.z + tool.length);
         let q = Joints::new(self.inverse_platform(&p)?);

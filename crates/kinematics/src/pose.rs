@@ -225,12 +225,21 @@ impl JointLimit {
 }
 
 /// Checks every joint against its limit; the first violation is the error.
+#[inline]
 pub fn check_limits(q: &Joints, limits: &[JointLimit]) -> Result<(), KinematicsError> {
     if q.len() != limits.len() {
         return Err(KinematicsError::BadInput {
             reason: format!("{} joints given, machine has {}", q.len(), limits.len()),
         });
     }
+    if q.as_slice().iter().zip(limits).all(|(v, l)| l.contains(*v)) {
+        return Ok(());
+    }
+    limit_violation(q, limits)
+}
+
+#[cold]
+fn limit_violation(q: &Joints, limits: &[JointLimit]) -> Result<(), KinematicsError> {
     for (i, (v, l)) in q.as_slice().iter().zip(limits).enumerate() {
         if !l.contains(*v) {
             return Err(l.violation(i, *v));

@@ -190,9 +190,10 @@ impl Kinematics for Trunnion {
         // Branch 1 (tilt ≥ 0) from the axis (table_ac/table_bc `solutions`), with its sines
         // and cosines read off the unit axis; branch 2 is (−tilt, C + π).
         let t1 = atan2(h, k.z);
+        let inv_h = 1.0 / h;
         let (c1, sc, cc) = match self.tilt {
-            TiltAxis::X => (atan2(k.x, k.y), k.x / h, k.y / h),
-            TiltAxis::Y => (atan2(k.y, -k.x), k.y / h, -k.x / h),
+            TiltAxis::X => (atan2(k.x, k.y), k.x * inv_h, k.y * inv_h),
+            TiltAxis::Y => (atan2(k.y, -k.x), k.y * inv_h, -k.x * inv_h),
         };
         let b1 = self.turns(t1, c1, previous);
         let b2 = self.turns(-t1, c1 + std::f64::consts::PI, previous);

@@ -72,17 +72,14 @@ impl Yzca {
         Joints::new([r - l * sa, tip.z + l * ca, c, a])
     }
 
-    /// Direction of the radial plane (as a C value) for a tip, falling back to the axis's
-    /// horizontal part and then to `previous_c` when both are on the C axis.
+    /// Direction of the radial plane (as a C value) through a tip, or `fallback` when the
+    /// tip is on the C axis.
     #[inline]
-    fn radial_c(&self, tip: &Vector3<f64>, axis: Option<&Vector3<f64>>, previous_c: f64) -> f64 {
-        if tip.x.hypot(tip.y) > self.tolerances.centre_mm {
-            (-tip.y).atan2(tip.x)
-        } else if let Some(k) = axis.filter(|k| k.x.hypot(k.y) > self.pole_sin) {
-            // Horizontal axis part is −sin A·(cos C, −sin C); this is the A > 0 branch.
-            k.y.atan2(-k.x)
+    fn radial_c(&self, tip: &Vector3<f64>, fallback: f64) -> f64 {
+        if (tip.x * tip.x + tip.y * tip.y).sqrt() > self.tolerances.centre_mm {
+            atan2(-tip.y, tip.x)
         } else {
-            previous_c
+            fallback
         }
     }
 }
@@ -214,7 +211,7 @@ impl Kinematics for Yzca {
         check_input(previous, 4)?;
         check_input(angles, 2)?;
         let (c_prog, a) = (angles[0], angles[1]);
-        let phi = self.radial_c(tip, None, c_prog);
+        let phi = self.radial_c(tip, c_prog);
         let lc = &self.limits[C];
         let cands = [phi, phi + std::f64::consts::PI].map(|c| {
             unwrap_within(c, c_prog, lc.min, lc.max)
