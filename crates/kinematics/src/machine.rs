@@ -11,6 +11,7 @@ use std::path::Path;
 
 use nalgebra::Vector3;
 use serde::Deserialize;
+use tezgah_geom::Axis;
 use thiserror::Error;
 
 use crate::cartesian::Cartesian;
@@ -265,6 +266,31 @@ impl Machine {
             .zip(&self.joints)
             .map(|(v, j)| v / j.to_internal())
             .collect()
+    }
+
+    /// The program axes (A, B, C) that carry the TCP angles of [`Kinematics::tcp_angles`], in
+    /// that order: (A, C) on table-ac, (B, C) on table-bc, (C, A) on yzca, none on a delta,
+    /// and on a Cartesian machine the extra joints by name (`a`, `b` or `c`).
+    pub fn tcp_axes(&self) -> Result<Vec<Axis>, MachineError> {
+        Ok(match &self.kinematics {
+            Model::TableAc(_) => vec![Axis::A, Axis::C],
+            Model::TableBc(_) => vec![Axis::B, Axis::C],
+            Model::Yzca(_) => vec![Axis::C, Axis::A],
+            Model::LinearDelta(_) => vec![],
+            Model::Cartesian(_) => self.joints[3..]
+                .iter()
+                .enumerate()
+                .map(|(i, j)| match j.name.to_ascii_lowercase().as_str() {
+                    "a" => Ok(Axis::A),
+                    "b" => Ok(Axis::B),
+                    "c" => Ok(Axis::C),
+                    _ => Err(invalid(
+                        format!("joint[{}].name", i + 3),
+                        "an extra joint of a cartesian machine must be named a, b or c to take a program axis",
+                    )),
+                })
+                .collect::<Result<_, _>>()?,
+        })
     }
 
     /// Joints at zero (or the nearest limit when zero is outside): a start for continuity.

@@ -4,6 +4,7 @@
 //! with TCP off, program axes are joints. The interpreter's G43.4 parsing lives elsewhere.
 
 use nalgebra::Vector3;
+use tezgah_geom::{Axis, Pose};
 
 use crate::error::KinematicsError;
 use crate::kinematics::Kinematics;
@@ -21,6 +22,39 @@ pub struct ProgramPose {
 }
 
 impl ProgramPose {
+    /// The TCP program pose of an interpreter [`Pose`] (X Y Z in mm, A B C in degrees):
+    /// the tip is X Y Z, the angles are the program axes `axes` in the model's order (see
+    /// [`crate::machine::Machine::tcp_axes`]), converted to radians.
+    pub fn from_program(pose: &Pose, axes: &[Axis]) -> Result<Self, KinematicsError> {
+        let mut angles = Joints::zeros(axes.len());
+        for (v, a) in angles.as_mut_slice().iter_mut().zip(axes) {
+            if a.is_linear() {
+                return Err(KinematicsError::BadInput {
+                    reason: format!("{} is not an orientation axis", a.letter()),
+                });
+            }
+            *v = pose[*a].to_radians();
+        }
+        if axes.len() > crate::pose::MAX_JOINTS {
+            return Err(KinematicsError::BadInput {
+                reason: "too many orientation axes".into(),
+            });
+        }
+        Ok(Self {
+            tip: Vector3::new(pose.x(), pose.y(), pose.z()),
+            angles,
+        })
+    }
+
+    /// Back to an interpreter [`Pose`] (angles in degrees; axes not listed are zero).
+    pub fn to_program(&self, axes: &[Axis]) -> Pose {
+        let mut p = Pose::new(self.tip.x, self.tip.y, self.tip.z, 0.0, 0.0, 0.0);
+        for (v, a) in self.angles.as_slice().iter().zip(axes) {
+            p[*a] = v.to_degrees();
+        }
+        p
+    }
+
     /// Linear interpolation of tip and angles: the TCP path between two program points.
     pub fn lerp(&self, other: &ProgramPose, t: f64) -> ProgramPose {
         ProgramPose {

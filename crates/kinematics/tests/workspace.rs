@@ -249,3 +249,40 @@ fn joint_velocity_through_the_jacobian() {
     }
     assert!(pose.axis.z < 1.0);
 }
+
+/// The interpreter's program pose (degrees) maps to TCP joints and back through each
+/// machine's program axes.
+#[test]
+fn tcp_from_interpreter_pose() {
+    use tezgah_geom::{Axis, Pose};
+    use tezgah_kinematics::tcp::{ProgramPose, Tcp};
+    let m = Machine::builtin("table-ac").unwrap();
+    let axes = m.tcp_axes().unwrap();
+    assert_eq!(axes, [Axis::A, Axis::C]);
+    let prog = Pose::new(12.0, -7.0, 3.0, 35.0, 0.0, 400.0);
+    let pp = ProgramPose::from_program(&prog, &axes).unwrap();
+    let tcp = Tcp::new(&m.kinematics, Tool::with_length(80.0));
+    let q = tcp.joints(&pp, &m.home()).unwrap();
+    let f = m.to_file_units(&q);
+    assert!(
+        (f[3] - 35.0).abs() < 1e-12 && (f[4] - 400.0).abs() < 1e-9,
+        "{f:?}"
+    );
+    let back = tcp.program(&q).unwrap().to_program(&axes);
+    for i in 0..6 {
+        assert!((back.0[i] - prog.0[i]).abs() < 1e-9, "{back:?}");
+    }
+    // the tool axis is the DESIGN.md one for (A, C)
+    let axis = tcp.tool_pose(&pp, &m.home()).unwrap().axis;
+    assert!((axis.into_inner() - ac_axis(35.0, 400.0)).norm() < 1e-12);
+    assert_eq!(
+        Machine::builtin("yzca").unwrap().tcp_axes().unwrap(),
+        [Axis::C, Axis::A]
+    );
+    assert!(Machine::builtin("linear-delta")
+        .unwrap()
+        .tcp_axes()
+        .unwrap()
+        .is_empty());
+    assert!(ProgramPose::from_program(&prog, &[Axis::X]).is_err());
+}
