@@ -164,9 +164,9 @@ impl Kinematics for Yzca {
         }
         let r = p.x * cc - p.y * sc;
         let a1 = atan2(-u, k.z);
-        let n = (u * u + k.z * k.z).sqrt();
-        let y1 = r + l * u / n; // r − l·sin A with sin A = −u/n
-        let z1 = p.z + l * k.z / n;
+        let inv_n = 1.0 / (u * u + k.z * k.z).sqrt();
+        let y1 = r + l * u * inv_n; // r − l·sin A with sin A = −u/n
+        let z1 = p.z + l * k.z * inv_n;
         // Branch 2 turns the table half a turn and tilts the other way: (−y, z, C + π, −A).
         let (lc, la) = (&self.limits[C], &self.limits[A]);
         let turns = |c: f64, a: f64| {
@@ -175,22 +175,38 @@ impl Kinematics for Yzca {
                 unwrap_within(a, previous[A], la.min, la.max)?,
             ))
         };
-        let cands = [
-            turns(c1, a1).map(|(c, a)| Joints::new([y1, z1, c, a])),
-            turns(c1 + std::f64::consts::PI, -a1).map(|(c, a)| Joints::new([-y1, z1, c, a])),
-        ];
-        let err = if cands.iter().all(Option::is_none) {
-            Some(
-                if unwrap_within(a1, previous[A], la.min, la.max).is_none() {
-                    la.violation(A, a1)
-                } else {
-                    lc.violation(C, unwrap_near(c1, previous[C]))
-                },
-            )
-        } else {
-            None
+        let b1 = turns(c1, a1);
+        let b2 = turns(c1 + std::f64::consts::PI, -a1);
+        let cost = |b: &Option<(f64, f64)>| {
+            b.map_or(f64::INFINITY, |(c, a)| {
+                (c - previous[C]).abs() + (a - previous[A]).abs()
+            })
         };
-        choose_nearest(&cands, err, previous, &[C, A], &self.limits)
+        let order = if cost(&b1) <= cost(&b2) {
+            [(b1, y1), (b2, -y1)]
+        } else {
+            [(b2, -y1), (b1, y1)]
+        };
+        let mut err = None;
+        for (b, y) in order {
+            let Some((c, a)) = b else { continue };
+            let q = Joints::new([y, z1, c, a]);
+            match check_limits(&q, &self.limits) {
+                Ok(()) => return Ok(q),
+                Err(e) => {
+                    err.get_or_insert(e);
+                }
+            }
+        }
+        Err(err.unwrap_or_else(|| {
+            if unwrap_within(a1, previous[A], la.min, la.max).is_none()
+                && unwrap_within(-a1, previous[A], la.min, la.max).is_none()
+            {
+                la.violation(A, a1)
+            } else {
+                lc.violation(C, unwrap_near(c1, previous[C]))
+            }
+        }))
     }
 
     fn tcp_angles(&self, q: &Joints) -> Joints {
