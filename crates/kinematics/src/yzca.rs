@@ -72,6 +72,19 @@ impl Yzca {
         Joints::new([r - l * sa, tip.z + l * ca, c, a])
     }
 
+    /// Tip on the C axis: the radial plane from the axis's horizontal part (the A > 0
+    /// branch: that part is −sin A·(cos C, −sin C)), or keep C when the axis is vertical too.
+    #[cold]
+    fn radial_on_axis(&self, k: &Vector3<f64>, previous_c: f64) -> (f64, f64, f64) {
+        let hk = (k.x * k.x + k.y * k.y).sqrt();
+        if hk > self.pole_sin {
+            (atan2(k.y, -k.x), k.y / hk, -k.x / hk)
+        } else {
+            let (s, co) = previous_c.sin_cos();
+            (previous_c, s, co)
+        }
+    }
+
     /// Direction of the radial plane (as a C value) through a tip, or `fallback` when the
     /// tip is on the C axis.
     #[inline]
@@ -81,6 +94,31 @@ impl Yzca {
         } else {
             fallback
         }
+    }
+}
+
+/// Turns of (C, A) nearest `previous` within limits, or `None`.
+#[inline(always)]
+fn turns(
+    c: f64,
+    a: f64,
+    previous: &Joints,
+    lc: &JointLimit,
+    la: &JointLimit,
+) -> Option<(f64, f64)> {
+    Some((
+        unwrap_within(c, previous[C], lc.min, lc.max)?,
+        unwrap_within(a, previous[A], la.min, la.max)?,
+    ))
+}
+
+#[cold]
+fn out_of_plane(t: f64) -> KinematicsError {
+    KinematicsError::AxisUnreachable {
+        reason: format!(
+            "Y-Z-C-A tilts only in the radial plane; the axis is {:.3e} rad out of it",
+            t.clamp(-1.0, 1.0).asin()
+        ),
     }
 }
 
@@ -139,28 +177,18 @@ impl Kinematics for Yzca {
         let l = self.lever(tool);
         // The radial plane (cos C, −sin C): from the tip, else from the axis, else keep C.
         let rho = (p.x * p.x + p.y * p.y).sqrt();
-        let hk = (k.x * k.x + k.y * k.y).sqrt();
         let (c1, sc, cc) = if rho > self.tolerances.centre_mm {
-            (atan2(-p.y, p.x), -p.y / rho, p.x / rho)
-        } else if hk > self.pole_sin {
-            // horizontal axis part is −sin A·(cos C, −sin C); this is the A > 0 branch
-            (atan2(k.y, -k.x), k.y / hk, -k.x / hk)
+            let inv = 1.0 / rho;
+            (atan2(-p.y, p.x), -p.y * inv, p.x * inv)
         } else {
-            let c = previous[C];
-            let (s, co) = c.sin_cos();
-            (c, s, co)
+            self.radial_on_axis(&k, previous[C])
         };
         // Axis components along the radial and tangential (sin C, cos C) directions: a
         // 4-axis machine tilts only in the radial plane.
         let u = k.x * cc - k.y * sc;
         let t = k.x * sc + k.y * cc;
         if t.abs() > self.axis_sin {
-            return Err(KinematicsError::AxisUnreachable {
-                reason: format!(
-                    "Y-Z-C-A tilts only in the radial plane; the axis is {:.3e} rad out of it",
-                    t.clamp(-1.0, 1.0).asin()
-                ),
-            });
+            return Err(out_of_plane(t));
         }
         let r = p.x * cc - p.y * sc;
         let a1 = atan2(-u, k.z);
@@ -169,14 +197,8 @@ impl Kinematics for Yzca {
         let z1 = p.z + l * k.z * inv_n;
         // Branch 2 turns the table half a turn and tilts the other way: (−y, z, C + π, −A).
         let (lc, la) = (&self.limits[C], &self.limits[A]);
-        let turns = |c: f64, a: f64| {
-            Some((
-                unwrap_within(c, previous[C], lc.min, lc.max)?,
-                unwrap_within(a, previous[A], la.min, la.max)?,
-            ))
-        };
-        let b1 = turns(c1, a1);
-        let b2 = turns(c1 + std::f64::consts::PI, -a1);
+        let b1 = turns(c1, a1, previous, lc, la);
+        let b2 = turns(c1 + std::f64::consts::PI, -a1, previous, lc, la);
         let cost = |b: &Option<(f64, f64)>| {
             b.map_or(f64::INFINITY, |(c, a)| {
                 (c - previous[C]).abs() + (a - previous[A]).abs()
