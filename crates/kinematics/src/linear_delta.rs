@@ -28,6 +28,9 @@ pub struct DeltaGeometry {
     /// Smallest angle between a rod and the platform plane, rad (reference 002 uses 5°):
     /// the rate q̇ = J·ṗ blows up as a rod becomes horizontal.
     pub min_rod_angle: f64,
+    /// Largest angle, rad, between a rod and its direction with the platform at the centre:
+    /// the spherical joints' cone (reference 002's joints turn 22°). `None`: unchecked.
+    pub max_joint_angle: Option<f64>,
 }
 
 /// The linear-delta model: joints `[tower 1, tower 2, tower 3]` carriage heights, mm.
@@ -39,6 +42,9 @@ pub struct LinearDelta {
     max_d2: f64,
     limits: Vec<JointLimit>,
     axis_sin: f64,
+    /// Unit rod directions (platform → carriage) with the platform at the centre, and the
+    /// cosine of the joint cone, when the cone is checked.
+    cone: Option<([Vector3<f64>; 3], f64)>,
 }
 
 impl LinearDelta {
@@ -75,7 +81,17 @@ impl LinearDelta {
             });
         }
         let max_d = g.rod_length * g.min_rod_angle.cos();
+        let h0 = (g.rod_length * g.rod_length - g.radius * g.radius)
+            .max(0.0)
+            .sqrt();
+        let cone = g.max_joint_angle.map(|a| {
+            (
+                towers.map(|(x, y)| Vector3::new(x, y, h0) / g.rod_length),
+                a.cos(),
+            )
+        });
         Ok(Self {
+            cone,
             towers,
             rod2: g.rod_length * g.rod_length,
             max_d2: max_d * max_d,
@@ -107,9 +123,75 @@ impl LinearDelta {
             if d2 > self.max_d2 {
                 return Err(self.rod_error(i, d2));
             }
-            *qi = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
+            let h = (self.rod2 - d2).sqrt();
+            if let Some((home, cos_max)) = &self.cone {
+                let rod = Vector3::new(-dx, -dy, h);
+                if rod.dot(&home[i]) < cos_max * self.geometry.rod_length {
+                    return Err(self.cone_error(i, rod.dot(&home[i]) / self.geometry.rod_length));
+                }
+            }
+            *qi = p.z + h - self.geometry.carriage_offsets[i];
         }
         Ok(q)
+    }
+
+    #[cold]
+    fn cone_error(&self, i: usize, cos: f64) -> KinematicsError {
+        KinematicsError::Unreachable {
+            reason: format!(
+                "tower {} rod {:.3}° from its central direction (spherical joint limit {:.3}°)",
+                i + 1,
+                cos.clamp(-1.0, 1.0).acos().to_degrees(),
+                self.geometry.max_joint_angle.unwrap_or(0.0).to_degrees()
+            ),
+        }
+    }
+
+    /// Workspace volume, mm³: grid points (spacing `step_mm`) where the inverse succeeds
+    /// within the rod angle, the joint cone and the carriage strokes, times the cell volume.
+    /// Reference 002 §2.4 reports 18 786 cm³ without a method; its digest derives ≈ 46 900 cm³
+    /// (500 mm stroke, 5° rod angle) and ≈ 16 600 cm³ (plus a 22° joint cone), which this
+    /// reproduces. Needs finite joint limits; refuses grids over `max_points` points.
+    pub fn workspace_volume(&self, step_mm: f64, max_points: u64) -> Result<f64, KinematicsError> {
+        let bad = |reason: &str| KinematicsError::BadInput {
+            reason: reason.into(),
+        };
+        if !(step_mm.is_finite() && step_mm > 0.0) {
+            return Err(bad("grid step must be > 0"));
+        }
+        let g = &self.geometry;
+        let reach = g.radius + g.rod_length;
+        let mut z_lo = f64::INFINITY;
+        let mut z_hi = f64::NEG_INFINITY;
+        for (l, o) in self.limits.iter().zip(g.carriage_offsets) {
+            // z = q + offset − h with 0 ≤ h ≤ L
+            z_lo = z_lo.min(l.min + o - g.rod_length);
+            z_hi = z_hi.max(l.max + o);
+        }
+        if !(z_lo.is_finite() && z_hi.is_finite()) {
+            return Err(bad("workspace volume needs finite carriage limits"));
+        }
+        let nxy = (2.0 * reach / step_mm).ceil() as u64 + 1;
+        let nz = ((z_hi - z_lo) / step_mm).ceil() as u64 + 1;
+        if nxy.saturating_mul(nxy).saturating_mul(nz) > max_points {
+            return Err(bad("grid too fine for max_points"));
+        }
+        let mut inside: u64 = 0;
+        for ix in 0..nxy {
+            let x = -reach + ix as f64 * step_mm;
+            for iy in 0..nxy {
+                let y = -reach + iy as f64 * step_mm;
+                for iz in 0..nz {
+                    let p = Vector3::new(x, y, z_lo + iz as f64 * step_mm);
+                    if let Ok(q) = self.inverse_platform(&p) {
+                        if q.iter().zip(&self.limits).all(|(v, l)| l.contains(*v)) {
+                            inside += 1;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(inside as f64 * step_mm.powi(3))
     }
 
     #[cold]

@@ -114,6 +114,7 @@ struct RawKinematics {
     tower_angles: Option<[f64; 3]>,
     carriage_offsets: Option<[f64; 3]>,
     min_rod_angle_deg: Option<f64>,
+    max_joint_angle_deg: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -434,6 +435,7 @@ fn allowed(kind: &str) -> &'static [&'static str] {
             "tower_angles",
             "carriage_offsets",
             "min_rod_angle_deg",
+            "max_joint_angle_deg",
         ],
         _ => &[],
     }
@@ -475,7 +477,7 @@ fn check_joint_kinds(
 fn build_model(k: &RawKinematics, joints: &[Joint]) -> Result<Model, MachineError> {
     use JointKind::{Linear as L, Rotary as R};
     let kind = k.kind.as_str();
-    let present: [(&str, bool); 11] = [
+    let present: [(&str, bool); 12] = [
         ("axis_tolerance_deg", k.axis_tolerance_deg.is_some()),
         ("pole_cone_deg", k.pole_cone_deg.is_some()),
         ("centre_tolerance_mm", k.centre_tolerance_mm.is_some()),
@@ -487,6 +489,7 @@ fn build_model(k: &RawKinematics, joints: &[Joint]) -> Result<Model, MachineErro
         ("tower_angles", k.tower_angles.is_some()),
         ("carriage_offsets", k.carriage_offsets.is_some()),
         ("min_rod_angle_deg", k.min_rod_angle_deg.is_some()),
+        ("max_joint_angle_deg", k.max_joint_angle_deg.is_some()),
     ];
     let ok = allowed(kind);
     if ok.is_empty() {
@@ -596,7 +599,18 @@ fn build_model(k: &RawKinematics, joints: &[Joint]) -> Result<Model, MachineErro
                     "must be in [0, 90)",
                 ));
             }
+            let max_joint = match k.max_joint_angle_deg {
+                Some(v) if v.is_finite() && v > 0.0 && v < 180.0 => Some(v.to_radians()),
+                Some(_) => {
+                    return Err(invalid(
+                        "kinematics.max_joint_angle_deg",
+                        "must be in (0, 180)",
+                    ))
+                }
+                None => None,
+            };
             let geometry = DeltaGeometry {
+                max_joint_angle: max_joint,
                 radius,
                 rod_length: rod,
                 tower_angles: [

@@ -382,3 +382,37 @@ fn iso9283_errors() {
     );
     assert_eq!(evaluate(&[]), Err(Iso9283Error::Empty));
 }
+
+/// Reference 002 §2.4 [DERIVED in the digest]: a 500 mm stroke with the 5° rod-angle rule gives
+/// ≈ 46 900 cm³; adding a 22° spherical-joint cone about the central rod direction ≈ 16 600 cm³.
+/// (The thesis's own 18 786 cm³ has no stated method.) Such a cone excludes the thesis's ISO
+/// pose P3, which is why the built-in file leaves it off.
+#[test]
+fn delta_workspace_volume_002_2_4() {
+    let m = delta();
+    let tezgah_kinematics::Model::LinearDelta(d) = &m.kinematics else {
+        unreachable!()
+    };
+    let v = d.workspace_volume(7.0, 50_000_000).unwrap() / 1000.0;
+    assert!((v - 46_900.0).abs() < 0.01 * 46_900.0, "{v} cm³");
+    let text = Machine::builtin_text("linear-delta")
+        .unwrap()
+        .replace("# max_joint_angle_deg = 22.0", "max_joint_angle_deg = 22.0");
+    let coned = Machine::from_toml_str(&text).unwrap();
+    let tezgah_kinematics::Model::LinearDelta(dc) = &coned.kinematics else {
+        unreachable!()
+    };
+    let v = dc.workspace_volume(7.0, 50_000_000).unwrap() / 1000.0;
+    assert!((v - 16_600.0).abs() < 0.01 * 16_600.0, "{v} cm³");
+    let p3 = ToolPose::vertical(Vector3::new(-100.0, 100.0, 100.0));
+    let e = coned
+        .kinematics
+        .inverse(&p3, &Tool::default(), &coned.home())
+        .unwrap_err();
+    assert!(e.to_string().contains("28.59"), "{e}");
+    assert!(m
+        .kinematics
+        .inverse(&p3, &Tool::default(), &m.home())
+        .is_ok());
+    assert!(d.workspace_volume(0.001, 1_000_000).is_err());
+}

@@ -25,6 +25,7 @@ fn delta(radius: f64, rod: f64, angles_deg: [f64; 3], offsets: [f64; 3]) -> Line
             tower_angles: angles_deg.map(f64::to_radians),
             carriage_offsets: offsets,
             min_rod_angle: 0.0,
+            max_joint_angle: None,
         },
         free_limits(&[JointKind::Linear; 3]),
         Tolerances::default(),
