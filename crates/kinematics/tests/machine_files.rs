@@ -318,6 +318,17 @@ fn bad_fields_are_named() {
         let msg = Machine::from_toml_str(text).unwrap_err().to_string();
         assert!(msg.starts_with(&format!("{field}: ")), "{msg}");
     }
+    let (f, r) =
+        field_error(&delta.replace("# max_joint_angle_deg = 22.0", "max_joint_angle_deg = 0.0"));
+    assert_eq!(
+        (f.as_str(), r.as_str()),
+        ("kinematics.max_joint_angle_deg", "must be in (0, 180)")
+    );
+    let (f, _) = field_error(&mill.replace(
+        "[kinematics]\n",
+        "[kinematics]\nmax_joint_angle_deg = 20.0\n",
+    ));
+    assert_eq!(f, "kinematics.max_joint_angle_deg");
     // Joint count per model.
     let (f, r) = field_error(&mill[..mill.rfind("[[joint]]").unwrap()]);
     assert_eq!(f, "joint");
