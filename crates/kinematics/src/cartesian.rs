@@ -5,7 +5,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::KinematicsError;
-use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
+use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 
 /// X Y Z plus independent axes; the tool axis is always workpiece +Z.
@@ -83,6 +83,7 @@ impl Kinematics for Cartesian {
         tool: &Tool,
         previous: &Joints,
     ) -> Result<Joints, KinematicsError> {
+        check_tip(tip)?;
         check_input(previous, self.limits.len())?;
         check_input(angles, self.limits.len() - 3)?;
         let mut q = *previous;

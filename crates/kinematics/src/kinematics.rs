@@ -177,6 +177,18 @@ pub(crate) fn check_input(q: &Joints, n: usize) -> Result<(), KinematicsError> {
     Ok(())
 }
 
+/// Checks a tip is finite (TCP input).
+#[inline]
+pub(crate) fn check_tip(t: &Vector3<f64>) -> Result<(), KinematicsError> {
+    if t.x.is_finite() && t.y.is_finite() && t.z.is_finite() {
+        Ok(())
+    } else {
+        Err(KinematicsError::BadInput {
+            reason: "non-finite tip".into(),
+        })
+    }
+}
+
 /// Checks a pose is finite.
 #[inline]
 pub(crate) fn check_pose(p: &ToolPose) -> Result<(), KinematicsError> {

@@ -6,7 +6,7 @@ use nalgebra::{Matrix3, Vector3};
 
 use crate::angle::{atan2, unwrap_within};
 use crate::error::KinematicsError;
-use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
+use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 use crate::{table_ac, table_bc};
 
@@ -245,6 +245,7 @@ impl Kinematics for Trunnion {
         tool: &Tool,
         previous: &Joints,
     ) -> Result<Joints, KinematicsError> {
+        check_tip(tip)?;
         check_input(previous, 5)?;
         check_input(angles, 2)?;
         // Under TCP the program's angles are the table angles themselves.

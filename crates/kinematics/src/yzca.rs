@@ -17,7 +17,7 @@ use nalgebra::Vector3;
 use crate::angle::{atan2, unwrap_near, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{
-    check_input, check_pose, choose_nearest, Jacobian, Kinematics, Tolerances,
+    check_input, check_pose, check_tip, choose_nearest, Jacobian, Kinematics, Tolerances,
 };
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 
@@ -246,6 +246,7 @@ impl Kinematics for Yzca {
         tool: &Tool,
         previous: &Joints,
     ) -> Result<Joints, KinematicsError> {
+        check_tip(tip)?;
         check_input(previous, 4)?;
         check_input(angles, 2)?;
         let (c_prog, a) = (angles[0], angles[1]);

@@ -285,4 +285,12 @@ fn tcp_from_interpreter_pose() {
         .unwrap()
         .is_empty());
     assert!(ProgramPose::from_program(&prog, &[Axis::X]).is_err());
+    let nan = ProgramPose {
+        tip: Vector3::new(f64::NAN, 0.0, 0.0),
+        angles: pp.angles,
+    };
+    assert!(matches!(
+        tcp.joints(&nan, &m.home()),
+        Err(KinematicsError::BadInput { .. })
+    ));
 }
