@@ -113,7 +113,7 @@ impl LinearDelta {
 
     /// Joints for a platform point (tool length already removed), checked against the rod
     /// angle; the hot path of the 1 ms loop (three square roots).
-    #[inline]
+    #[inline(always)]
     pub fn inverse_platform(&self, p: &Vector3<f64>) -> Result<[f64; 3], KinematicsError> {
         let mut q = [0.0; 3];
         for (i, (qi, (tx, ty))) in q.iter_mut().zip(self.towers).enumerate() {
@@ -123,16 +123,31 @@ impl LinearDelta {
             if d2 > self.max_d2 {
                 return Err(self.rod_error(i, d2));
             }
-            let h = (self.rod2 - d2).sqrt();
-            if let Some((home, cos_max)) = &self.cone {
-                let rod = Vector3::new(-dx, -dy, h);
-                if rod.dot(&home[i]) < cos_max * self.geometry.rod_length {
-                    return Err(self.cone_error(i, rod.dot(&home[i]) / self.geometry.rod_length));
-                }
-            }
-            *qi = p.z + h - self.geometry.carriage_offsets[i];
+            *qi = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
+        }
+        if self.cone.is_some() {
+            self.check_cone(p, &q)?;
         }
         Ok(q)
+    }
+
+    /// The spherical-joint cone, kept out of the plain inverse so a machine without it pays
+    /// one predictable branch.
+    #[inline(never)]
+    fn check_cone(&self, p: &Vector3<f64>, q: &[f64; 3]) -> Result<(), KinematicsError> {
+        let Some((home, cos_max)) = &self.cone else {
+            return Ok(());
+        };
+        for (i, (tx, ty)) in self.towers.into_iter().enumerate() {
+            // rod from the platform joint to the carriage joint, length L
+            let h = q[i] + self.geometry.carriage_offsets[i] - p.z;
+            let rod = Vector3::new(tx - p.x, ty - p.y, h);
+            let cos = rod.dot(&home[i]) / self.geometry.rod_length;
+            if cos < *cos_max {
+                return Err(self.cone_error(i, cos));
+            }
+        }
+        Ok(())
     }
 
     #[cold]
