@@ -112,7 +112,8 @@ impl LinearDelta {
     }
 
     /// Joints for a platform point (tool length already removed), checked against the rod
-    /// angle; the hot path of the 1 ms loop (three square roots).
+    /// angle (not the joint cone: see [`Self::inverse_platform_checked`]); the hot path of the
+    /// 1 ms loop (three square roots).
     #[inline(always)]
     pub fn inverse_platform(&self, p: &Vector3<f64>) -> Result<[f64; 3], KinematicsError> {
         let mut q = [0.0; 3];
@@ -125,6 +126,13 @@ impl LinearDelta {
             }
             *qi = p.z + (self.rod2 - d2).sqrt() - self.geometry.carriage_offsets[i];
         }
+        Ok(q)
+    }
+
+    /// [`Self::inverse_platform`] plus the spherical-joint cone when the machine has one.
+    #[inline(always)]
+    pub fn inverse_platform_checked(&self, p: &Vector3<f64>) -> Result<[f64; 3], KinematicsError> {
+        let q = self.inverse_platform(p)?;
         if self.cone.is_some() {
             self.check_cone(p, &q)?;
         }
@@ -198,7 +206,7 @@ impl LinearDelta {
                 let y = -reach + iy as f64 * step_mm;
                 for iz in 0..nz {
                     let p = Vector3::new(x, y, z_lo + iz as f64 * step_mm);
-                    if let Ok(q) = self.inverse_platform(&p) {
+                    if let Ok(q) = self.inverse_platform_checked(&p) {
                         if q.iter().zip(&self.limits).all(|(v, l)| l.contains(*v)) {
                             inside += 1;
                         }
@@ -328,7 +336,7 @@ impl Kinematics for LinearDelta {
         check_input(previous, 3)?;
         self.check_axis(pose)?;
         let p = Vector3::new(pose.tip.x, pose.tip.y, pose.tip.z + tool.length);
-        let q = Joints::new(self.inverse_platform(&p)?);
+        let q = Joints::new(self.inverse_platform_checked(&p)?);
         check_limits(&q, &self.limits)?;
         Ok(q)
     }
