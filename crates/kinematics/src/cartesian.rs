@@ -1,0 +1,105 @@
+//! Cartesian machine: X Y Z position the spindle gauge point directly, further joints are
+//! independent (rotary or linear) axes that do not move the tool. The default machine
+//! (`machines/mill3.toml`); the identity map of the data flow's inverse step.
+
+use nalgebra::{Matrix3, Vector3};
+
+use crate::error::KinematicsError;
+use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
+use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+
+/// X Y Z plus independent axes; the tool axis is always workpiece +Z.
+#[derive(Clone, Debug)]
+pub struct Cartesian {
+    limits: Vec<JointLimit>,
+    axis_sin: f64,
+}
+
+impl Cartesian {
+    /// A Cartesian machine; joints 0–2 are X Y Z (linear), the rest independent.
+    /// Fails unless there are 3 to [`crate::pose::MAX_JOINTS`] joints.
+    pub fn new(limits: Vec<JointLimit>, tolerances: Tolerances) -> Result<Self, KinematicsError> {
+        if limits.len() < 3 || limits.len() > crate::pose::MAX_JOINTS {
+            return Err(KinematicsError::BadInput {
+                reason: format!("cartesian needs 3 to 6 joints, got {}", limits.len()),
+            });
+        }
+        Ok(Self {
+            limits,
+            axis_sin: tolerances.axis_rad.sin(),
+        })
+    }
+}
+
+impl Kinematics for Cartesian {
+    fn joint_limits(&self) -> &[JointLimit] {
+        &self.limits
+    }
+
+    fn forward(&self, q: &Joints, tool: &Tool) -> Result<ToolPose, KinematicsError> {
+        check_input(q, self.limits.len())?;
+        Ok(ToolPose::vertical(Vector3::new(
+            q[0],
+            q[1],
+            q[2] - tool.length,
+        )))
+    }
+
+    fn inverse(
+        &self,
+        pose: &ToolPose,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_pose(pose)?;
+        check_input(previous, self.limits.len())?;
+        // The only axis this machine makes is +Z; the sine of the angle to it is the
+        // horizontal part of the unit axis.
+        let horizontal = (pose.axis.x * pose.axis.x + pose.axis.y * pose.axis.y).sqrt();
+        if pose.axis.z <= 0.0 || horizontal > self.axis_sin {
+            return Err(KinematicsError::AxisUnreachable {
+                reason: format!(
+                    "a Cartesian machine's tool axis is +Z; requested ({:.6}, {:.6}, {:.6})",
+                    pose.axis.x, pose.axis.y, pose.axis.z
+                ),
+            });
+        }
+        let mut q = *previous;
+        q[0] = pose.tip.x;
+        q[1] = pose.tip.y;
+        q[2] = pose.tip.z + tool.length;
+        check_limits(&q, &self.limits)?;
+        Ok(q)
+    }
+
+    fn tcp_angles(&self, q: &Joints) -> Joints {
+        Joints::from_slice(&q.as_slice()[3.min(q.len())..]).unwrap_or(Joints::zeros(0))
+    }
+
+    fn tcp_inverse(
+        &self,
+        tip: &Vector3<f64>,
+        angles: &Joints,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        check_tip(tip)?;
+        check_input(previous, self.limits.len())?;
+        check_input(angles, self.limits.len() - 3)?;
+        let mut q = *previous;
+        q[0] = tip.x;
+        q[1] = tip.y;
+        q[2] = tip.z + tool.length;
+        q.as_mut_slice()[3..].copy_from_slice(angles.as_slice());
+        check_limits(&q, &self.limits)?;
+        Ok(q)
+    }
+
+    fn jacobian(&self, q: &Joints, _tool: &Tool) -> Result<Jacobian, KinematicsError> {
+        check_input(q, self.limits.len())?;
+        let mut j = Jacobian::zeros(self.limits.len());
+        j.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&Matrix3::identity());
+        Ok(j)
+    }
+}

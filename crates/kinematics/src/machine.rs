@@ -1,0 +1,704 @@
+//! Machine definitions: the TOML file of DESIGN.md ("Machine definition (TOML)") read,
+//! validated field by field, and turned into a kinematic [`Model`]. The CLI's `--machine`
+//! and `tezgah machines` and the planner's joint limits all start here.
+//!
+//! Every error names its field (`joint[2].max_jerk: must be > 0`); unknown fields are
+//! refused. New issues add fields to the raw structs below with `#[serde(default)]` and to
+//! [`Motion`] / [`Joint`]; nothing else has to change.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use nalgebra::Vector3;
+use serde::Deserialize;
+use tezgah_geom::Axis;
+use thiserror::Error;
+
+use crate::cartesian::Cartesian;
+use crate::error::KinematicsError;
+use crate::kinematics::{Jacobian, Kinematics, Tolerances};
+use crate::linear_delta::{DeltaGeometry, LinearDelta};
+use crate::pose::{JointKind, JointLimit, Joints, Tool, ToolPose};
+use crate::trunnion::{TiltAxis, Trunnion};
+use crate::yzca::Yzca;
+
+/// Why a machine definition was refused.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum MachineError {
+    /// Not TOML, a wrong type, a missing or an unknown field (the message has line and column).
+    #[error("machine file: {message}")]
+    Toml {
+        /// The TOML reader's message.
+        message: String,
+    },
+    /// A field has a value the machine cannot use.
+    #[error("{field}: {reason}")]
+    Invalid {
+        /// Dotted path of the field, e.g. `joint[2].max_jerk`.
+        field: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// The file could not be read.
+    #[error("cannot read machine file {path}: {message}")]
+    Io {
+        /// The path given.
+        path: String,
+        /// The operating system's message.
+        message: String,
+    },
+    /// `Machine::builtin` was given a name that is not built in.
+    #[error("no built-in machine `{name}` (built in: {known})")]
+    UnknownBuiltin {
+        /// The name asked for.
+        name: String,
+        /// The built-in names, comma-separated.
+        known: String,
+    },
+}
+
+fn invalid(field: impl Into<String>, reason: impl Into<String>) -> MachineError {
+    MachineError::Invalid {
+        field: field.into(),
+        reason: reason.into(),
+    }
+}
+
+/// The built-in machine files, embedded at compile time; the first is the default.
+const BUILTIN: &[(&str, &str)] = &[
+    ("mill3", include_str!("../../../machines/mill3.toml")),
+    ("yzca", include_str!("../../../machines/yzca.toml")),
+    ("table-ac", include_str!("../../../machines/table-ac.toml")),
+    ("table-bc", include_str!("../../../machines/table-bc.toml")),
+    (
+        "linear-delta",
+        include_str!("../../../machines/linear-delta.toml"),
+    ),
+];
+
+/// Names accepted by [`Machine::builtin`], default first (for `tezgah machines`).
+pub fn builtin_names() -> impl Iterator<Item = &'static str> {
+    BUILTIN.iter().map(|(n, _)| *n)
+}
+
+// ---------------------------------------------------------------------------------------
+// Raw file shape (serde). Everything optional that some type lacks is checked by hand so the
+// error can say which field does not belong.
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMachine {
+    name: String,
+    kinematics: RawKinematics,
+    motion: RawMotion,
+    #[serde(default)]
+    joint: Vec<RawJoint>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawKinematics {
+    #[serde(rename = "type")]
+    kind: String,
+    axis_tolerance_deg: Option<f64>,
+    pole_cone_deg: Option<f64>,
+    centre_tolerance_mm: Option<f64>,
+    // table-ac / table-bc
+    pivot: Option<[f64; 3]>,
+    c_offset: Option<[f64; 3]>,
+    // yzca
+    pivot_to_gauge: Option<f64>,
+    // linear-delta
+    radius: Option<f64>,
+    rod_length: Option<f64>,
+    tower_angles: Option<[f64; 3]>,
+    carriage_offsets: Option<[f64; 3]>,
+    min_rod_angle_deg: Option<f64>,
+    max_joint_angle_deg: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawMotion {
+    period_s: f64,
+    tolerance_mm: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawJoint {
+    name: String,
+    kind: String,
+    min: Option<f64>,
+    max: Option<f64>,
+    #[serde(default)]
+    endless: bool,
+    max_velocity: f64,
+    max_acceleration: f64,
+    max_jerk: f64,
+}
+
+// ---------------------------------------------------------------------------------------
+// Validated machine.
+
+/// The `[motion]` table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    /// Interpolation period, s.
+    pub period_s: f64,
+    /// Path deviation allowed for smoothing, chord error and segmentation, mm.
+    pub tolerance_mm: f64,
+}
+
+/// One `[[joint]]`, in machine-file units (mm or degrees).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Joint {
+    /// Name (column header of the samples CSV).
+    pub name: String,
+    /// Linear or rotary.
+    pub kind: JointKind,
+    /// Lower limit, mm or deg (−∞ for an endless rotary).
+    pub min: f64,
+    /// Upper limit, mm or deg (+∞ for an endless rotary).
+    pub max: f64,
+    /// A rotary that turns forever (no position limits).
+    pub endless: bool,
+    /// mm/s or deg/s.
+    pub max_velocity: f64,
+    /// mm/s² or deg/s².
+    pub max_acceleration: f64,
+    /// mm/s³ or deg/s³.
+    pub max_jerk: f64,
+}
+
+impl Joint {
+    /// Factor from file units to internal units: 1 for mm, π/180 for degrees.
+    pub fn to_internal(&self) -> f64 {
+        match self.kind {
+            JointKind::Linear => 1.0,
+            JointKind::Rotary => PI / 180.0,
+        }
+    }
+
+    /// Position limits in internal units.
+    pub fn limit(&self) -> JointLimit {
+        let s = self.to_internal();
+        JointLimit::new(&self.name, self.kind, self.min * s, self.max * s)
+    }
+}
+
+/// A validated machine: name, kinematic model, motion settings, joints.
+#[derive(Clone, Debug)]
+pub struct Machine {
+    /// `name`.
+    pub name: String,
+    /// The model built from `[kinematics]` and the joints.
+    pub kinematics: Model,
+    /// `[motion]`.
+    pub motion: Motion,
+    /// `[[joint]]`, in file order (the order of joint values everywhere).
+    pub joints: Vec<Joint>,
+}
+
+impl Machine {
+    /// Parses and validates a machine file's text.
+    pub fn from_toml_str(text: &str) -> Result<Self, MachineError> {
+        let raw: RawMachine = toml::from_str(text).map_err(|e| MachineError::Toml {
+            message: e.to_string().trim_end().to_owned(),
+        })?;
+        build(raw)
+    }
+
+    /// Reads, parses and validates a machine file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Self, MachineError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| MachineError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        Self::from_toml_str(&text)
+    }
+
+    /// A built-in machine by name (see [`builtin_names`]).
+    pub fn builtin(name: &str) -> Result<Self, MachineError> {
+        match BUILTIN.iter().find(|(n, _)| *n == name) {
+            Some((_, text)) => Self::from_toml_str(text),
+            None => Err(MachineError::UnknownBuiltin {
+                name: name.to_owned(),
+                known: builtin_names().collect::<Vec<_>>().join(", "),
+            }),
+        }
+    }
+
+    /// The default machine (`mill3`, a 3-axis Cartesian mill).
+    pub fn default_machine() -> Self {
+        // The embedded file is checked by the crate's tests; a failure here is a build bug.
+        Self::builtin(BUILTIN[0].0).expect("embedded default machine is valid")
+    }
+
+    /// The text of a built-in machine file (to show or copy it).
+    pub fn builtin_text(name: &str) -> Option<&'static str> {
+        BUILTIN.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    }
+
+    /// Joint values from machine-file units (mm, degrees) to internal units (mm, rad).
+    pub fn from_file_units(&self, values: &[f64]) -> Result<Joints, KinematicsError> {
+        if values.len() != self.joints.len() {
+            return Err(KinematicsError::BadInput {
+                reason: format!(
+                    "{} joints given, machine has {}",
+                    values.len(),
+                    self.joints.len()
+                ),
+            });
+        }
+        let mut q = Joints::from_slice(values)?;
+        for (v, j) in q.as_mut_slice().iter_mut().zip(&self.joints) {
+            *v *= j.to_internal();
+        }
+        Ok(q)
+    }
+
+    /// Joint values from internal units to machine-file units (what the samples CSV prints;
+    /// rotary joints stay continuous, never wrapped).
+    pub fn to_file_units(&self, q: &Joints) -> Vec<f64> {
+        q.as_slice()
+            .iter()
+            .zip(&self.joints)
+            .map(|(v, j)| v / j.to_internal())
+            .collect()
+    }
+
+    /// The program axes (A, B, C) that carry the TCP angles of [`Kinematics::tcp_angles`], in
+    /// that order: (A, C) on table-ac, (B, C) on table-bc, (C, A) on yzca, none on a delta,
+    /// and on a Cartesian machine the extra joints by name (`a`, `b` or `c`).
+    pub fn tcp_axes(&self) -> Result<Vec<Axis>, MachineError> {
+        Ok(match &self.kinematics {
+            Model::TableAc(_) => vec![Axis::A, Axis::C],
+            Model::TableBc(_) => vec![Axis::B, Axis::C],
+            Model::Yzca(_) => vec![Axis::C, Axis::A],
+            Model::LinearDelta(_) => vec![],
+            Model::Cartesian(_) => self.joints[3..]
+                .iter()
+                .enumerate()
+                .map(|(i, j)| match j.name.to_ascii_lowercase().as_str() {
+                    "a" => Ok(Axis::A),
+                    "b" => Ok(Axis::B),
+                    "c" => Ok(Axis::C),
+                    _ => Err(invalid(
+                        format!("joint[{}].name", i + 3),
+                        "an extra joint of a cartesian machine must be named a, b or c to take a program axis",
+                    )),
+                })
+                .collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// Joints at zero (or the nearest limit when zero is outside): a start for continuity.
+    pub fn home(&self) -> Joints {
+        let mut q = Joints::zeros(self.joints.len());
+        for (v, l) in q
+            .as_mut_slice()
+            .iter_mut()
+            .zip(self.kinematics.joint_limits())
+        {
+            *v = 0.0_f64.clamp(l.min, l.max);
+        }
+        q
+    }
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, MachineError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(field, "must be > 0"))
+    }
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, MachineError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(invalid(field, "must be finite"))
+    }
+}
+
+fn finite3(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, MachineError> {
+    for (i, x) in v.iter().enumerate() {
+        finite(&format!("{field}[{i}]"), *x)?;
+    }
+    Ok(Vector3::from(v))
+}
+
+fn build(raw: RawMachine) -> Result<Machine, MachineError> {
+    if raw.name.trim().is_empty() {
+        return Err(invalid("name", "must not be empty"));
+    }
+    let motion = Motion {
+        period_s: positive("motion.period_s", raw.motion.period_s)?,
+        tolerance_mm: positive("motion.tolerance_mm", raw.motion.tolerance_mm)?,
+    };
+    let joints = raw
+        .joint
+        .into_iter()
+        .enumerate()
+        .map(|(i, j)| build_joint(i, j))
+        .collect::<Result<Vec<_>, _>>()?;
+    for (i, j) in joints.iter().enumerate() {
+        if let Some(k) = joints[..i].iter().position(|o| o.name == j.name) {
+            return Err(invalid(
+                format!("joint[{i}].name"),
+                format!("`{}` is already the name of joint[{k}]", j.name),
+            ));
+        }
+    }
+    let kinematics = build_model(&raw.kinematics, &joints)?;
+    Ok(Machine {
+        name: raw.name,
+        kinematics,
+        motion,
+        joints,
+    })
+}
+
+fn build_joint(i: usize, j: RawJoint) -> Result<Joint, MachineError> {
+    let f = |name: &str| format!("joint[{i}].{name}");
+    if j.name.trim().is_empty() {
+        return Err(invalid(f("name"), "must not be empty"));
+    }
+    let kind = match j.kind.as_str() {
+        "linear" => JointKind::Linear,
+        "rotary" => JointKind::Rotary,
+        other => {
+            return Err(invalid(
+                f("kind"),
+                format!("`{other}` is not `linear` or `rotary`"),
+            ))
+        }
+    };
+    let (min, max) = if j.endless {
+        if kind != JointKind::Rotary {
+            return Err(invalid(f("endless"), "only a rotary joint can be endless"));
+        }
+        if j.min.is_some() {
+            return Err(invalid(f("min"), "an endless joint has no limits"));
+        }
+        if j.max.is_some() {
+            return Err(invalid(f("max"), "an endless joint has no limits"));
+        }
+        (f64::NEG_INFINITY, f64::INFINITY)
+    } else {
+        let min = finite(
+            &f("min"),
+            j.min.ok_or_else(|| invalid(f("min"), "missing"))?,
+        )?;
+        let max = finite(
+            &f("max"),
+            j.max.ok_or_else(|| invalid(f("max"), "missing"))?,
+        )?;
+        if max <= min {
+            return Err(invalid(
+                f("max"),
+                format!("must be greater than min ({min})"),
+            ));
+        }
+        (min, max)
+    };
+    Ok(Joint {
+        name: j.name,
+        kind,
+        min,
+        max,
+        endless: j.endless,
+        max_velocity: positive(&f("max_velocity"), j.max_velocity)?,
+        max_acceleration: positive(&f("max_acceleration"), j.max_acceleration)?,
+        max_jerk: positive(&f("max_jerk"), j.max_jerk)?,
+    })
+}
+
+/// Which kinematics parameters each type accepts.
+fn allowed(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "cartesian" => &["axis_tolerance_deg"],
+        "yzca" => &[
+            "axis_tolerance_deg",
+            "pole_cone_deg",
+            "centre_tolerance_mm",
+            "pivot_to_gauge",
+        ],
+        "table-ac" | "table-bc" => &["axis_tolerance_deg", "pole_cone_deg", "pivot", "c_offset"],
+        "linear-delta" => &[
+            "axis_tolerance_deg",
+            "radius",
+            "rod_length",
+            "tower_angles",
+            "carriage_offsets",
+            "min_rod_angle_deg",
+            "max_joint_angle_deg",
+        ],
+        _ => &[],
+    }
+}
+
+fn check_joint_kinds(
+    kind: &str,
+    joints: &[Joint],
+    expected: &[JointKind],
+) -> Result<(), MachineError> {
+    if joints.len() != expected.len() {
+        return Err(invalid(
+            "joint",
+            format!(
+                "{kind} needs {} joints, the file has {}",
+                expected.len(),
+                joints.len()
+            ),
+        ));
+    }
+    for (i, (j, e)) in joints.iter().zip(expected).enumerate() {
+        if j.kind != *e {
+            return Err(invalid(
+                format!("joint[{i}].kind"),
+                format!(
+                    "{kind} needs a {} joint here",
+                    if *e == JointKind::Linear {
+                        "linear"
+                    } else {
+                        "rotary"
+                    }
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn build_model(k: &RawKinematics, joints: &[Joint]) -> Result<Model, MachineError> {
+    use JointKind::{Linear as L, Rotary as R};
+    let kind = k.kind.as_str();
+    let present: [(&str, bool); 12] = [
+        ("axis_tolerance_deg", k.axis_tolerance_deg.is_some()),
+        ("pole_cone_deg", k.pole_cone_deg.is_some()),
+        ("centre_tolerance_mm", k.centre_tolerance_mm.is_some()),
+        ("pivot", k.pivot.is_some()),
+        ("c_offset", k.c_offset.is_some()),
+        ("pivot_to_gauge", k.pivot_to_gauge.is_some()),
+        ("radius", k.radius.is_some()),
+        ("rod_length", k.rod_length.is_some()),
+        ("tower_angles", k.tower_angles.is_some()),
+        ("carriage_offsets", k.carriage_offsets.is_some()),
+        ("min_rod_angle_deg", k.min_rod_angle_deg.is_some()),
+        ("max_joint_angle_deg", k.max_joint_angle_deg.is_some()),
+    ];
+    let ok = allowed(kind);
+    if ok.is_empty() {
+        return Err(invalid(
+            "kinematics.type",
+            format!("`{kind}` is not one of cartesian, yzca, table-ac, table-bc, linear-delta"),
+        ));
+    }
+    if let Some((name, _)) = present.iter().find(|(n, p)| *p && !ok.contains(n)) {
+        return Err(invalid(
+            format!("kinematics.{name}"),
+            format!("not a parameter of {kind}"),
+        ));
+    }
+    let d = Tolerances::default();
+    let tol = Tolerances {
+        axis_rad: match k.axis_tolerance_deg {
+            Some(v) => positive("kinematics.axis_tolerance_deg", v)?.to_radians(),
+            None => d.axis_rad,
+        },
+        pole_cone_rad: match k.pole_cone_deg {
+            Some(v) => positive("kinematics.pole_cone_deg", v)?.to_radians(),
+            None => d.pole_cone_rad,
+        },
+        centre_mm: match k.centre_tolerance_mm {
+            Some(v) => positive("kinematics.centre_tolerance_mm", v)?,
+            None => d.centre_mm,
+        },
+    };
+    let limits: Vec<JointLimit> = joints.iter().map(Joint::limit).collect();
+    let wrap = |e: KinematicsError| invalid("kinematics", e.to_string());
+    let require = |name: &str, v: Option<f64>| -> Result<f64, MachineError> {
+        v.ok_or_else(|| {
+            invalid(
+                format!("kinematics.{name}"),
+                format!("missing (required by {kind})"),
+            )
+        })
+    };
+    Ok(match kind {
+        "cartesian" => {
+            if joints.len() < 3 || joints.len() > crate::pose::MAX_JOINTS {
+                return Err(invalid(
+                    "joint",
+                    format!(
+                        "cartesian needs 3 to {} joints, the file has {}",
+                        crate::pose::MAX_JOINTS,
+                        joints.len()
+                    ),
+                ));
+            }
+            check_joint_kinds(kind, &joints[..3], &[L, L, L])?;
+            Model::Cartesian(Cartesian::new(limits, tol).map_err(wrap)?)
+        }
+        "yzca" => {
+            check_joint_kinds(kind, joints, &[L, L, R, R])?;
+            let l = finite(
+                "kinematics.pivot_to_gauge",
+                require("pivot_to_gauge", k.pivot_to_gauge)?,
+            )?;
+            Model::Yzca(Yzca::new(l, limits, tol).map_err(wrap)?)
+        }
+        "table-ac" | "table-bc" => {
+            check_joint_kinds(kind, joints, &[L, L, L, R, R])?;
+            let pivot = finite3(
+                "kinematics.pivot",
+                k.pivot.ok_or_else(|| {
+                    invalid("kinematics.pivot", format!("missing (required by {kind})"))
+                })?,
+            )?;
+            let c_offset = finite3("kinematics.c_offset", k.c_offset.unwrap_or([0.0; 3]))?;
+            let (tilt, wrapf): (TiltAxis, fn(Trunnion) -> Model) = if kind == "table-ac" {
+                (TiltAxis::X, Model::TableAc)
+            } else {
+                (TiltAxis::Y, Model::TableBc)
+            };
+            wrapf(Trunnion::new(tilt, pivot, c_offset, limits, tol).map_err(wrap)?)
+        }
+        _ => {
+            check_joint_kinds(kind, joints, &[L, L, L])?;
+            let radius = positive("kinematics.radius", require("radius", k.radius)?)?;
+            let rod = positive(
+                "kinematics.rod_length",
+                require("rod_length", k.rod_length)?,
+            )?;
+            if rod <= radius {
+                return Err(invalid(
+                    "kinematics.rod_length",
+                    format!("must be greater than radius ({radius}) or the centre is unreachable"),
+                ));
+            }
+            let angles = finite3(
+                "kinematics.tower_angles",
+                k.tower_angles.unwrap_or([90.0, 210.0, 330.0]),
+            )?;
+            let offsets = finite3(
+                "kinematics.carriage_offsets",
+                k.carriage_offsets.unwrap_or([0.0; 3]),
+            )?;
+            let min_angle = finite(
+                "kinematics.min_rod_angle_deg",
+                k.min_rod_angle_deg.unwrap_or(0.0),
+            )?;
+            if !(0.0..90.0).contains(&min_angle) {
+                return Err(invalid(
+                    "kinematics.min_rod_angle_deg",
+                    "must be in [0, 90)",
+                ));
+            }
+            let max_joint = match k.max_joint_angle_deg {
+                Some(v) if v.is_finite() && v > 0.0 && v < 180.0 => Some(v.to_radians()),
+                Some(_) => {
+                    return Err(invalid(
+                        "kinematics.max_joint_angle_deg",
+                        "must be in (0, 180)",
+                    ))
+                }
+                None => None,
+            };
+            let geometry = DeltaGeometry {
+                max_joint_angle: max_joint,
+                radius,
+                rod_length: rod,
+                tower_angles: [
+                    angles.x.to_radians(),
+                    angles.y.to_radians(),
+                    angles.z.to_radians(),
+                ],
+                carriage_offsets: [offsets.x, offsets.y, offsets.z],
+                min_rod_angle: min_angle.to_radians(),
+            };
+            Model::LinearDelta(
+                LinearDelta::new(geometry, limits, tol)
+                    .map_err(|e| invalid("kinematics.tower_angles", e.to_string()))?,
+            )
+        }
+    })
+}
+
+/// The kinematic models, one variant per `kinematics.type` (static dispatch for the 1 ms loop).
+#[derive(Clone, Debug)]
+pub enum Model {
+    /// `cartesian`
+    Cartesian(Cartesian),
+    /// `yzca`
+    Yzca(Yzca),
+    /// `table-ac`
+    TableAc(Trunnion),
+    /// `table-bc`
+    TableBc(Trunnion),
+    /// `linear-delta`
+    LinearDelta(LinearDelta),
+}
+
+impl Model {
+    /// The `kinematics.type` string.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Model::Cartesian(_) => "cartesian",
+            Model::Yzca(_) => "yzca",
+            Model::TableAc(_) => "table-ac",
+            Model::TableBc(_) => "table-bc",
+            Model::LinearDelta(_) => "linear-delta",
+        }
+    }
+}
+
+macro_rules! dispatch {
+    ($self:ident, $m:ident => $e:expr) => {
+        match $self {
+            Model::Cartesian($m) => $e,
+            Model::Yzca($m) => $e,
+            Model::TableAc($m) => $e,
+            Model::TableBc($m) => $e,
+            Model::LinearDelta($m) => $e,
+        }
+    };
+}
+
+impl Kinematics for Model {
+    fn joint_limits(&self) -> &[JointLimit] {
+        dispatch!(self, m => m.joint_limits())
+    }
+    #[inline]
+    fn forward(&self, q: &Joints, tool: &Tool) -> Result<ToolPose, KinematicsError> {
+        dispatch!(self, m => m.forward(q, tool))
+    }
+    #[inline]
+    fn inverse(
+        &self,
+        pose: &ToolPose,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        dispatch!(self, m => m.inverse(pose, tool, previous))
+    }
+    fn tcp_angles(&self, q: &Joints) -> Joints {
+        dispatch!(self, m => m.tcp_angles(q))
+    }
+    fn tcp_inverse(
+        &self,
+        tip: &Vector3<f64>,
+        angles: &Joints,
+        tool: &Tool,
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        dispatch!(self, m => m.tcp_inverse(tip, angles, tool, previous))
+    }
+    fn jacobian(&self, q: &Joints, tool: &Tool) -> Result<Jacobian, KinematicsError> {
+        dispatch!(self, m => m.jacobian(q, tool))
+    }
+}
