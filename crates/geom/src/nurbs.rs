@@ -1,0 +1,214 @@
+//! Rational B-spline curves (NURBS) of any degree up to [`MAX_DEGREE`]: the G06.2 block and the
+//! output of spline fitting. Evaluation uses span search A2.1, basis functions A2.2/A2.3 and
+//! the rational derivative rule A4.2 (Piegl & Tiller) up to the third derivative.
+
+use nalgebra::Vector4;
+
+use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
+use crate::curve::{clamp_param, Curve, Vec3};
+use crate::error::CurveError;
+
+/// `C(u) = Σ N_{i,p}(u) w_i P_i / Σ N_{i,p}(u) w_i`, `u` in `[knots[p], knots[n+1]]`.
+///
+/// Control points are stored homogeneous (`w·x, w·y, w·z, w`), as A4.2 works on them. The
+/// knot vector need not be clamped: the domain is always `[u_p, u_{n+1}]` (P&T §2.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Nurbs {
+    degree: usize,
+    knots: Vec<f64>,
+    cw: Vec<Vector4<f64>>,
+    /// First and last non-empty span of the domain (for A2.1 at the domain ends).
+    first: usize,
+    last: usize,
+}
+
+impl Nurbs {
+    /// A NURBS curve. Validates: degree in `1..=MAX_DEGREE`, at least `degree + 1` control
+    /// points, one weight per point, `points + degree + 1` knots, everything finite, knots
+    /// non-decreasing, weights > 0, no knot repeated more than `degree` times inside the
+    /// domain (the curve would break apart there) or `degree + 1` times anywhere, and a
+    /// non-empty domain.
+    pub fn new(
+        degree: usize,
+        points: &[Vec3],
+        weights: &[f64],
+        knots: Vec<f64>,
+    ) -> Result<Self, CurveError> {
+        if degree == 0 || degree > MAX_DEGREE {
+            return Err(CurveError::Degree {
+                degree,
+                max: MAX_DEGREE,
+            });
+        }
+        if points.len() < degree + 1 {
+            return Err(CurveError::TooFewPoints {
+                points: points.len(),
+                degree,
+                need: degree + 1,
+            });
+        }
+        if weights.len() != points.len() {
+            return Err(CurveError::WeightCount {
+                weights: weights.len(),
+                points: points.len(),
+            });
+        }
+        let expected = points.len() + degree + 1;
+        if knots.len() != expected {
+            return Err(CurveError::KnotCount {
+                got: knots.len(),
+                expected,
+            });
+        }
+        if !points.iter().flat_map(|p| p.iter()).all(|c| c.is_finite())
+            || !knots.iter().all(|k| k.is_finite())
+        {
+            return Err(CurveError::NotFinite);
+        }
+        for (index, &value) in weights.iter().enumerate() {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(CurveError::Weight { index, value });
+            }
+        }
+        for i in 1..knots.len() {
+            if knots[i] < knots[i - 1] {
+                return Err(CurveError::KnotsDecreasing {
+                    index: i,
+                    value: knots[i],
+                });
+            }
+        }
+        let n = points.len() - 1;
+        let (lo, hi) = (knots[degree], knots[n + 1]);
+        if lo >= hi {
+            return Err(CurveError::EmptyDomain);
+        }
+        let mut i = 0;
+        while i < knots.len() {
+            let mut j = i;
+            while j + 1 < knots.len() && knots[j + 1] == knots[i] {
+                j += 1;
+            }
+            let m = j - i + 1;
+            let inside = knots[i] > lo && knots[i] < hi;
+            if m > degree + 1 || (inside && m > degree) {
+                return Err(CurveError::KnotMultiplicity {
+                    value: knots[i],
+                    multiplicity: m,
+                    degree,
+                });
+            }
+            i = j + 1;
+        }
+        let first = (degree..=n)
+            .find(|&s| knots[s] < knots[s + 1])
+            .unwrap_or(degree);
+        let last = (degree..=n)
+            .rev()
+            .find(|&s| knots[s] < knots[s + 1])
+            .unwrap_or(n);
+        let cw = points
+            .iter()
+            .zip(weights)
+            .map(|(p, &w)| Vector4::new(p.x * w, p.y * w, p.z * w, w))
+            .collect();
+        Ok(Nurbs {
+            degree,
+            knots,
+            cw,
+            first,
+            last,
+        })
+    }
+
+    /// A non-rational B-spline (all weights 1).
+    pub fn bspline(degree: usize, points: &[Vec3], knots: Vec<f64>) -> Result<Self, CurveError> {
+        Nurbs::new(degree, points, &vec![1.0; points.len()], knots)
+    }
+
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+    /// Control points in Cartesian form.
+    pub fn control_points(&self) -> Vec<Vec3> {
+        self.cw
+            .iter()
+            .map(|c| Vec3::new(c.x / c.w, c.y / c.w, c.z / c.w))
+            .collect()
+    }
+    pub fn weights(&self) -> Vec<f64> {
+        self.cw.iter().map(|c| c.w).collect()
+    }
+
+    fn span(&self, u: f64) -> (usize, f64) {
+        let (a, b) = self.domain();
+        let u = clamp_param(u, a, b);
+        (find_span(&self.knots, self.first, self.last, u), u)
+    }
+}
+
+/// Binomial coefficients up to 3 for A4.2.
+const BIN: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [1.0, 1.0, 0.0, 0.0],
+    [1.0, 2.0, 1.0, 0.0],
+    [1.0, 3.0, 3.0, 1.0],
+];
+
+impl Curve for Nurbs {
+    fn domain(&self) -> (f64, f64) {
+        (self.knots[self.degree], self.knots[self.cw.len()])
+    }
+
+    fn point(&self, u: f64) -> Vec3 {
+        let p = self.degree;
+        let (span, u) = self.span(u);
+        let mut n = [0.0; W];
+        basis_funs(&self.knots, span, u, p, &mut n);
+        let mut h = Vector4::zeros();
+        for (j, nj) in n[..=p].iter().enumerate() {
+            h += self.cw[span - p + j] * *nj;
+        }
+        Vec3::new(h.x, h.y, h.z) / h.w
+    }
+
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        let p = self.degree;
+        let (span, u) = self.span(u);
+        let mut nd = [[0.0; W]; MAX_DER + 1];
+        ders_basis_funs(&self.knots, span, u, p, MAX_DER, &mut nd);
+        // Derivatives of the homogeneous curve Cw (A3.2 on the 4-D points).
+        let mut aw = [Vector4::zeros(); MAX_DER + 1];
+        for (k, a) in aw.iter_mut().enumerate().take(MAX_DER.min(p) + 1) {
+            for j in 0..=p {
+                *a += self.cw[span - p + j] * nd[k][j];
+            }
+        }
+        // A4.2 RatCurveDerivs: C^(k) = (A^(k) - Σ_{i=1..k} C(k,i) w^(i) C^(k-i)) / w.
+        let mut ck = [Vec3::zeros(); MAX_DER + 1];
+        let w0 = aw[0].w;
+        for k in 0..=MAX_DER {
+            let mut v = Vec3::new(aw[k].x, aw[k].y, aw[k].z);
+            for i in 1..=k {
+                v -= ck[k - i] * (BIN[k][i] * aw[i].w);
+            }
+            ck[k] = v / w0;
+        }
+        ck
+    }
+
+    fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut out = vec![a];
+        for &k in &self.knots {
+            if k > *out.last().unwrap_or(&a) && k < b {
+                out.push(k);
+            }
+        }
+        out.push(b);
+        out
+    }
+}
