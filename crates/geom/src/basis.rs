@@ -2,6 +2,9 @@
 //! non-zero basis functions A2.2 and their derivatives A2.3. The kernel under [`crate::nurbs`]
 //! and the spline fitters; fixed-size stack arrays keep evaluation allocation-free.
 
+// Index loops mirror the book's pseudo-code, so the code can be checked against it line by line.
+#![allow(clippy::needless_range_loop)]
+
 /// Highest supported degree; arrays below are sized for it. Controllers use degree ≤ 5.
 pub const MAX_DEGREE: usize = 15;
 /// Array width: basis functions of one span (`degree + 1`).

@@ -2,6 +2,9 @@
 //! output of spline fitting. Evaluation uses span search A2.1, basis functions A2.2/A2.3 and
 //! the rational derivative rule A4.2 (Piegl & Tiller) up to the third derivative.
 
+// Index loops mirror the book's pseudo-code, so the code can be checked against it line by line.
+#![allow(clippy::needless_range_loop)]
+
 use nalgebra::Vector4;
 
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
