@@ -7,19 +7,26 @@
 
 pub mod arc;
 pub mod arclen;
+mod banded;
 pub mod basis;
+pub mod bezier;
 pub mod curve;
+pub mod deviation;
 pub mod error;
+pub mod fit;
 pub mod line;
 pub mod moves;
 pub mod nurbs;
 pub mod pose;
+pub mod quintic;
 
 pub use arc::{Arc, Helix};
 pub use arclen::ArcLengthMap;
+pub use bezier::Bezier;
 pub use curve::{Curve, Vec3};
 pub use error::CurveError;
 pub use line::Line;
 pub use moves::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, StopKind, Turn};
 pub use nurbs::Nurbs;
 pub use pose::{Axis, Pose};
+pub use quintic::{Quintic, State};

@@ -1,0 +1,217 @@
+//! Tolerance-bounded least-squares approximation (Piegl & Tiller A9.7 with end points fixed,
+//! plus knot insertion): the fewest-knots spline we find that stays within a tolerance of every
+//! input point and every input segment. This is what compression of short G1 runs runs on.
+//!
+//! Loop: solve the least-squares problem for the current knots; measure, for every segment
+//! `Q_k Q_{k+1}`, the largest distance from the curve piece `u` in `[t_k, t_{k+1}]` to that
+//! segment, and for every point its distance to the curve (sampling plus golden-section
+//! refinement, [`crate::deviation`]); split each knot span that holds a violation near the worst
+//! spot; repeat. Knot spans that would hold too little data for a well-posed least-squares
+//! problem get extra samples of the polyline itself, so refinement always converges toward the
+//! polyline instead of running out of data (the plain A9.7 stalls at interpolation).
+
+use super::params::{check_points, parameters, Parameterisation};
+use crate::banded::Banded;
+use crate::basis::{basis_funs, find_span, MAX_DEGREE, W};
+use crate::curve::{Curve, Vec3};
+use crate::deviation::{closest_point, max_distance_to_segment};
+use crate::error::CurveError;
+use crate::nurbs::Nurbs;
+
+/// Rounds of knot insertion before giving up; each round at least shortens every offending
+/// span to three quarters, so 64 rounds reach spans of 1e-8 of the parameter range.
+const MAX_ROUNDS: usize = 64;
+/// Samples per segment for the deviation checks (then refined).
+const SAMPLES: usize = 8;
+
+/// The fitted curve and how it was obtained.
+#[derive(Debug, Clone)]
+pub struct Approximation {
+    /// Clamped B-spline; its ends are exactly the first and last input points.
+    pub curve: Nurbs,
+    /// Parameter of each input point (segment `k` corresponds to `[params[k], params[k+1]]`).
+    pub params: Vec<f64>,
+    /// Largest measured distance over all points and segments (≤ the tolerance).
+    pub max_deviation: f64,
+    /// Least-squares solves it took.
+    pub rounds: usize,
+}
+
+/// Fit a degree-`p` B-spline to the polyline `points` so that every point is within
+/// `tolerance` of the curve and every curve piece is within `tolerance` of its segment.
+pub fn approximate(
+    points: &[Vec3],
+    p: usize,
+    tolerance: f64,
+    method: Parameterisation,
+) -> Result<Approximation, CurveError> {
+    if p == 0 || p > MAX_DEGREE {
+        return Err(CurveError::Degree {
+            degree: p,
+            max: MAX_DEGREE,
+        });
+    }
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(CurveError::Tolerance(tolerance));
+    }
+    check_points(points, p, 2)?;
+    let t = parameters(points, method, p)?;
+    let m = points.len() - 1;
+    let mut interior: Vec<f64> = Vec::new();
+    let mut data: Vec<(f64, Vec3)> = t.iter().copied().zip(points.iter().copied()).collect();
+    let mut best = f64::INFINITY;
+    for round in 1..=MAX_ROUNDS {
+        densify(&mut data, &interior, p, &t, points);
+        let curve = least_squares(&data, &interior, p)?;
+        // Worst violation per knot span: (distance, u).
+        let bounds: Vec<f64> = std::iter::once(0.0)
+            .chain(interior.iter().copied())
+            .chain(std::iter::once(1.0))
+            .collect();
+        let mut worst_in_span: Vec<Option<(f64, f64)>> = vec![None; bounds.len() - 1];
+        let mut worst = 0.0f64;
+        let mut note = |d: f64, u: f64| {
+            worst = worst.max(d);
+            if d > tolerance {
+                let s = bounds
+                    .partition_point(|&x| x <= u)
+                    .clamp(1, bounds.len() - 1)
+                    - 1;
+                if worst_in_span[s].is_none_or(|(w, _)| d > w) {
+                    worst_in_span[s] = Some((d, u));
+                }
+            }
+        };
+        for k in 0..m {
+            let (a, b) = (&points[k], &points[k + 1]);
+            let d = max_distance_to_segment(&curve, t[k], t[k + 1], a, b, SAMPLES);
+            note(d.distance, d.u);
+        }
+        for k in 1..m {
+            // The point at its own parameter bounds the distance; refine only when needed.
+            let direct = (curve.point(t[k]) - points[k]).norm();
+            if direct > tolerance {
+                let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], SAMPLES);
+                note(d.distance, d.u);
+            }
+        }
+        if worst <= tolerance {
+            return Ok(Approximation {
+                curve,
+                params: t,
+                max_deviation: worst,
+                rounds: round,
+            });
+        }
+        best = best.min(worst);
+        let mut added = false;
+        for (s, w) in worst_in_span.iter().enumerate() {
+            if let Some((_, u)) = w {
+                let (a, b) = (bounds[s], bounds[s + 1]);
+                let q = 0.25 * (b - a);
+                // Split near the worst spot but never closer than a quarter to a span end.
+                let xi = u.clamp(a + q, b - q);
+                if xi > a && xi < b {
+                    interior.push(xi);
+                    added = true;
+                }
+            }
+        }
+        if !added {
+            break;
+        }
+        interior.sort_by(f64::total_cmp);
+    }
+    Err(CurveError::NotConverged {
+        tolerance,
+        achieved: best,
+        iterations: MAX_ROUNDS,
+    })
+}
+
+/// The point of the polyline at parameter `u` (linear within segment `k`).
+fn polyline_at(u: f64, t: &[f64], points: &[Vec3]) -> Vec3 {
+    let k = t.partition_point(|&x| x <= u).clamp(1, t.len() - 1) - 1;
+    let f = (u - t[k]) / (t[k + 1] - t[k]);
+    points[k] + (points[k + 1] - points[k]) * f
+}
+
+/// Give every knot span at least `max(1, p − 1)` data parameters strictly inside it (added as
+/// samples of the polyline), which keeps the least-squares problem well posed
+/// (Schoenberg–Whitney) however finely the knots are refined.
+fn densify(data: &mut Vec<(f64, Vec3)>, interior: &[f64], p: usize, t: &[f64], points: &[Vec3]) {
+    let need = p.saturating_sub(1).max(1);
+    let bounds: Vec<f64> = std::iter::once(0.0)
+        .chain(interior.iter().copied())
+        .chain(std::iter::once(1.0))
+        .collect();
+    let mut extra = Vec::new();
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let lo = data.partition_point(|d| d.0 <= a);
+        let hi = data.partition_point(|d| d.0 < b);
+        let have = hi.saturating_sub(lo);
+        if have < need {
+            for i in 1..=need {
+                let u = a + (b - a) * i as f64 / (need + 1) as f64;
+                extra.push((u, polyline_at(u, t, points)));
+            }
+        }
+    }
+    if !extra.is_empty() {
+        data.extend(extra);
+        data.sort_by(|x, y| x.0.total_cmp(&y.0));
+        data.dedup_by(|x, y| x.0 == y.0);
+    }
+}
+
+/// Least squares with the end control points pinned to the end data (A9.7's formulation):
+/// minimise `Σ |C(t_k) − Q_k|²` over the interior control points.
+fn least_squares(data: &[(f64, Vec3)], interior: &[f64], p: usize) -> Result<Nurbs, CurveError> {
+    let mut knots = vec![0.0; p + 1];
+    knots.extend_from_slice(interior);
+    knots.extend(std::iter::repeat_n(1.0, p + 1));
+    let n = knots.len() - p - 2; // index of the last control point
+    let (q0, qm) = match (data.first(), data.last()) {
+        (Some(a), Some(b)) => (a.1, b.1),
+        _ => return Err(CurveError::Singular),
+    };
+    let unknowns = n.saturating_sub(1);
+    let mut ctrl = Vec::with_capacity(n + 1);
+    ctrl.push(q0);
+    if unknowns > 0 {
+        let mut a = Banded::new(unknowns, p, p);
+        let mut rhs = vec![Vec3::zeros(); unknowns];
+        let mut b = [0.0; W];
+        for &(u, q) in &data[1..data.len() - 1] {
+            let s = find_span(&knots, p, n, u);
+            basis_funs(&knots, s, u, p, &mut b);
+            let mut r = q;
+            for (j, v) in b[..=p].iter().enumerate() {
+                let i = s - p + j;
+                if i == 0 {
+                    r -= q0 * *v;
+                } else if i == n {
+                    r -= qm * *v;
+                }
+            }
+            for (j, bj) in b[..=p].iter().enumerate() {
+                let i = s - p + j;
+                if i == 0 || i == n {
+                    continue;
+                }
+                rhs[i - 1] += r * *bj;
+                for (l, bl) in b[..=p].iter().enumerate() {
+                    let c = s - p + l;
+                    if c != 0 && c != n {
+                        a.add(i - 1, c - 1, bj * bl);
+                    }
+                }
+            }
+        }
+        a.solve(&mut rhs)?;
+        ctrl.extend(rhs);
+    }
+    ctrl.push(qm);
+    Nurbs::bspline(p, &ctrl, knots)
+}
