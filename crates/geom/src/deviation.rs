@@ -43,30 +43,51 @@ pub fn point_polyline_distance(p: &Vec3, polyline: &[Vec3]) -> f64 {
 }
 
 /// Maximise `f` on `[u0, u1]`: `samples + 1` equally spaced samples, then golden-section
-/// search in the bracket around the best sample.
+/// search in the bracket around every local maximum among the samples (a piece that wiggles
+/// has several; refining only the best sample can miss a taller peak between samples).
 pub fn maximise(f: impl Fn(f64) -> f64, u0: f64, u1: f64, samples: usize) -> Deviation {
     let n = samples.max(2);
     let h = (u1 - u0) / n as f64;
+    let at = |i: usize| if i == n { u1 } else { u0 + h * i as f64 };
+    let vals: Vec<f64> = (0..=n).map(|i| f(at(i))).collect();
     let mut best = Deviation {
-        distance: f(u0),
+        distance: vals[0],
         u: u0,
     };
-    let mut best_i = 0;
-    for i in 1..=n {
-        let u = if i == n { u1 } else { u0 + h * i as f64 };
-        let d = f(u);
-        if d > best.distance {
-            best = Deviation { distance: d, u };
-            best_i = i;
+    for (i, &v) in vals.iter().enumerate() {
+        if v > best.distance {
+            best = Deviation {
+                distance: v,
+                u: at(i),
+            };
         }
     }
     if h.is_nan() || h <= 0.0 {
         return best;
     }
-    let (mut a, mut b) = (
-        u0 + h * best_i.saturating_sub(1) as f64,
-        (u0 + h * (best_i + 1) as f64).min(u1),
-    );
+    for i in 0..=n {
+        let left = if i > 0 {
+            vals[i - 1]
+        } else {
+            f64::NEG_INFINITY
+        };
+        let right = if i < n {
+            vals[i + 1]
+        } else {
+            f64::NEG_INFINITY
+        };
+        if vals[i] >= left && vals[i] >= right {
+            let d = golden(&f, at(i.saturating_sub(1)), at((i + 1).min(n)));
+            if d.distance > best.distance {
+                best = d;
+            }
+        }
+    }
+    best
+}
+
+/// Golden-section search for the maximum of `f` on `[a, b]` (assumed unimodal there).
+fn golden(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> Deviation {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
     let (mut f1, mut f2) = (f(x1), f(x2));
@@ -85,12 +106,17 @@ pub fn maximise(f: impl Fn(f64) -> f64, u0: f64, u1: f64, samples: usize) -> Dev
             f2 = f(x2);
         }
     }
-    for (u, d) in [(x1, f1), (x2, f2)] {
-        if d > best.distance {
-            best = Deviation { distance: d, u };
+    if f1 >= f2 {
+        Deviation {
+            distance: f1,
+            u: x1,
+        }
+    } else {
+        Deviation {
+            distance: f2,
+            u: x2,
         }
     }
-    best
 }
 
 /// Largest distance from the curve piece `u` in `[u0, u1]` to the segment `a`–`b`.

@@ -3,10 +3,14 @@
 //! input point and every input segment. This is what compression of short G1 runs runs on.
 //!
 //! Loop: solve the least-squares problem for the current knots; measure, for every segment
-//! `Q_k Q_{k+1}`, the largest distance from the curve piece `u` in `[t_k, t_{k+1}]` to that
-//! segment, and for every point its distance to the curve (sampling plus golden-section
-//! refinement, [`crate::deviation`]); split each knot span that holds a violation near the worst
-//! spot; repeat. Knot spans that would hold too little data for a well-posed least-squares
+//! `Q_k Q_{k+1}`, the largest distance from the curve piece `u` in `[t_k, t_{k+1}]` to the
+//! polyline around it (segments `k−1, k, k+1`: the piece may drift a little along the path
+//! across a vertex, which is no deviation), and for every point its distance to the curve
+//! (sampling plus golden-section refinement, [`crate::deviation`]); split each knot span that
+//! holds a violation near the worst spot; repeat. The result: every input point is within the
+//! tolerance of the curve, and every point of the curve within the tolerance of the polyline
+//! (of the segment its piece belongs to or a neighbour) — the two directions of the Hausdorff
+//! distance, locally. Knot spans that would hold too little data for a well-posed least-squares
 //! problem get extra samples of the polyline itself, so refinement always converges toward the
 //! polyline instead of running out of data (the plain A9.7 stalls at interpolation).
 
@@ -14,7 +18,7 @@ use super::params::{check_points, parameters, Parameterisation};
 use crate::banded::Banded;
 use crate::basis::{basis_funs, find_span, MAX_DEGREE, W};
 use crate::curve::{Curve, Vec3};
-use crate::deviation::{closest_point, max_distance_to_segment};
+use crate::deviation::{closest_point, maximise, point_segment_distance};
 use crate::error::CurveError;
 use crate::nurbs::Nurbs;
 
@@ -38,7 +42,8 @@ pub struct Approximation {
 }
 
 /// Fit a degree-`p` B-spline to the polyline `points` so that every point is within
-/// `tolerance` of the curve and every curve piece is within `tolerance` of its segment.
+/// `tolerance` of the curve and every curve piece is within `tolerance` of its segment or the
+/// segments either side of it.
 pub fn approximate(
     points: &[Vec3],
     p: usize,
@@ -84,14 +89,39 @@ pub fn approximate(
         };
         for k in 0..m {
             let (a, b) = (&points[k], &points[k + 1]);
-            let d = max_distance_to_segment(&curve, t[k], t[k + 1], a, b, SAMPLES);
+            // More samples where knots fall inside the piece: each span may bend on its own.
+            let inside = interior.partition_point(|&x| x < t[k + 1])
+                - interior.partition_point(|&x| x <= t[k]);
+            let samples = SAMPLES + 4 * inside;
+            let d = maximise(
+                |u| {
+                    let c = curve.point(u);
+                    // The piece belongs to segment k, but a little tangential drift of the
+                    // parameter across a vertex is no deviation from the path: measure to the
+                    // segments around it.
+                    let mut d = point_segment_distance(&c, a, b);
+                    if k > 0 {
+                        d = d.min(point_segment_distance(&c, &points[k - 1], a));
+                    }
+                    if k + 2 <= m {
+                        d = d.min(point_segment_distance(&c, b, &points[k + 2]));
+                    }
+                    d
+                },
+                t[k],
+                t[k + 1],
+                samples,
+            );
             note(d.distance, d.u);
         }
         for k in 1..m {
             // The point at its own parameter bounds the distance; refine only when needed.
             let direct = (curve.point(t[k]) - points[k]).norm();
             if direct > tolerance {
-                let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], SAMPLES);
+                let inside = interior.partition_point(|&x| x < t[k + 1])
+                    - interior.partition_point(|&x| x <= t[k - 1]);
+                let samples = 2 * SAMPLES + 4 * inside;
+                let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], samples);
                 note(d.distance, d.u);
             }
         }
