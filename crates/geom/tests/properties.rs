@@ -180,9 +180,9 @@ proptest! {
                 prop_assert!(d <= tol + slack, "segment {} piece off by {} > {}", k, d, tol);
             }
         }
-        for k in 1..q.len() - 1 {
+        for (k, qk) in q.iter().enumerate().take(q.len() - 1).skip(1) {
             let (u0, u1) = (a.params[k - 1], a.params[k + 1]);
-            let dist = |u: f64| (c.point(u) - q[k]).norm();
+            let dist = |u: f64| (c.point(u) - qk).norm();
             let h = (u1 - u0) / 400.0;
             let i = (0..=400)
                 .min_by(|&i, &j| dist(u0 + h * i as f64).total_cmp(&dist(u0 + h * j as f64)))
