@@ -69,9 +69,26 @@ pub fn ders_basis_funs(
     nd: usize,
     ders: &mut [[f64; W]; MAX_DER + 1],
 ) {
-    let mut ndu = [[0.0; W]; W];
-    let mut left = [0.0; W];
-    let mut right = [0.0; W];
+    // Scratch arrays sized to the degree: zeroing a 16×16 table costs more than the
+    // arithmetic of a cubic, and controllers use degree ≤ 5.
+    match p {
+        0..=3 => ders_impl::<4>(knots, span, u, p, nd, ders),
+        4..=5 => ders_impl::<6>(knots, span, u, p, nd, ders),
+        _ => ders_impl::<W>(knots, span, u, p, nd, ders),
+    }
+}
+
+fn ders_impl<const N: usize>(
+    knots: &[f64],
+    span: usize,
+    u: f64,
+    p: usize,
+    nd: usize,
+    ders: &mut [[f64; W]; MAX_DER + 1],
+) {
+    let mut ndu = [[0.0; N]; N];
+    let mut left = [0.0; N];
+    let mut right = [0.0; N];
     ndu[0][0] = 1.0;
     for j in 1..=p {
         left[j] = u - knots[span + 1 - j];
@@ -93,7 +110,7 @@ pub fn ders_basis_funs(
         ders[0][j] = ndu[j][p];
     }
     let nd = nd.min(p).min(MAX_DER);
-    let mut a = [[0.0; W]; 2];
+    let mut a = [[0.0; N]; 2];
     let pi = p as isize;
     for r in 0..=pi {
         let (mut s1, mut s2) = (0usize, 1usize);

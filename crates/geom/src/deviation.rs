@@ -8,8 +8,9 @@ use crate::curve::{Curve, Vec3};
 /// right basin for the curves tezgah builds (a piece turns by far less than a half circle).
 pub const DEFAULT_SAMPLES: usize = 16;
 
-/// Golden-section iterations: shrinks the bracket by 0.618⁶⁰ ≈ 3e-13.
-const GOLDEN_ITERATIONS: usize = 60;
+/// Golden-section iterations: shrink the bracket (two sample spacings) by 0.618³² ≈ 2e-7;
+/// near a smooth maximum the value error is quadratic in that.
+const GOLDEN_ITERATIONS: usize = 32;
 
 /// A distance and the curve parameter where it occurs.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -146,6 +146,32 @@ impl Nurbs {
         self.cw.iter().map(|c| c.w).collect()
     }
 
+    /// C and its derivatives up to `nd` (higher ones left zero).
+    fn rat_derivs(&self, u: f64, nd: usize) -> [Vec3; 4] {
+        let p = self.degree;
+        let (span, u) = self.span(u);
+        let mut nders = [[0.0; W]; MAX_DER + 1];
+        ders_basis_funs(&self.knots, span, u, p, nd, &mut nders);
+        // Derivatives of the homogeneous curve Cw (A3.2 on the 4-D points).
+        let mut aw = [Vector4::zeros(); MAX_DER + 1];
+        for (k, a) in aw.iter_mut().enumerate().take(nd.min(p) + 1) {
+            for j in 0..=p {
+                *a += self.cw[span - p + j] * nders[k][j];
+            }
+        }
+        // A4.2 RatCurveDerivs: C^(k) = (A^(k) - Σ_{i=1..k} C(k,i) w^(i) C^(k-i)) / w.
+        let mut ck = [Vec3::zeros(); MAX_DER + 1];
+        let w0 = aw[0].w;
+        for k in 0..=nd.min(MAX_DER) {
+            let mut v = Vec3::new(aw[k].x, aw[k].y, aw[k].z);
+            for i in 1..=k {
+                v -= ck[k - i] * (BIN[k][i] * aw[i].w);
+            }
+            ck[k] = v / w0;
+        }
+        ck
+    }
+
     fn span(&self, u: f64) -> (usize, f64) {
         let (a, b) = self.domain();
         let u = clamp_param(u, a, b);
@@ -179,28 +205,12 @@ impl Curve for Nurbs {
     }
 
     fn derivs(&self, u: f64) -> [Vec3; 4] {
-        let p = self.degree;
-        let (span, u) = self.span(u);
-        let mut nd = [[0.0; W]; MAX_DER + 1];
-        ders_basis_funs(&self.knots, span, u, p, MAX_DER, &mut nd);
-        // Derivatives of the homogeneous curve Cw (A3.2 on the 4-D points).
-        let mut aw = [Vector4::zeros(); MAX_DER + 1];
-        for (k, a) in aw.iter_mut().enumerate().take(MAX_DER.min(p) + 1) {
-            for j in 0..=p {
-                *a += self.cw[span - p + j] * nd[k][j];
-            }
-        }
-        // A4.2 RatCurveDerivs: C^(k) = (A^(k) - Σ_{i=1..k} C(k,i) w^(i) C^(k-i)) / w.
-        let mut ck = [Vec3::zeros(); MAX_DER + 1];
-        let w0 = aw[0].w;
-        for k in 0..=MAX_DER {
-            let mut v = Vec3::new(aw[k].x, aw[k].y, aw[k].z);
-            for i in 1..=k {
-                v -= ck[k - i] * (BIN[k][i] * aw[i].w);
-            }
-            ck[k] = v / w0;
-        }
-        ck
+        self.rat_derivs(u, MAX_DER)
+    }
+
+    fn d1(&self, u: f64) -> Vec3 {
+        // The arc-length quadrature only needs C'; skip the higher basis derivatives.
+        self.rat_derivs(u, 1)[1]
     }
 
     fn breakpoints(&self) -> Vec<f64> {
