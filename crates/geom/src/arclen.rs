@@ -14,9 +14,10 @@
 //! is rigorous in the asymptotic regime of a smooth integrand on each panel, which the span
 //! split and the halving test enforce; a panel that reaches the depth limit (a cusp where
 //! `C' = 0` has a kink in `|C'|`) is accepted anyway and its difference still counts in
-//! [`ArcLengthMap::error_estimate`]. `u(s)` solves `s(u) = s` with the same panel quadrature,
-//! so `s(u(s)) = s` to the Newton tolerance (`tol / 100`), and `u(s)` inherits the bound above
-//! as an arc-length error.
+//! [`ArcLengthMap::error_estimate`]. `u(s)` solves `s(u) = s` with the same panel quadrature
+//! (safeguarded Newton from a cubic Hermite guess; the last quadrature is skipped when the
+//! Newton step's second-order residual is already below the tolerance), so `s(u(s)) = s` to the
+//! Newton tolerance (`tol / 100`), and `u(s)` inherits the bound above as an arc-length error.
 
 use crate::curve::{clamp_param, Curve};
 use crate::error::CurveError;
@@ -188,14 +189,23 @@ impl ArcLengthMap {
             if hi - lo <= f64::EPSILON * (ua.abs() + ub.abs()) {
                 break;
             }
-            let v = curve.speed(u);
-            let next = u - f / v;
+            let [_, d1, d2, _] = curve.derivs(u);
+            let v = d1.norm();
+            let step = f / v;
+            let next = u - step;
             // Newton inside the bracket, bisection when it would leave it (or v = 0).
-            u = if next > lo && next < hi {
-                next
+            if next > lo && next < hi {
+                // After the step the residual is F''·δ²/2 to third order (F' = |C'|,
+                // F'' = C'·C''/|C'|); when that is far inside the tolerance, the quadrature
+                // that would confirm it can be skipped.
+                let fpp = d1.dot(&d2) / v;
+                if (fpp * step * step).abs() <= 0.5 * self.newton_tolerance {
+                    return next;
+                }
+                u = next;
             } else {
-                0.5 * (lo + hi)
-            };
+                u = 0.5 * (lo + hi);
+            }
         }
         u
     }

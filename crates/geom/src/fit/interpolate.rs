@@ -27,7 +27,7 @@ pub fn interpolate(
     let m = points.len() - 1;
     let knots = match method {
         Parameterisation::Universal => uniform_knots(m, p),
-        _ => averaged_knots(&t, p),
+        _ => averaged_knots(&t, p)?,
     };
     // Row k of the collocation matrix has its non-zeros in columns span−p..=span; find the
     // band first, then fill.

@@ -126,12 +126,20 @@ pub fn parameters(
 
 /// Averaged knots (P&T eq. 9.8): clamped, `u_{j+p} = (1/p) Σ_{i=j}^{j+p−1} t_i` for
 /// `j = 1..=m−p`. The reference prints the indices off by one (it counts order, not degree).
-pub fn averaged_knots(t: &[f64], p: usize) -> Vec<f64> {
+/// Needs at least `p + 1` parameters.
+pub fn averaged_knots(t: &[f64], p: usize) -> Result<Vec<f64>, CurveError> {
+    if p == 0 || t.len() < p + 1 {
+        return Err(CurveError::TooFewPoints {
+            points: t.len(),
+            degree: p,
+            need: p + 1,
+        });
+    }
     let m = t.len() - 1;
     let mut k = vec![t[0]; p + 1];
-    for j in 1..=m.saturating_sub(p) {
+    for j in 1..=m - p {
         k.push(t[j..j + p].iter().sum::<f64>() / p as f64);
     }
     k.extend(std::iter::repeat_n(t[m], p + 1));
-    k
+    Ok(k)
 }
