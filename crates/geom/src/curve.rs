@@ -109,3 +109,47 @@ impl<C: Curve + ?Sized> Curve for &C {
         (**self).length()
     }
 }
+
+/// A path is a list of `Box<dyn Curve>`; boxes are curves too.
+impl<C: Curve + ?Sized> Curve for Box<C> {
+    fn domain(&self) -> (f64, f64) {
+        (**self).domain()
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        (**self).derivs(u)
+    }
+    fn point(&self, u: f64) -> Vec3 {
+        (**self).point(u)
+    }
+    fn d1(&self, u: f64) -> Vec3 {
+        (**self).d1(u)
+    }
+    fn speed(&self, u: f64) -> f64 {
+        (**self).speed(u)
+    }
+    fn curvature(&self, u: f64) -> f64 {
+        (**self).curvature(u)
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        (**self).breakpoints()
+    }
+    fn length(&self) -> f64 {
+        (**self).length()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::line::Line;
+
+    #[test]
+    fn curves_are_object_safe_and_boxable() {
+        let l = Line::new(Vec3::zeros(), Vec3::new(3.0, 4.0, 0.0)).unwrap();
+        let path: Vec<Box<dyn Curve>> = vec![Box::new(l)];
+        assert_eq!(path[0].length(), 5.0);
+        assert_eq!(path[0].point(5.0), Vec3::new(3.0, 4.0, 0.0));
+        assert_eq!(curvature_of(&Vec3::zeros(), &Vec3::x()), f64::INFINITY);
+        assert_eq!(curvature_of(&Vec3::zeros(), &Vec3::zeros()), 0.0);
+    }
+}

@@ -15,6 +15,7 @@
 //! polyline instead of running out of data (the plain A9.7 stalls at interpolation).
 
 use super::params::{check_points, parameters, Parameterisation};
+use super::pieces::Pieces;
 use crate::banded::Banded;
 use crate::basis::{basis_funs, find_span, MAX_DEGREE, W};
 use crate::curve::{Curve, Vec3};
@@ -61,70 +62,16 @@ pub fn approximate(
     }
     check_points(points, p, 2)?;
     let t = parameters(points, method, p)?;
-    let m = points.len() - 1;
     let mut interior: Vec<f64> = Vec::new();
     let mut data: Vec<(f64, Vec3)> = t.iter().copied().zip(points.iter().copied()).collect();
     let mut best = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {
         densify(&mut data, &interior, p, &t, points);
         let curve = least_squares(&data, &interior, p)?;
-        // Worst violation per knot span: (distance, u).
-        let bounds: Vec<f64> = std::iter::once(0.0)
-            .chain(interior.iter().copied())
-            .chain(std::iter::once(1.0))
-            .collect();
-        let mut worst_in_span: Vec<Option<(f64, f64)>> = vec![None; bounds.len() - 1];
-        let mut worst = 0.0f64;
-        let mut note = |d: f64, u: f64| {
-            worst = worst.max(d);
-            if d > tolerance {
-                let s = bounds
-                    .partition_point(|&x| x <= u)
-                    .clamp(1, bounds.len() - 1)
-                    - 1;
-                if worst_in_span[s].is_none_or(|(w, _)| d > w) {
-                    worst_in_span[s] = Some((d, u));
-                }
-            }
+        let (worst, worst_in_span) = match Pieces::new(&curve) {
+            Some(fast) => measure(&fast, points, &t, &interior, tolerance),
+            None => measure(&curve, points, &t, &interior, tolerance),
         };
-        for k in 0..m {
-            let (a, b) = (&points[k], &points[k + 1]);
-            // More samples where knots fall inside the piece: each span may bend on its own.
-            let inside = interior.partition_point(|&x| x < t[k + 1])
-                - interior.partition_point(|&x| x <= t[k]);
-            let samples = SAMPLES + 4 * inside;
-            let d = maximise(
-                |u| {
-                    let c = curve.point(u);
-                    // The piece belongs to segment k, but a little tangential drift of the
-                    // parameter across a vertex is no deviation from the path: measure to the
-                    // segments around it.
-                    let mut d = point_segment_distance(&c, a, b);
-                    if k > 0 {
-                        d = d.min(point_segment_distance(&c, &points[k - 1], a));
-                    }
-                    if k + 2 <= m {
-                        d = d.min(point_segment_distance(&c, b, &points[k + 2]));
-                    }
-                    d
-                },
-                t[k],
-                t[k + 1],
-                samples,
-            );
-            note(d.distance, d.u);
-        }
-        for k in 1..m {
-            // The point at its own parameter bounds the distance; refine only when needed.
-            let direct = (curve.point(t[k]) - points[k]).norm();
-            if direct > tolerance {
-                let inside = interior.partition_point(|&x| x < t[k + 1])
-                    - interior.partition_point(|&x| x <= t[k - 1]);
-                let samples = 2 * SAMPLES + 4 * inside;
-                let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], samples);
-                note(d.distance, d.u);
-            }
-        }
         if worst <= tolerance {
             return Ok(Approximation {
                 curve,
@@ -135,6 +82,7 @@ pub fn approximate(
         }
         best = best.min(worst);
         let mut added = false;
+        let bounds = span_bounds(&interior);
         for (s, w) in worst_in_span.iter().enumerate() {
             if let Some((_, u)) = w {
                 let (a, b) = (bounds[s], bounds[s + 1]);
@@ -157,6 +105,80 @@ pub fn approximate(
         achieved: best,
         iterations: MAX_ROUNDS,
     })
+}
+
+/// `[0, interior knots…, 1]`.
+fn span_bounds(interior: &[f64]) -> Vec<f64> {
+    std::iter::once(0.0)
+        .chain(interior.iter().copied())
+        .chain(std::iter::once(1.0))
+        .collect()
+}
+
+/// Largest deviation over all pieces and points, and the worst violation `(distance, u)` in
+/// each knot span (None where the span is within tolerance).
+fn measure<C: Curve>(
+    curve: &C,
+    points: &[Vec3],
+    t: &[f64],
+    interior: &[f64],
+    tolerance: f64,
+) -> (f64, Vec<Option<(f64, f64)>>) {
+    let m = points.len() - 1;
+    let bounds = span_bounds(interior);
+    let mut worst_in_span: Vec<Option<(f64, f64)>> = vec![None; bounds.len() - 1];
+    let mut worst = 0.0f64;
+    let mut note = |d: f64, u: f64| {
+        worst = worst.max(d);
+        if d > tolerance {
+            let s = bounds
+                .partition_point(|&x| x <= u)
+                .clamp(1, bounds.len() - 1)
+                - 1;
+            if worst_in_span[s].is_none_or(|(w, _)| d > w) {
+                worst_in_span[s] = Some((d, u));
+            }
+        }
+    };
+    for k in 0..m {
+        let (a, b) = (&points[k], &points[k + 1]);
+        // More samples where knots fall inside the piece: each span may bend on its own.
+        let inside =
+            interior.partition_point(|&x| x < t[k + 1]) - interior.partition_point(|&x| x <= t[k]);
+        let samples = SAMPLES + 4 * inside;
+        let d = maximise(
+            |u| {
+                let c = curve.point(u);
+                // The piece belongs to segment k, but a little tangential drift of the
+                // parameter across a vertex is no deviation from the path: measure to the
+                // segments around it.
+                let mut d = point_segment_distance(&c, a, b);
+                if k > 0 {
+                    d = d.min(point_segment_distance(&c, &points[k - 1], a));
+                }
+                if k + 2 <= m {
+                    d = d.min(point_segment_distance(&c, b, &points[k + 2]));
+                }
+                d
+            },
+            t[k],
+            t[k + 1],
+            samples,
+        );
+        note(d.distance, d.u);
+    }
+    for k in 1..m {
+        // The point at its own parameter bounds the distance; refine only when needed.
+        let direct = (curve.point(t[k]) - points[k]).norm();
+        if direct > tolerance {
+            let inside = interior.partition_point(|&x| x < t[k + 1])
+                - interior.partition_point(|&x| x <= t[k - 1]);
+            let samples = 2 * SAMPLES + 4 * inside;
+            let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], samples);
+            note(d.distance, d.u);
+        }
+    }
+    (worst, worst_in_span)
 }
 
 /// The point of the polyline at parameter `u` (linear within segment `k`).
