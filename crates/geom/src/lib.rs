@@ -19,6 +19,7 @@ pub mod moves;
 pub mod nurbs;
 pub mod pose;
 pub mod quintic;
+pub mod trim;
 
 pub use arc::{Arc, Helix};
 pub use arclen::ArcLengthMap;
@@ -30,3 +31,4 @@ pub use moves::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, StopKind, Tu
 pub use nurbs::Nurbs;
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};
+pub use trim::Trimmed;
