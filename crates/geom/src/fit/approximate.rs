@@ -19,7 +19,7 @@ use super::pieces::Pieces;
 use crate::banded::Banded;
 use crate::basis::{basis_funs, find_span, MAX_DEGREE, W};
 use crate::curve::{Curve, Vec3};
-use crate::deviation::{closest_point, maximise, point_segment_distance};
+use crate::deviation::{closest_point, maximise, point_segment_distance, Deviation};
 use crate::error::CurveError;
 use crate::nurbs::Nurbs;
 
@@ -68,10 +68,17 @@ pub fn approximate(
     for round in 1..=MAX_ROUNDS {
         densify(&mut data, &interior, p, &t, points);
         let curve = least_squares(&data, &interior, p)?;
-        let (worst, worst_in_span) = match Pieces::new(&curve) {
-            Some(fast) => measure(&fast, points, &t, &interior, tolerance),
-            None => measure(&curve, points, &t, &interior, tolerance),
+        let fast = Pieces::new(&curve);
+        let check = |quick| match &fast {
+            Some(f) => measure(f, points, &t, &interior, tolerance, quick),
+            None => measure(&curve, points, &t, &interior, tolerance, quick),
         };
+        // A samples-only pass finds the violations of the early rounds at a fraction of the
+        // cost; only when it finds none does the refined check (the one that can accept) run.
+        let (mut worst, mut worst_in_span) = check(true);
+        if worst <= tolerance {
+            (worst, worst_in_span) = check(false);
+        }
         if worst <= tolerance {
             return Ok(Approximation {
                 curve,
@@ -123,6 +130,7 @@ fn measure<C: Curve>(
     t: &[f64],
     interior: &[f64],
     tolerance: f64,
+    quick: bool,
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
     let bounds = span_bounds(interior);
@@ -146,26 +154,29 @@ fn measure<C: Curve>(
         let inside =
             interior.partition_point(|&x| x < t[k + 1]) - interior.partition_point(|&x| x <= t[k]);
         let samples = SAMPLES + 4 * inside;
-        let d = maximise(
-            |u| {
-                let c = curve.point(u);
-                // The piece belongs to segment k, but a little tangential drift of the
-                // parameter across a vertex is no deviation from the path: measure to the
-                // segments around it.
-                let mut d = point_segment_distance(&c, a, b);
-                if k > 0 {
-                    d = d.min(point_segment_distance(&c, &points[k - 1], a));
-                }
-                if k + 2 <= m {
-                    d = d.min(point_segment_distance(&c, b, &points[k + 2]));
-                }
-                d
-            },
-            t[k],
-            t[k + 1],
-            samples,
-        );
+        let dist = |u: f64| {
+            let c = curve.point(u);
+            // The piece belongs to segment k, but a little tangential drift of the
+            // parameter across a vertex is no deviation from the path: measure to the
+            // segments around it.
+            let mut d = point_segment_distance(&c, a, b);
+            if k > 0 {
+                d = d.min(point_segment_distance(&c, &points[k - 1], a));
+            }
+            if k + 2 <= m {
+                d = d.min(point_segment_distance(&c, b, &points[k + 2]));
+            }
+            d
+        };
+        let d = if quick {
+            sampled_max(dist, t[k], t[k + 1], samples)
+        } else {
+            maximise(dist, t[k], t[k + 1], samples)
+        };
         note(d.distance, d.u);
+    }
+    if quick {
+        return (worst, worst_in_span);
     }
     for k in 1..m {
         // The point at its own parameter bounds the distance; refine only when needed.
@@ -179,6 +190,30 @@ fn measure<C: Curve>(
         }
     }
     (worst, worst_in_span)
+}
+
+/// The largest of `samples + 1` equally spaced values: a lower bound of the maximum, enough
+/// to prove a violation (not to prove compliance).
+fn sampled_max(f: impl Fn(f64) -> f64, u0: f64, u1: f64, samples: usize) -> Deviation {
+    let h = (u1 - u0) / samples as f64;
+    (0..=samples)
+        .map(|i| {
+            let u = if i == samples { u1 } else { u0 + h * i as f64 };
+            Deviation { distance: f(u), u }
+        })
+        .fold(
+            Deviation {
+                distance: f64::NEG_INFINITY,
+                u: u0,
+            },
+            |a, b| {
+                if b.distance > a.distance {
+                    b
+                } else {
+                    a
+                }
+            },
+        )
 }
 
 /// The point of the polyline at parameter `u` (linear within segment `k`).
