@@ -146,6 +146,87 @@ impl Nurbs {
         self.cw.iter().map(|c| c.w).collect()
     }
 
+    /// A5.1 CurveKnotIns: the same curve with `u` inserted `times` more times (`u` strictly
+    /// inside the domain; its multiplicity may not exceed the degree). Knot insertion is how a
+    /// spline is cut at a corner or compared control point by control point with another.
+    pub fn insert_knot(&self, u: f64, times: usize) -> Result<Nurbs, CurveError> {
+        let p = self.degree;
+        let (lo, hi) = self.domain();
+        if !u.is_finite() {
+            return Err(CurveError::NotFinite);
+        }
+        if !(u > lo && u < hi) {
+            return Err(CurveError::EmptyDomain);
+        }
+        let s = self.knots.iter().filter(|&&k| k == u).count();
+        if s + times > p {
+            return Err(CurveError::KnotMultiplicity {
+                value: u,
+                multiplicity: s + times,
+                degree: p,
+            });
+        }
+        if times == 0 {
+            return Ok(self.clone());
+        }
+        let (up, pw, r) = (&self.knots, &self.cw, times);
+        let np = pw.len() - 1;
+        let mp = np + p + 1;
+        let k = find_span(up, self.first, self.last, u);
+        let mut uq = Vec::with_capacity(up.len() + r);
+        uq.extend_from_slice(&up[..=k]);
+        uq.extend(std::iter::repeat_n(u, r));
+        uq.extend_from_slice(&up[k + 1..=mp]);
+        let mut qw = vec![Vector4::zeros(); np + r + 1];
+        qw[..=k - p].copy_from_slice(&pw[..=k - p]);
+        qw[k - s + r..].copy_from_slice(&pw[k - s..]);
+        let mut rw: Vec<Vector4<f64>> = pw[k - p..=k - s].to_vec();
+        let mut l = k - p;
+        for j in 1..=r {
+            l = k - p + j;
+            for i in 0..=p - j - s {
+                let alpha = (u - up[l + i]) / (up[i + k + 1] - up[l + i]);
+                rw[i] = rw[i + 1] * alpha + rw[i] * (1.0 - alpha);
+            }
+            qw[l] = rw[0];
+            qw[k + r - j - s] = rw[p - j - s];
+        }
+        if l + 1 < k - s {
+            qw[l + 1..k - s].copy_from_slice(&rw[1..k - s - l]);
+        }
+        Nurbs::from_homogeneous(p, qw, uq)
+    }
+
+    /// Cut the curve at `u` (strictly inside the domain) into two curves that meet there:
+    /// `u` is inserted up to multiplicity `degree`, and the control polygon splits at the
+    /// control point that then lies on the curve.
+    pub fn split(&self, u: f64) -> Result<(Nurbs, Nurbs), CurveError> {
+        let p = self.degree;
+        let s = self.knots.iter().filter(|&&k| k == u).count();
+        let full = self.insert_knot(u, p.saturating_sub(s))?;
+        let a = full.knots.partition_point(|&k| k < u); // first index of u
+        let mut lk = full.knots[..a + p].to_vec();
+        lk.push(u);
+        let mut rk = vec![u];
+        rk.extend_from_slice(&full.knots[a..]);
+        let left = Nurbs::from_homogeneous(p, full.cw[..a].to_vec(), lk)?;
+        let right = Nurbs::from_homogeneous(p, full.cw[a - 1..].to_vec(), rk)?;
+        Ok((left, right))
+    }
+
+    fn from_homogeneous(
+        degree: usize,
+        cw: Vec<Vector4<f64>>,
+        knots: Vec<f64>,
+    ) -> Result<Nurbs, CurveError> {
+        let w: Vec<f64> = cw.iter().map(|c| c.w).collect();
+        let pts: Vec<Vec3> = cw
+            .iter()
+            .map(|c| Vec3::new(c.x / c.w, c.y / c.w, c.z / c.w))
+            .collect();
+        Nurbs::new(degree, &pts, &w, knots)
+    }
+
     /// C and its derivatives up to `nd` (higher ones left zero).
     fn rat_derivs(&self, u: f64, nd: usize) -> [Vec3; 4] {
         let p = self.degree;

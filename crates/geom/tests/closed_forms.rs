@@ -331,3 +331,38 @@ fn quintic_corner_blends_of_reference_004() {
         assert!((b.point(u) - q.point(u * q.duration())).norm() < 1e-13);
     }
 }
+
+#[test]
+fn knot_insertion_and_split_keep_the_curve() {
+    let pts: Vec<Vec3> = (0..8)
+        .map(|i| Vec3::new(i as f64, ((i * 3) % 5) as f64, (i % 3) as f64))
+        .collect();
+    let w = [1.0, 2.0, 0.5, 1.0, 3.0, 1.0, 0.7, 1.0];
+    let knots = vec![0., 0., 0., 0., 0.2, 0.4, 0.4, 0.7, 1., 1., 1., 1.];
+    let c = Nurbs::new(3, &pts, &w, knots).unwrap();
+    let grid: Vec<f64> = (0..=50).map(|i| i as f64 / 50.0).collect();
+    for (u, times) in [(0.3, 1), (0.3, 3), (0.4, 1), (0.55, 2)] {
+        let d = c.insert_knot(u, times).unwrap();
+        assert_eq!(d.control_points().len(), 8 + times);
+        for &x in &grid {
+            assert!((d.point(x) - c.point(x)).norm() < 1e-12, "u={u} x={x}");
+        }
+    }
+    // 0.4 already appears twice: a third and fourth copy would exceed the degree.
+    assert!(c.insert_knot(0.4, 2).is_err());
+    assert!(c.insert_knot(0.0, 1).is_err());
+    for u in [0.1, 0.4, 0.63] {
+        let (l, r) = c.split(u).unwrap();
+        assert_eq!(l.domain(), (0.0, u));
+        assert_eq!(r.domain(), (u, 1.0));
+        for &x in &grid {
+            let part = if x <= u { &l } else { &r };
+            assert!(
+                (part.point(x) - c.point(x)).norm() < 1e-12,
+                "split {u} at {x}"
+            );
+        }
+        assert!((l.point(u) - r.point(u)).norm() < 1e-13);
+        assert!((l.length() + r.length() - c.length()).abs() < 1e-9);
+    }
+}

@@ -97,6 +97,43 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Knot insertion (A5.1) and splitting never change the curve, whatever the degree, the
+    /// weights and the multiplicity already present; impossible insertions are typed errors.
+    #[test]
+    fn knot_insertion_and_split_keep_random_nurbs(
+        c in nurbs(), pick in 0.0f64..1.0, frac in 0.0f64..1.0, times in 1usize..=5, on_knot: bool
+    ) {
+        let (a, b) = c.domain();
+        let bps = c.breakpoints();
+        let u = if on_knot && bps.len() > 2 {
+            bps[1 + ((pick * (bps.len() - 2) as f64) as usize).min(bps.len() - 3)]
+        } else {
+            a + (b - a) * (0.01 + 0.98 * frac)
+        };
+        let grid: Vec<f64> = (0..=40).map(|i| a + (b - a) * i as f64 / 40.0).collect();
+        let scale = 1.0 + grid.iter().map(|&x| c.point(x).norm()).fold(0.0, f64::max);
+        match c.insert_knot(u, times) {
+            Ok(d) => {
+                for &x in &grid {
+                    prop_assert!((d.point(x) - c.point(x)).norm() <= 1e-11 * scale);
+                }
+            }
+            Err(_) => {
+                let s = c.knots().iter().filter(|&&k| k == u).count();
+                prop_assert!(s + times > c.degree());
+            }
+        }
+        let (l, r) = c.split(u).unwrap();
+        for &x in &grid {
+            let part = if x <= u { &l } else { &r };
+            prop_assert!((part.point(x) - c.point(x)).norm() <= 1e-11 * scale, "x={} u={}", x, u);
+        }
+    }
+}
+
 /// A random polyline: segment lengths and turn angles bounded, as the compression stage will
 /// hand over runs of short moves between sharp corners.
 fn polyline(
