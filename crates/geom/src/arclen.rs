@@ -19,7 +19,7 @@
 //! Newton step's second-order residual is already below the tolerance), so `s(u(s)) = s` to the
 //! Newton tolerance (`tol / 100`), and `u(s)` inherits the bound above as an arc-length error.
 
-use crate::curve::{clamp_param, Curve};
+use crate::curve::{clamp_param, Curve, Vec3};
 use crate::error::CurveError;
 
 /// 8-point Gauss–Legendre nodes (positive half) and weights on [-1, 1].
@@ -148,6 +148,34 @@ impl ArcLengthMap {
         let u = clamp_param(u, self.u[0], self.u[n]);
         let k = self.u.partition_point(|&x| x <= u).clamp(1, n) - 1;
         self.s[k] + gauss_legendre(curve, self.u[k], u)
+    }
+
+    /// The point at arc length `s`.
+    pub fn point_at<C: Curve + ?Sized>(&self, curve: &C, s: f64) -> Vec3 {
+        curve.point(self.u_at(curve, s))
+    }
+
+    /// `[C, dC/ds, d²C/ds², d³C/ds³]` at arc length `s`: position, unit tangent, curvature
+    /// vector and its rate — what the feed planner multiplies by ṡ, s̈, s⃛ to get velocity,
+    /// acceleration and jerk. Chain rule with `u(s)`: `u_s = 1/v`, `u_ss = −(C'·C'')/v⁴`,
+    /// `u_sss = −(|C''|² + C'·C⁽³⁾)/v⁵ + 4(C'·C'')²/v⁷`, `v = |C'|`. Zero speed (a cusp) gives
+    /// zero derivatives rather than NaN.
+    pub fn derivs_at<C: Curve + ?Sized>(&self, curve: &C, s: f64) -> [Vec3; 4] {
+        let [p, d1, d2, d3] = curve.derivs(self.u_at(curve, s));
+        let v = d1.norm();
+        if v == 0.0 || !v.is_finite() {
+            return [p, Vec3::zeros(), Vec3::zeros(), Vec3::zeros()];
+        }
+        let dot12 = d1.dot(&d2);
+        let g1 = 1.0 / v;
+        let g2 = -dot12 / v.powi(4);
+        let g3 = -(d2.norm_squared() + d1.dot(&d3)) / v.powi(5) + 4.0 * dot12 * dot12 / v.powi(7);
+        [
+            p,
+            d1 * g1,
+            d2 * (g1 * g1) + d1 * g2,
+            d3 * (g1 * g1 * g1) + d2 * (3.0 * g1 * g2) + d1 * g3,
+        ]
     }
 
     /// Parameter `u` at arc length `s` (clamped to `[0, length]`).

@@ -366,3 +366,51 @@ fn knot_insertion_and_split_keep_the_curve() {
         assert!((l.length() + r.length() - c.length()).abs() < 1e-9);
     }
 }
+
+#[test]
+fn arc_length_derivatives_of_a_helix_and_a_nurbs() {
+    // Helix r = 2, lead 3 over one turn: |dC/ds| = 1, |d²C/ds²| = κ = r/(r²+c²), and
+    // d³C/ds³ = −κ² T + κτ B, so |d³C/ds³| = κ·sqrt(κ² + τ²) with τ = c/(r²+c²).
+    let a = Arc::new(
+        Vec3::zeros(),
+        Vec3::new(2.0, 0.0, 0.0),
+        Vec3::z(),
+        2.0 * PI,
+        3.0,
+    )
+    .unwrap();
+    let m = ArcLengthMap::new(&a, 1e-12).unwrap();
+    let (r, c) = (2.0, 3.0 / (2.0 * PI));
+    let (k, tau) = (r / (r * r + c * c), c / (r * r + c * c));
+    for s in [0.0, 1.0, 5.5, m.length()] {
+        let [_, t, n, j] = m.derivs_at(&a, s);
+        assert!((t.norm() - 1.0).abs() < 1e-12);
+        assert!((n.norm() - k).abs() < 1e-12);
+        assert!((j.norm() - k * (k * k + tau * tau).sqrt()).abs() < 1e-12);
+    }
+    // A rational curve against finite differences of C(u(s)).
+    let pts = [
+        Vec3::new(0., 0., 0.),
+        Vec3::new(1., 2., 0.),
+        Vec3::new(3., 2., 1.),
+        Vec3::new(4., 0., 2.),
+    ];
+    let n = Nurbs::new(
+        3,
+        &pts,
+        &[1.0, 3.0, 0.5, 1.0],
+        vec![0., 0., 0., 0., 1., 1., 1., 1.],
+    )
+    .unwrap();
+    let m = ArcLengthMap::new(&n, 1e-13).unwrap();
+    let s = 0.4 * m.length();
+    let h = 1e-3;
+    let d = m.derivs_at(&n, s);
+    let at = |x: f64| m.derivs_at(&n, x);
+    let (up, down) = (at(s + h), at(s - h));
+    for (k, dk) in d.iter().enumerate().skip(1) {
+        let fd = (up[k - 1] - down[k - 1]) / (2.0 * h);
+        assert!((fd - dk).norm() < 1e-5 * (1.0 + dk.norm()), "k={k}");
+    }
+    assert!((m.point_at(&n, s) - d[0]).norm() < 1e-15);
+}
