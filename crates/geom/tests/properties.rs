@@ -242,7 +242,7 @@ proptest! {
 
     /// CAM output samples a smooth surface curve with short chords; on such runs (segments
     /// 0.05–0.3 mm, radius of curvature ≥ 3 mm so the chords themselves are within a few µm,
-    /// tolerance 10 µm) the fit must need less than a quarter as many control points as points.
+    /// tolerance 10 µm) the fit must need less than a third as many control points as points.
     #[test]
     fn approximation_compresses_sampled_smooth_curves(
         steps in prop::collection::vec(0.05f64..0.3, 40..=200),
@@ -258,6 +258,6 @@ proptest! {
         let a = approximate(&q, 3, 0.01, Parameterisation::Centripetal).unwrap();
         prop_assert!(a.max_deviation <= 0.01);
         let n = a.curve.control_points().len();
-        prop_assert!(4 * n < q.len(), "{} control points for {} points", n, q.len());
+        prop_assert!(3 * n < q.len(), "{} control points for {} points", n, q.len());
     }
 }
