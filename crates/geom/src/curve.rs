@@ -15,7 +15,7 @@ pub const LENGTH_TOLERANCE: f64 = 1e-10;
 /// Derivatives are with respect to the curve's own parameter `u`; the arc-length map converts
 /// to and from the arc length `s`.
 pub trait Curve {
-    /// `(u_start, u_end)`, `u_start < u_end`.
+    /// `(u_start, u_end)`, `u_start <= u_end` (equal only for a zero-length line).
     fn domain(&self) -> (f64, f64);
 
     /// `[C, C', C'', C''']` at `u`.

@@ -414,3 +414,48 @@ fn arc_length_derivatives_of_a_helix_and_a_nurbs() {
     }
     assert!((m.point_at(&n, s) - d[0]).norm() < 1e-15);
 }
+
+#[test]
+fn deviation_measures_on_a_circle() {
+    use tezgah_geom::deviation::{curve_to_curve, curve_to_polyline, polyline_to_curve};
+    // Quarter circle r = 10 as an exact NURBS and as an arc: they coincide.
+    let r = 10.0;
+    let pts = [
+        Vec3::new(r, 0., 0.),
+        Vec3::new(r, r, 0.),
+        Vec3::new(0., r, 0.),
+    ];
+    let nurbs = Nurbs::new(
+        2,
+        &pts,
+        &[1.0, SQRT_2 / 2.0, 1.0],
+        vec![0., 0., 0., 1., 1., 1.],
+    )
+    .unwrap();
+    let arc = Arc::new(
+        Vec3::zeros(),
+        Vec3::new(r, 0., 0.),
+        Vec3::z(),
+        FRAC_PI_2,
+        0.0,
+    )
+    .unwrap();
+    assert!(curve_to_curve(&nurbs, &arc, 16).distance < 1e-9);
+    // A chordal polyline of n pieces: curve → polyline is the sagitta r(1 − cos(θ/2)), found
+    // mid-chord; polyline → curve is the same.
+    let n = 6;
+    let poly: Vec<Vec3> = (0..=n)
+        .map(|i| {
+            let a = FRAC_PI_2 * i as f64 / n as f64;
+            Vec3::new(r * a.cos(), r * a.sin(), 0.0)
+        })
+        .collect();
+    let sagitta = r * (1.0 - (FRAC_PI_2 / n as f64 / 2.0).cos());
+    let d = curve_to_polyline(&arc, &poly, 16);
+    assert!(
+        (d.distance - sagitta).abs() < 1e-9,
+        "{} vs {sagitta}",
+        d.distance
+    );
+    assert!((polyline_to_curve(&arc, &poly, 16) - sagitta).abs() < 1e-9);
+}
