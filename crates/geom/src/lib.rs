@@ -10,6 +10,7 @@ pub mod arclen;
 mod banded;
 pub mod basis;
 pub mod bezier;
+pub mod curvature;
 pub mod curve;
 pub mod deviation;
 pub mod error;

@@ -1,6 +1,7 @@
 //! Golden NURBS numbers of reference 000 §5 (items 1–4): lengths, weighted lengths and the
 //! curvature maxima of the (3.39) demo curve. Each value is checked to every digit given.
 
+use tezgah_geom::curvature::curvature_peaks;
 use tezgah_geom::{ArcLengthMap, Curve, Nurbs, Vec3};
 
 /// |got − want| within half a unit of the last digit given.
@@ -91,28 +92,12 @@ fn item3_table_2_4b_planar_first_eleven_weights() {
     assert_digits(length(&curve_249(&w1, false)), 49.3914, 4);
 }
 
-/// Local maxima of κ(u) on a dense grid, refined by golden-section search.
+/// Local maxima of κ(u) through the library's peak finder (64 samples per knot span).
 fn curvature_maxima(c: &Nurbs) -> Vec<(f64, f64)> {
-    let n = 4000;
-    let k: Vec<f64> = (0..=n).map(|i| c.curvature(i as f64 / n as f64)).collect();
-    let mut out = Vec::new();
-    for i in 1..n {
-        if k[i] > k[i - 1] && k[i] >= k[i + 1] {
-            let (mut a, mut b) = ((i - 1) as f64 / n as f64, (i + 1) as f64 / n as f64);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            for _ in 0..80 {
-                let (x1, x2) = (b - g * (b - a), a + g * (b - a));
-                if c.curvature(x1) > c.curvature(x2) {
-                    b = x2;
-                } else {
-                    a = x1;
-                }
-            }
-            let u = 0.5 * (a + b);
-            out.push((u, c.curvature(u)));
-        }
-    }
-    out
+    curvature_peaks(c, 64)
+        .into_iter()
+        .map(|p| (p.u, p.curvature))
+        .collect()
 }
 
 #[test]
