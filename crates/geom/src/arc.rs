@@ -22,6 +22,9 @@ pub const FULL_CIRCLE_ANGLE: f64 = 1e-9;
 /// arc has `h = 0`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Arc {
+    /// Exact end points, returned at `u = 0` and `u = 1` so joints meet bit for bit.
+    start: Vec3,
+    end: Vec3,
     center: Vec3,
     e1: Vec3,
     e2: Vec3,
@@ -82,6 +85,8 @@ impl Arc {
             -(a + extra)
         };
         Ok(Arc {
+            start: s,
+            end: e,
             center: c,
             e1,
             e2,
@@ -120,7 +125,9 @@ impl Arc {
             return Err(CurveError::ZeroRadius);
         }
         let e1 = v0 / r0;
-        Ok(Arc {
+        let mut arc = Arc {
+            start,
+            end: start,
             center: center + normal * h0,
             e1,
             e2: normal.cross(&e1),
@@ -129,7 +136,24 @@ impl Arc {
             dr: 0.0,
             sweep,
             rise,
-        })
+        };
+        arc.end = arc.eval(1.0)[0];
+        Ok(arc)
+    }
+
+    /// The formula itself, without the exact end points.
+    fn eval(&self, u: f64) -> [Vec3; 4] {
+        let (th, dr) = (self.sweep, self.dr);
+        let r = self.r0 + dr * u;
+        let (s, c) = (th * u).sin_cos();
+        // rho = radial unit vector, tau = its derivative with respect to the angle.
+        let rho = self.e1 * c + self.e2 * s;
+        let tau = self.e2 * c - self.e1 * s;
+        let p = self.center + rho * r + self.normal * (self.rise * u);
+        let d1 = rho * dr + tau * (r * th) + self.normal * self.rise;
+        let d2 = tau * (2.0 * dr * th) - rho * (r * th * th);
+        let d3 = rho * (-3.0 * dr * th * th) - tau * (r * th * th * th);
+        [p, d1, d2, d3]
     }
 
     /// Centre at the start's height along the normal.
@@ -165,17 +189,13 @@ impl Curve for Arc {
 
     fn derivs(&self, u: f64) -> [Vec3; 4] {
         let u = clamp_param(u, 0.0, 1.0);
-        let (th, dr) = (self.sweep, self.dr);
-        let r = self.r0 + dr * u;
-        let (s, c) = (th * u).sin_cos();
-        // rho = radial unit vector, tau = its derivative with respect to the angle.
-        let rho = self.e1 * c + self.e2 * s;
-        let tau = self.e2 * c - self.e1 * s;
-        let p = self.center + rho * r + self.normal * (self.rise * u);
-        let d1 = rho * dr + tau * (r * th) + self.normal * self.rise;
-        let d2 = tau * (2.0 * dr * th) - rho * (r * th * th);
-        let d3 = rho * (-3.0 * dr * th * th) - tau * (r * th * th * th);
-        [p, d1, d2, d3]
+        let mut d = self.eval(u);
+        if u <= 0.0 {
+            d[0] = self.start;
+        } else if u >= 1.0 {
+            d[0] = self.end;
+        }
+        d
     }
 
     fn length(&self) -> f64 {

@@ -53,7 +53,14 @@ impl Curve for Line {
     fn derivs(&self, u: f64) -> [Vec3; 4] {
         let u = clamp_param(u, 0.0, self.length);
         let z = Vec3::zeros();
-        [self.start + self.dir * u, self.dir, z, z]
+        // The end is returned exactly, not as start + dir·length (rounding): joints must
+        // meet bit for bit.
+        let p = if u >= self.length {
+            self.end
+        } else {
+            self.start + self.dir * u
+        };
+        [p, self.dir, z, z]
     }
     fn curvature(&self, _u: f64) -> f64 {
         0.0

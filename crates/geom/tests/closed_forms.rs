@@ -459,3 +459,22 @@ fn deviation_measures_on_a_circle() {
     );
     assert!((polyline_to_curve(&arc, &poly, 16) - sagitta).abs() < 1e-9);
 }
+
+#[test]
+fn programmed_end_points_are_exact() {
+    // Joints between path pieces must meet bit for bit, not to rounding.
+    let s = Pose::new(0.1, 0.2, 0.3, 0.0, 0.0, 0.0);
+    let mv = ArcMove {
+        plane: Plane::XY,
+        end: Pose::new(7.3, 1.9, 2.2, 0.0, 0.0, 0.0),
+        center: [3.7, 1.05],
+        turn: -2,
+    };
+    let a = Arc::from_move(&s, &mv).unwrap();
+    assert_eq!(a.point(0.0), Vec3::new(0.1, 0.2, 0.3));
+    assert_eq!(a.point(1.0), Vec3::new(7.3, 1.9, 2.2));
+    assert_eq!(a.derivs(1.0)[0], Vec3::new(7.3, 1.9, 2.2));
+    let l = Line::new(Vec3::new(0.1, 0.2, 0.3), Vec3::new(7.3, 1.9, 2.2)).unwrap();
+    assert_eq!(l.point(l.length()), Vec3::new(7.3, 1.9, 2.2));
+    assert_eq!(l.point(0.0), Vec3::new(0.1, 0.2, 0.3));
+}
