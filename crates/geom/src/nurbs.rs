@@ -1,0 +1,308 @@
+//! Rational B-spline curves (NURBS) of any degree up to [`MAX_DEGREE`]: the G06.2 block and the
+//! output of spline fitting. Evaluation uses span search A2.1, basis functions A2.2/A2.3 and
+//! the rational derivative rule A4.2 (Piegl & Tiller) up to the third derivative.
+
+// Index loops mirror the book's pseudo-code, so the code can be checked against it line by line.
+#![allow(clippy::needless_range_loop)]
+
+use nalgebra::Vector4;
+
+use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
+use crate::curve::{clamp_param, Curve, Vec3};
+use crate::error::CurveError;
+
+/// `C(u) = Σ N_{i,p}(u) w_i P_i / Σ N_{i,p}(u) w_i`, `u` in `[knots[p], knots[n+1]]`.
+///
+/// Control points are stored homogeneous (`w·x, w·y, w·z, w`), as A4.2 works on them. The
+/// knot vector need not be clamped: the domain is always `[u_p, u_{n+1}]` (P&T §2.2).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Nurbs {
+    degree: usize,
+    knots: Vec<f64>,
+    cw: Vec<Vector4<f64>>,
+    /// First and last non-empty span of the domain (for A2.1 at the domain ends).
+    first: usize,
+    last: usize,
+}
+
+impl Nurbs {
+    /// A NURBS curve. Validates: degree in `1..=MAX_DEGREE`, at least `degree + 1` control
+    /// points, one weight per point, `points + degree + 1` knots, everything finite, knots
+    /// non-decreasing, weights > 0, no knot repeated more than `degree` times inside the
+    /// domain (the curve would break apart there) or `degree + 1` times anywhere, and a
+    /// non-empty domain.
+    pub fn new(
+        degree: usize,
+        points: &[Vec3],
+        weights: &[f64],
+        knots: Vec<f64>,
+    ) -> Result<Self, CurveError> {
+        if degree == 0 || degree > MAX_DEGREE {
+            return Err(CurveError::Degree {
+                degree,
+                max: MAX_DEGREE,
+            });
+        }
+        if points.len() < degree + 1 {
+            return Err(CurveError::TooFewPoints {
+                points: points.len(),
+                degree,
+                need: degree + 1,
+            });
+        }
+        if weights.len() != points.len() {
+            return Err(CurveError::WeightCount {
+                weights: weights.len(),
+                points: points.len(),
+            });
+        }
+        let expected = points.len() + degree + 1;
+        if knots.len() != expected {
+            return Err(CurveError::KnotCount {
+                got: knots.len(),
+                expected,
+            });
+        }
+        if !points.iter().flat_map(|p| p.iter()).all(|c| c.is_finite())
+            || !knots.iter().all(|k| k.is_finite())
+        {
+            return Err(CurveError::NotFinite);
+        }
+        for (index, &value) in weights.iter().enumerate() {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(CurveError::Weight { index, value });
+            }
+        }
+        for i in 1..knots.len() {
+            if knots[i] < knots[i - 1] {
+                return Err(CurveError::KnotsDecreasing {
+                    index: i,
+                    value: knots[i],
+                });
+            }
+        }
+        let n = points.len() - 1;
+        let (lo, hi) = (knots[degree], knots[n + 1]);
+        if lo >= hi {
+            return Err(CurveError::EmptyDomain);
+        }
+        let mut i = 0;
+        while i < knots.len() {
+            let mut j = i;
+            while j + 1 < knots.len() && knots[j + 1] == knots[i] {
+                j += 1;
+            }
+            let m = j - i + 1;
+            let inside = knots[i] > lo && knots[i] < hi;
+            if m > degree + 1 || (inside && m > degree) {
+                return Err(CurveError::KnotMultiplicity {
+                    value: knots[i],
+                    multiplicity: m,
+                    degree,
+                });
+            }
+            i = j + 1;
+        }
+        let first = (degree..=n)
+            .find(|&s| knots[s] < knots[s + 1])
+            .unwrap_or(degree);
+        let last = (degree..=n)
+            .rev()
+            .find(|&s| knots[s] < knots[s + 1])
+            .unwrap_or(n);
+        let cw = points
+            .iter()
+            .zip(weights)
+            .map(|(p, &w)| Vector4::new(p.x * w, p.y * w, p.z * w, w))
+            .collect();
+        Ok(Nurbs {
+            degree,
+            knots,
+            cw,
+            first,
+            last,
+        })
+    }
+
+    /// A non-rational B-spline (all weights 1).
+    pub fn bspline(degree: usize, points: &[Vec3], knots: Vec<f64>) -> Result<Self, CurveError> {
+        Nurbs::new(degree, points, &vec![1.0; points.len()], knots)
+    }
+
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+    /// Control points in Cartesian form.
+    pub fn control_points(&self) -> Vec<Vec3> {
+        self.cw
+            .iter()
+            .map(|c| Vec3::new(c.x / c.w, c.y / c.w, c.z / c.w))
+            .collect()
+    }
+    pub fn weights(&self) -> Vec<f64> {
+        self.cw.iter().map(|c| c.w).collect()
+    }
+
+    /// A5.1 CurveKnotIns: the same curve with `u` inserted `times` more times (`u` strictly
+    /// inside the domain; its multiplicity may not exceed the degree). Knot insertion is how a
+    /// spline is cut at a corner or compared control point by control point with another.
+    pub fn insert_knot(&self, u: f64, times: usize) -> Result<Nurbs, CurveError> {
+        let p = self.degree;
+        let (lo, hi) = self.domain();
+        if !u.is_finite() {
+            return Err(CurveError::NotFinite);
+        }
+        if !(u > lo && u < hi) {
+            return Err(CurveError::EmptyDomain);
+        }
+        let s = self.knots.iter().filter(|&&k| k == u).count();
+        if s + times > p {
+            return Err(CurveError::KnotMultiplicity {
+                value: u,
+                multiplicity: s + times,
+                degree: p,
+            });
+        }
+        if times == 0 {
+            return Ok(self.clone());
+        }
+        let (up, pw, r) = (&self.knots, &self.cw, times);
+        let np = pw.len() - 1;
+        let mp = np + p + 1;
+        let k = find_span(up, self.first, self.last, u);
+        let mut uq = Vec::with_capacity(up.len() + r);
+        uq.extend_from_slice(&up[..=k]);
+        uq.extend(std::iter::repeat_n(u, r));
+        uq.extend_from_slice(&up[k + 1..=mp]);
+        let mut qw = vec![Vector4::zeros(); np + r + 1];
+        qw[..=k - p].copy_from_slice(&pw[..=k - p]);
+        qw[k - s + r..].copy_from_slice(&pw[k - s..]);
+        let mut rw: Vec<Vector4<f64>> = pw[k - p..=k - s].to_vec();
+        let mut l = k - p;
+        for j in 1..=r {
+            l = k - p + j;
+            for i in 0..=p - j - s {
+                let alpha = (u - up[l + i]) / (up[i + k + 1] - up[l + i]);
+                rw[i] = rw[i + 1] * alpha + rw[i] * (1.0 - alpha);
+            }
+            qw[l] = rw[0];
+            qw[k + r - j - s] = rw[p - j - s];
+        }
+        if l + 1 < k - s {
+            qw[l + 1..k - s].copy_from_slice(&rw[1..k - s - l]);
+        }
+        Nurbs::from_homogeneous(p, qw, uq)
+    }
+
+    /// Cut the curve at `u` (strictly inside the domain) into two curves that meet there:
+    /// `u` is inserted up to multiplicity `degree`, and the control polygon splits at the
+    /// control point that then lies on the curve.
+    pub fn split(&self, u: f64) -> Result<(Nurbs, Nurbs), CurveError> {
+        let p = self.degree;
+        let s = self.knots.iter().filter(|&&k| k == u).count();
+        let full = self.insert_knot(u, p.saturating_sub(s))?;
+        let a = full.knots.partition_point(|&k| k < u); // first index of u
+        let mut lk = full.knots[..a + p].to_vec();
+        lk.push(u);
+        let mut rk = vec![u];
+        rk.extend_from_slice(&full.knots[a..]);
+        let left = Nurbs::from_homogeneous(p, full.cw[..a].to_vec(), lk)?;
+        let right = Nurbs::from_homogeneous(p, full.cw[a - 1..].to_vec(), rk)?;
+        Ok((left, right))
+    }
+
+    fn from_homogeneous(
+        degree: usize,
+        cw: Vec<Vector4<f64>>,
+        knots: Vec<f64>,
+    ) -> Result<Nurbs, CurveError> {
+        let w: Vec<f64> = cw.iter().map(|c| c.w).collect();
+        let pts: Vec<Vec3> = cw
+            .iter()
+            .map(|c| Vec3::new(c.x / c.w, c.y / c.w, c.z / c.w))
+            .collect();
+        Nurbs::new(degree, &pts, &w, knots)
+    }
+
+    /// C and its derivatives up to `nd` (higher ones left zero).
+    fn rat_derivs(&self, u: f64, nd: usize) -> [Vec3; 4] {
+        let p = self.degree;
+        let (span, u) = self.span(u);
+        let mut nders = [[0.0; W]; MAX_DER + 1];
+        ders_basis_funs(&self.knots, span, u, p, nd, &mut nders);
+        // Derivatives of the homogeneous curve Cw (A3.2 on the 4-D points).
+        let mut aw = [Vector4::zeros(); MAX_DER + 1];
+        for (k, a) in aw.iter_mut().enumerate().take(nd.min(p) + 1) {
+            for j in 0..=p {
+                *a += self.cw[span - p + j] * nders[k][j];
+            }
+        }
+        // A4.2 RatCurveDerivs: C^(k) = (A^(k) - Σ_{i=1..k} C(k,i) w^(i) C^(k-i)) / w.
+        let mut ck = [Vec3::zeros(); MAX_DER + 1];
+        let w0 = aw[0].w;
+        for k in 0..=nd.min(MAX_DER) {
+            let mut v = Vec3::new(aw[k].x, aw[k].y, aw[k].z);
+            for i in 1..=k {
+                v -= ck[k - i] * (BIN[k][i] * aw[i].w);
+            }
+            ck[k] = v / w0;
+        }
+        ck
+    }
+
+    fn span(&self, u: f64) -> (usize, f64) {
+        let (a, b) = self.domain();
+        let u = clamp_param(u, a, b);
+        (find_span(&self.knots, self.first, self.last, u), u)
+    }
+}
+
+/// Binomial coefficients up to 3 for A4.2.
+const BIN: [[f64; 4]; 4] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [1.0, 1.0, 0.0, 0.0],
+    [1.0, 2.0, 1.0, 0.0],
+    [1.0, 3.0, 3.0, 1.0],
+];
+
+impl Curve for Nurbs {
+    fn domain(&self) -> (f64, f64) {
+        (self.knots[self.degree], self.knots[self.cw.len()])
+    }
+
+    fn point(&self, u: f64) -> Vec3 {
+        let p = self.degree;
+        let (span, u) = self.span(u);
+        let mut n = [0.0; W];
+        basis_funs(&self.knots, span, u, p, &mut n);
+        let mut h = Vector4::zeros();
+        for (j, nj) in n[..=p].iter().enumerate() {
+            h += self.cw[span - p + j] * *nj;
+        }
+        Vec3::new(h.x, h.y, h.z) / h.w
+    }
+
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        self.rat_derivs(u, MAX_DER)
+    }
+
+    fn d1(&self, u: f64) -> Vec3 {
+        // The arc-length quadrature only needs C'; skip the higher basis derivatives.
+        self.rat_derivs(u, 1)[1]
+    }
+
+    fn breakpoints(&self) -> Vec<f64> {
+        let (a, b) = self.domain();
+        let mut out = vec![a];
+        for &k in &self.knots {
+            if k > *out.last().unwrap_or(&a) && k < b {
+                out.push(k);
+            }
+        }
+        out.push(b);
+        out
+    }
+}

@@ -1,0 +1,263 @@
+//! Property tests on random curves and polylines: NURBS derivatives agree with finite
+//! differences, the arc-length map inverts itself within its bound, interpolation passes
+//! through its points, approximation stays within tolerance of every point and segment (checked
+//! by an independent dense sampling), and nothing produces NaN.
+
+use proptest::prelude::*;
+use tezgah_geom::deviation::point_segment_distance;
+use tezgah_geom::fit::{approximate, interpolate, Parameterisation};
+use tezgah_geom::{ArcLengthMap, Curve, Nurbs, Vec3};
+
+fn vec3(r: f64) -> impl Strategy<Value = Vec3> {
+    (-r..r, -r..r, -r..r).prop_map(|(x, y, z)| Vec3::new(x, y, z))
+}
+
+/// A random clamped NURBS: degree 1–5, up to 8 extra control points, weights 0.2–5, interior
+/// knots from positive increments (distinct, so no knot exceeds the multiplicity rule).
+fn nurbs() -> impl Strategy<Value = Nurbs> {
+    (1usize..=5, 0usize..=8).prop_flat_map(|(p, extra)| {
+        let n = p + 1 + extra;
+        (
+            prop::collection::vec(vec3(50.0), n),
+            prop::collection::vec(0.2f64..5.0, n),
+            prop::collection::vec(0.2f64..1.0, extra + 1),
+        )
+            .prop_map(move |(pts, w, inc)| {
+                let mut knots = vec![0.0; p + 1];
+                let mut acc = 0.0;
+                for d in &inc[..extra] {
+                    acc += d;
+                    knots.push(acc);
+                }
+                acc += inc[extra];
+                knots.extend(std::iter::repeat_n(acc, p + 1));
+                Nurbs::new(p, &pts, &w, knots).expect("generated NURBS is valid")
+            })
+    })
+}
+
+/// A point strictly inside a knot span chosen by `pick` in [0,1) and `frac` in [0.1, 0.9].
+fn inside_span(c: &Nurbs, pick: f64, frac: f64) -> (f64, f64) {
+    let b = c.breakpoints();
+    let i = ((pick * (b.len() - 1) as f64) as usize).min(b.len() - 2);
+    (b[i] + (b[i + 1] - b[i]) * frac, b[i + 1] - b[i])
+}
+
+/// Richardson-extrapolated central difference of `f` at `u` (error O(h⁴)).
+fn diff(f: impl Fn(f64) -> Vec3, u: f64, h: f64) -> Vec3 {
+    let d = |h: f64| (f(u + h) - f(u - h)) / (2.0 * h);
+    (d(h / 2.0) * 4.0 - d(h)) / 3.0
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn nurbs_derivatives_match_finite_differences(
+        c in nurbs(), pick in 0.0f64..1.0, frac in 0.1f64..0.9
+    ) {
+        let (u, width) = inside_span(&c, pick, frac);
+        let h = 1e-3 * width;
+        let d = c.derivs(u);
+        prop_assert!(d.iter().all(|v| v.iter().all(|x| x.is_finite())));
+        for k in 1..4 {
+            let fd = diff(|x| c.derivs(x)[k - 1], u, h);
+            // Scale: the derivative itself and the lower one over the span width.
+            let scale = 1.0 + d[k].norm() + d[k - 1].norm() / width;
+            let err = (fd - d[k]).norm();
+            prop_assert!(err <= 1e-6 * scale, "k={} err={} scale={} u={}", k, err, scale, u);
+        }
+        let k = c.curvature(u);
+        prop_assert!(!k.is_nan() && k >= 0.0);
+        prop_assert!((c.point(u) - d[0]).norm() <= 1e-12 * (1.0 + d[0].norm()));
+    }
+
+    #[test]
+    fn arc_length_map_inverts_within_its_bound(
+        c in nurbs(), fracs in prop::collection::vec(0.0f64..=1.0, 8)
+    ) {
+        let tol = 1e-9;
+        let m = ArcLengthMap::new(&c, tol).unwrap();
+        let fine = ArcLengthMap::new(&c, 1e-12).unwrap();
+        prop_assert!(m.length().is_finite() && m.length() > 0.0);
+        prop_assert!((m.length() - fine.length()).abs() <= tol, "{} vs {}", m.length(), fine.length());
+        let (a, b) = c.domain();
+        let mut last_u = a;
+        let mut sorted = fracs.clone();
+        sorted.sort_by(f64::total_cmp);
+        for f in sorted {
+            let s = f * m.length();
+            let u = m.u_at(&c, s);
+            prop_assert!(u >= a && u <= b && u >= last_u);
+            last_u = u;
+            prop_assert!((m.s_at(&c, u) - s).abs() <= tol, "s={} back={}", s, m.s_at(&c, u));
+            // The independent fine map agrees within the coarse map's bound.
+            prop_assert!((fine.s_at(&c, u) - s).abs() <= 2.0 * tol);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Knot insertion (A5.1) and splitting never change the curve, whatever the degree, the
+    /// weights and the multiplicity already present; impossible insertions are typed errors.
+    #[test]
+    fn knot_insertion_and_split_keep_random_nurbs(
+        c in nurbs(), pick in 0.0f64..1.0, frac in 0.0f64..1.0, times in 1usize..=5, on_knot: bool
+    ) {
+        let (a, b) = c.domain();
+        let bps = c.breakpoints();
+        let u = if on_knot && bps.len() > 2 {
+            bps[1 + ((pick * (bps.len() - 2) as f64) as usize).min(bps.len() - 3)]
+        } else {
+            a + (b - a) * (0.01 + 0.98 * frac)
+        };
+        let grid: Vec<f64> = (0..=40).map(|i| a + (b - a) * i as f64 / 40.0).collect();
+        let scale = 1.0 + grid.iter().map(|&x| c.point(x).norm()).fold(0.0, f64::max);
+        match c.insert_knot(u, times) {
+            Ok(d) => {
+                for &x in &grid {
+                    prop_assert!((d.point(x) - c.point(x)).norm() <= 1e-11 * scale);
+                }
+            }
+            Err(_) => {
+                let s = c.knots().iter().filter(|&&k| k == u).count();
+                prop_assert!(s + times > c.degree());
+            }
+        }
+        let (l, r) = c.split(u).unwrap();
+        for &x in &grid {
+            let part = if x <= u { &l } else { &r };
+            prop_assert!((part.point(x) - c.point(x)).norm() <= 1e-11 * scale, "x={} u={}", x, u);
+        }
+    }
+}
+
+/// A random polyline: segment lengths and turn angles bounded, as the compression stage will
+/// hand over runs of short moves between sharp corners.
+fn polyline(
+    n: std::ops::RangeInclusive<usize>,
+    len: (f64, f64),
+    max_turn: f64,
+) -> impl Strategy<Value = Vec<Vec3>> {
+    let turn = move || -max_turn..max_turn;
+    prop::collection::vec((len.0..len.1, turn(), turn()), n).prop_map(|steps| {
+        let mut p = Vec3::zeros();
+        let (mut heading, mut pitch, mut out) = (0.0f64, 0.0f64, vec![Vec3::zeros()]);
+        for (l, dh, dp) in steps {
+            heading += dh;
+            pitch = (pitch + dp).clamp(-0.5, 0.5);
+            let dir = Vec3::new(
+                pitch.cos() * heading.cos(),
+                pitch.cos() * heading.sin(),
+                pitch.sin(),
+            );
+            p += dir * l;
+            out.push(p);
+        }
+        out
+    })
+}
+
+fn method() -> impl Strategy<Value = Parameterisation> {
+    prop_oneof![
+        Just(Parameterisation::Uniform),
+        Just(Parameterisation::ChordLength),
+        Just(Parameterisation::Centripetal),
+        Just(Parameterisation::Universal),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn interpolation_passes_through_points(
+        q in polyline(3..=40, (0.05, 5.0), 1.2), m in method(), p in 1usize..=5
+    ) {
+        prop_assume!(q.len() > p);
+        let (c, t) = interpolate(&q, p, m).unwrap();
+        prop_assert_eq!(t.len(), q.len());
+        prop_assert!(t.windows(2).all(|w| w[0] < w[1]));
+        for (k, qk) in q.iter().enumerate() {
+            let e = (c.point(t[k]) - qk).norm();
+            prop_assert!(e <= 1e-9, "point {} off by {}", k, e);
+        }
+        prop_assert!(c.length().is_finite());
+    }
+
+    #[test]
+    fn approximation_stays_within_tolerance(
+        q in polyline(2..=60, (0.05, 0.3), 0.6),
+        tol in 0.001f64..0.05,
+        m in prop_oneof![Just(Parameterisation::ChordLength), Just(Parameterisation::Centripetal)],
+        p in 2usize..=5,
+    ) {
+        let a = approximate(&q, p, tol, m).unwrap();
+        let c = &a.curve;
+        prop_assert!(a.max_deviation <= tol);
+        // Ends are exact.
+        prop_assert_eq!(c.point(0.0), q[0]);
+        prop_assert_eq!(c.point(1.0), *q.last().unwrap());
+        // Independent check: dense sampling of every piece against its segment, and of the
+        // curve near every point (slack for the sampling's own resolution only).
+        let slack = 1e-9;
+        for k in 0..q.len() - 1 {
+            let (u0, u1) = (a.params[k], a.params[k + 1]);
+            for i in 0..=64 {
+                let pt = c.point(u0 + (u1 - u0) * i as f64 / 64.0);
+                prop_assert!(pt.iter().all(|x| x.is_finite()));
+                // Piece k against its segment and the neighbouring ones (the fitter's contract).
+                let lo = k.saturating_sub(1);
+                let hi = (k + 2).min(q.len() - 1);
+                let d = (lo..hi)
+                    .map(|j| point_segment_distance(&pt, &q[j], &q[j + 1]))
+                    .fold(f64::INFINITY, f64::min);
+                prop_assert!(d <= tol + slack, "segment {} piece off by {} > {}", k, d, tol);
+            }
+        }
+        for (k, qk) in q.iter().enumerate().take(q.len() - 1).skip(1) {
+            let (u0, u1) = (a.params[k - 1], a.params[k + 1]);
+            let dist = |u: f64| (c.point(u) - qk).norm();
+            let h = (u1 - u0) / 400.0;
+            let i = (0..=400)
+                .min_by(|&i, &j| dist(u0 + h * i as f64).total_cmp(&dist(u0 + h * j as f64)))
+                .unwrap();
+            // Ternary search between the neighbouring samples (distance is unimodal there).
+            let (mut lo, mut hi) = ((u0 + h * (i as f64 - 1.0)).max(u0), (u0 + h * (i as f64 + 1.0)).min(u1));
+            for _ in 0..100 {
+                let (m1, m2) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+                if dist(m1) < dist(m2) { hi = m2 } else { lo = m1 }
+            }
+            let best = dist(0.5 * (lo + hi)).min(dist(u0 + h * i as f64));
+            prop_assert!(best <= tol + slack, "point {} off by {} > {}", k, best, tol);
+        }
+
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// CAM output samples a smooth surface curve with short chords; on such runs (segments
+    /// 0.05–0.3 mm, radius of curvature ≥ 3 mm so the chords themselves are within a few µm,
+    /// tolerance 10 µm) the fit must need less than a third as many control points as points.
+    #[test]
+    fn approximation_compresses_sampled_smooth_curves(
+        steps in prop::collection::vec(0.05f64..0.3, 40..=200),
+        amp in 0.5f64..3.0, wave in 20.0f64..60.0, rise in -0.2f64..0.2,
+    ) {
+        let mut s = 0.0;
+        let mut q = vec![Vec3::new(0.0, 0.0, amp)];
+        for d in steps {
+            s += d; // arc length along x is close enough to the chord for this purpose
+            let w = std::f64::consts::TAU * s / wave;
+            q.push(Vec3::new(s, amp * w.sin(), amp * w.cos() + rise * s));
+        }
+        let a = approximate(&q, 3, 0.01, Parameterisation::Centripetal).unwrap();
+        prop_assert!(a.max_deviation <= 0.01);
+        let n = a.curve.control_points().len();
+        prop_assert!(3 * n < q.len(), "{} control points for {} points", n, q.len());
+    }
+}
