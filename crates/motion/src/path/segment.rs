@@ -1,0 +1,100 @@
+//! The unit the feed planner times: one piece of the tool-tip path with its feed, the rotary
+//! axes that move along it, and what happens at its end.
+//!
+//! This is the contract between path building (compression, corner blending) and feed
+//! planning (look-ahead, interpolation): the builder emits [`PathItem`]s in program order, the
+//! planner consumes them as a stream.
+
+use tezgah_geom::{Curve, Vec3};
+
+/// How fast a segment is to be run, before the machine's limits lower it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SegmentFeed {
+    /// G0: the machine's rapid speed (limited per joint by the machine file).
+    Rapid,
+    /// Programmed feed along the path, mm/s (tip speed; a segment that turns only rotary axes
+    /// carries its rotary speed in deg/s here, see [`Segment::rotary_only`]).
+    Feed(f64),
+    /// G93: the segment takes this long, seconds (or longer if a limit forbids).
+    InverseTime(f64),
+}
+
+/// What joins a segment to the next one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Junction {
+    /// Position, tangent and curvature continue (a blend or spline joint): no junction limit
+    /// beyond the curvature limits of the two segments.
+    Smooth,
+    /// Position and tangent continue, curvature may jump (line into tangent arc).
+    Tangent,
+    /// A corner: the path turns. The planner must pass it at zero speed (G61 corners, or a
+    /// corner the blender was not allowed to round).
+    Corner,
+    /// Exact stop at the end of this segment (G61.1, before a dwell, a pause or program end).
+    Stop,
+}
+
+/// One piece of the tool-tip path.
+pub struct Segment {
+    /// The tool tip, mm, in the frame of the moves (work offsets and tool length applied).
+    pub curve: Box<dyn Curve + Send + Sync>,
+    /// Arc length of `curve`, mm.
+    pub length: f64,
+    /// A B C at the start and end of the segment, degrees; they move in proportion to the
+    /// arc length travelled (or to time, for a segment with no tip motion).
+    pub rotary: [[f64; 3]; 2],
+    /// 1-based source line.
+    pub line: u32,
+    pub feed: SegmentFeed,
+    /// What joins this segment to the next.
+    pub end: Junction,
+    /// The path tolerance in force (mm): chord error and smoothing stay within it.
+    pub tolerance: f64,
+}
+
+impl Segment {
+    /// Whether only rotary axes move (the tip stands still): such a segment is timed by its
+    /// rotary travel, and `feed` is in deg/s.
+    pub fn rotary_only(&self) -> bool {
+        self.length <= f64::EPSILON
+    }
+
+    /// The largest rotary travel of the segment, degrees.
+    pub fn rotary_travel(&self) -> f64 {
+        let [a, b] = self.rotary;
+        (0..3).map(|i| (b[i] - a[i]).abs()).fold(0.0, f64::max)
+    }
+
+    /// Tip position at parameter `u` of the curve.
+    pub fn point(&self, u: f64) -> Vec3 {
+        self.curve.point(u)
+    }
+}
+
+impl std::fmt::Debug for Segment {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Segment")
+            .field("length", &self.length)
+            .field("rotary", &self.rotary)
+            .field("line", &self.line)
+            .field("feed", &self.feed)
+            .field("end", &self.end)
+            .field("tolerance", &self.tolerance)
+            .finish_non_exhaustive()
+    }
+}
+
+/// What the path stage emits, in program order.
+#[derive(Debug)]
+pub enum PathItem {
+    Segment(Segment),
+    /// G4: stand still this long, seconds (the segment before ends with [`Junction::Stop`]).
+    Dwell {
+        seconds: f64,
+        line: u32,
+    },
+    /// M0/M1/M60 or program end: the machine stands still.
+    Stop {
+        line: u32,
+    },
+}
