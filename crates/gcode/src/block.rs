@@ -68,6 +68,9 @@ pub enum OKeyword {
     Continue,
     Repeat,
     EndRepeat,
+    /// A bare `O<n>` line: the start of a Fanuc-style subprogram (ended by M99), or the
+    /// program number on the first line.
+    Program,
 }
 
 impl OKeyword {
@@ -90,11 +93,11 @@ impl OKeyword {
     ];
 
     pub fn name(self) -> &'static str {
-        let (name, _) = Self::NAMES
+        Self::NAMES
             .iter()
             .find(|(_, k)| *k == self)
-            .expect("every keyword is named");
-        std::str::from_utf8(name).unwrap_or("?")
+            .and_then(|(name, _)| std::str::from_utf8(name).ok())
+            .unwrap_or("program")
     }
 }
 
@@ -378,6 +381,7 @@ pub fn read_o_word(r: &mut Reader, at: u32, evaluate: bool) -> ReadResult<OWord>
         .iter()
         .find(|(name, _)| *name == word)
         .map(|&(_, k)| k)
+        .or(word.is_empty().then_some(OKeyword::Program))
         .ok_or_else(|| {
             let text = String::from_utf8_lossy(word).into_owned();
             (ErrorKind::UnknownOKeyword(text), word_start)

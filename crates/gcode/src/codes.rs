@@ -31,7 +31,9 @@ pub mod mgroup {
     pub const COOLANT: usize = 8;
     pub const OVERRIDE: usize = 9;
     pub const USER: usize = 10;
-    pub const COUNT: usize = 11;
+    /// M98/M99, Fanuc-style subprogram call and return.
+    pub const SUBPROGRAM: usize = 11;
+    pub const COUNT: usize = 12;
 }
 
 /// The modal group of G code `g10` (ten times the code), if LinuxCNC knows it.
@@ -94,6 +96,7 @@ pub fn m_group(m: i64) -> Option<usize> {
         7..=9 => COOLANT,
         48..=53 => OVERRIDE,
         70..=73 => IO,
+        98 | 99 => SUBPROGRAM,
         100..=199 => USER,
         _ => return None,
     })

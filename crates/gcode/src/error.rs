@@ -267,6 +267,10 @@ pub enum ErrorKind {
     RunawayLoop(String, u64),
     #[error("Subroutine calls nested deeper than {0}")]
     CallsTooDeep(usize),
+    #[error("Found 'm98' code with no P-word")]
+    M98WithoutP,
+    #[error("M99 outside a subprogram (an endlessly repeated main program) is not supported")]
+    M99InMain,
     #[error("{0} needs a [value]")]
     OWordNeedsValue(&'static str),
 

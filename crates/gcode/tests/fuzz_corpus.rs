@@ -4,7 +4,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use tezgah_gcode::{canon::Discard, check, Config, Interpreter};
+use tezgah_gcode::{canon::Discard, check, interp::ControlLimits, Config, Interpreter};
 
 fn corpus_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/interpret")
@@ -13,9 +13,16 @@ fn corpus_dir() -> PathBuf {
 /// What the fuzz target does with one input.
 fn run_input(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
-    let mut interp = Interpreter::new(Config::default());
+    let cfg = Config {
+        limits: ControlLimits {
+            max_loop_iterations: 1_000,
+            max_call_depth: 16,
+        },
+        ..Config::default()
+    };
+    let mut interp = Interpreter::new(cfg.clone());
     let _ = interp.run(&text, &mut Discard);
-    let _ = check(&text, Config::default());
+    let _ = check(&text, cfg);
 }
 
 #[test]

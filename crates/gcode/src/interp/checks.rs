@@ -135,6 +135,11 @@ fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<()
 const RULED_LETTERS: [u8; 10] = [b'd', b'e', b'h', b'i', b'j', b'k', b'l', b'p', b'q', b'r'];
 
 fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckError> {
+    if let Some(c) = block.m[mgroup::SUBPROGRAM] {
+        if c.code == 98 && !block.has(b'p') {
+            return Err((ErrorKind::M98WithoutP, c.at));
+        }
+    }
     let mode0 = block.g(ggroup::NON_MODAL);
     let g10 = mode0 == Some(100);
     let arc = matches!(motion, Some(20 | 30));
@@ -185,6 +190,7 @@ fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckErro
         b'l',
         // G74 takes no L, unlike the other cycles (LinuxCNC's rule).
         g10 || (cycle && motion != Some(740))
+            || m(mgroup::SUBPROGRAM) == Some(98)
             || matches!(motion, Some(52 | 760))
             || matches!(m(mgroup::IO), Some(66)),
         ErrorKind::LWordUnused,
@@ -197,6 +203,7 @@ fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckErro
             Some(50 | 52 | 740 | 760 | 820 | 840 | 860 | 880 | 890)
         )
         || matches!(m(mgroup::OVERRIDE), Some(50..=53))
+        || m(mgroup::SUBPROGRAM) == Some(98)
         || matches!(m(mgroup::IO), Some(62..=66))
         || m(mgroup::USER).is_some();
     rule(b'p', p_user, ErrorKind::PWordUnused)?;

@@ -56,6 +56,15 @@ struct Frame {
     saved: [f64; CALL_PARAMETERS],
     /// Loops open when the call was made; the callee's are dropped on return.
     loops: usize,
+    /// A Fanuc-style M98 call: parameters are shared, not saved, and the body runs L times.
+    fanuc: Option<FanucCall>,
+}
+
+/// The repeat state of an M98 call.
+#[derive(Debug, Clone, Copy)]
+struct FanucCall {
+    body: LinePos,
+    passes_left: u32,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -98,6 +107,14 @@ enum Skip {
         args: Vec<f64>,
         return_to: LinePos,
     },
+    /// The M99 that ends a Fanuc-style subprogram met in passing.
+    FanucDefinition,
+    /// An M98 call to a subprogram not met yet: its `O<n>` line.
+    FanucCall {
+        label: OLabel,
+        passes: u32,
+        return_to: LinePos,
+    },
 }
 
 /// The control-flow state of a running program.
@@ -108,13 +125,26 @@ pub struct Control {
     frames: Vec<Frame>,
     loops: Vec<Loop>,
     skip: Option<Skip>,
+    /// Fanuc-style subprograms met so far (the line after their `O<n>`).
+    programs: HashMap<OLabel, LinePos>,
+    /// Whether a line has executed: a bare `O<n>` before that is the program's number.
+    started: bool,
+    /// The line after the one executing (where an M98 returns to).
+    pub(super) next_line: Option<LinePos>,
 }
 
 impl Control {
+    pub(super) fn mark_started(&mut self) {
+        self.started = true;
+    }
+
     /// The error to report when the program ends in the middle of a skip.
     pub fn unfinished(&self) -> Option<ErrorKind> {
         Some(match self.skip.as_ref()? {
-            Skip::Call { label, .. } => ErrorKind::SubroutineNotFound(label.to_string()),
+            Skip::Call { label, .. } | Skip::FanucCall { label, .. } => {
+                ErrorKind::SubroutineNotFound(label.to_string())
+            }
+            Skip::FanucDefinition => ErrorKind::OWordTargetMissing("…".into(), "M99"),
             Skip::Definition(l) => ErrorKind::OWordTargetMissing(l.to_string(), "endsub"),
             Skip::Branch(l) | Skip::PastIf(l) => {
                 ErrorKind::OWordTargetMissing(l.to_string(), "endif")
@@ -138,6 +168,10 @@ impl Interpreter {
         sink: &mut impl CanonSink,
     ) -> Result<Flow, GcodeError> {
         let text = &self.norm.text;
+        if matches!(self.control.skip, Some(Skip::FanucDefinition)) && ends_subprogram(text) {
+            self.control.skip = None;
+            return Ok(Flow::Continue);
+        }
         // An N word may stand before the O-word.
         let mut i = 0;
         if text.first() == Some(&b'n') {
@@ -195,6 +229,19 @@ impl Interpreter {
                 return self.o_word(&o, line, sink).map_err(|(k, _)| span(k));
             }
             (
+                Some(Skip::FanucCall {
+                    label,
+                    passes,
+                    return_to,
+                }),
+                OKeyword::Program,
+            ) if matches(&label) => {
+                self.control.skip = None;
+                self.control.programs.insert(label, line.next());
+                self.enter_fanuc(line.next(), passes, return_to)
+                    .map_err(|(k, _)| span(k))?;
+            }
+            (
                 Some(Skip::Call {
                     label,
                     args,
@@ -249,11 +296,25 @@ impl Interpreter {
         let label = &o.label;
         let unmatched = |what| (ErrorKind::UnmatchedOWord(what, label.to_string()), o.at);
         match o.keyword {
+            // The program's number on its first line, or a Fanuc-style subprogram to pass over.
+            OKeyword::Program if !self.control.started => {}
+            OKeyword::Program => {
+                self.control.programs.insert(label.clone(), line.next());
+                self.control.skip = Some(Skip::FanucDefinition);
+            }
             OKeyword::Sub => {
                 self.control.subs.insert(label.clone(), line.next());
                 self.control.skip = Some(Skip::Definition(label.clone()));
             }
             OKeyword::EndSub | OKeyword::Return => {
+                if self
+                    .control
+                    .frames
+                    .last()
+                    .is_some_and(|f| f.fanuc.is_some())
+                {
+                    return Err(unmatched("M98 subprogram ended by"));
+                }
                 let frame = self.control.frames.pop().ok_or_else(|| {
                     unmatched(if o.keyword == OKeyword::Return {
                         "return"
@@ -430,6 +491,73 @@ impl Interpreter {
         Ok(Flow::Continue)
     }
 
+    /// M98 P… L… (call a Fanuc-style subprogram L times) and M99 (its end).
+    pub(super) fn subprogram(
+        &mut self,
+        block: &crate::block::Block,
+        m: u32,
+        at: u32,
+    ) -> Exec<Flow> {
+        let return_to = self.control.next_line.unwrap_or(LinePos::FIRST);
+        if m == 98 {
+            let p = block.get(b'p').unwrap_or(0.0).round() as i64;
+            let label = OLabel::Number(p);
+            let passes = block.get(b'l').map_or(1, |l| l.max(0.0).round() as u32);
+            if passes == 0 {
+                return Ok(Flow::Continue);
+            }
+            return match self.control.programs.get(&label).copied() {
+                Some(body) => {
+                    self.enter_fanuc(body, passes, return_to)?;
+                    Ok(Flow::Jump(body))
+                }
+                None => {
+                    self.control.skip = Some(Skip::FanucCall {
+                        label,
+                        passes,
+                        return_to,
+                    });
+                    Ok(Flow::Continue)
+                }
+            };
+        }
+        let Some(frame) = self.control.frames.last_mut() else {
+            return Err((ErrorKind::M99InMain, at));
+        };
+        let Some(fanuc) = frame.fanuc.as_mut() else {
+            return Err((ErrorKind::UnmatchedOWord("M99", "sub".into()), at));
+        };
+        fanuc.passes_left -= 1;
+        if fanuc.passes_left > 0 {
+            let body = fanuc.body;
+            self.count_pass(at)?;
+            return Ok(Flow::Jump(body));
+        }
+        let return_to = frame.return_to;
+        let loops = frame.loops;
+        self.control.frames.pop();
+        self.control.loops.truncate(loops);
+        Ok(Flow::Jump(return_to))
+    }
+
+    /// Start an M98 call: parameters stay as they are (Fanuc subprograms share them).
+    fn enter_fanuc(&mut self, body: LinePos, passes: u32, return_to: LinePos) -> Exec {
+        let depth = self.cfg.limits.max_call_depth;
+        if self.control.frames.len() >= depth {
+            return Err((ErrorKind::CallsTooDeep(depth), 0));
+        }
+        self.control.frames.push(Frame {
+            return_to,
+            saved: [0.0; CALL_PARAMETERS],
+            loops: self.control.loops.len(),
+            fanuc: Some(FanucCall {
+                body,
+                passes_left: passes,
+            }),
+        });
+        Ok(())
+    }
+
     /// Start a call: the caller's `#1`…`#30` are kept, the arguments take their place.
     fn enter_call(&mut self, args: &[f64], return_to: LinePos) -> Exec {
         let depth = self.cfg.limits.max_call_depth;
@@ -443,7 +571,18 @@ impl Interpreter {
             return_to,
             saved,
             loops: self.control.loops.len(),
+            fanuc: None,
         });
         Ok(())
     }
+}
+
+/// Whether a (normalised) line holds M99, the end of a Fanuc-style subprogram.
+fn ends_subprogram(text: &[u8]) -> bool {
+    text.windows(3).enumerate().any(|(i, w)| {
+        w == b"m99"
+            && !text
+                .get(i + 3)
+                .is_some_and(|c| c.is_ascii_digit() || *c == b'.')
+    })
 }

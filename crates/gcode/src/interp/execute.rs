@@ -181,6 +181,9 @@ impl Interpreter {
         if let Some(m) = motion {
             self.motion(block, m, sink)?;
         }
+        if let Some(m) = block.m[mgroup::SUBPROGRAM] {
+            return self.subprogram(block, m.code, m.at);
+        }
         if let Some(m) = block.m(mgroup::STOP) {
             return Ok(self.stop(m, sink));
         }

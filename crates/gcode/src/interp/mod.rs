@@ -276,12 +276,16 @@ impl Interpreter {
             line: line.number,
             n: block.n,
         };
+        self.control.next_line = Some(line.next());
         if let Some(o) = block.o.take() {
             let at = o.at as usize;
-            return self
+            let flow = self
                 .o_word(&o, line, sink)
                 .map_err(|(kind, _)| GcodeError::new(kind, line.span(at)));
+            self.control.mark_started();
+            return flow;
         }
+        self.control.mark_started();
         self.execute_block(block, line, sink)
     }
 
@@ -381,6 +385,9 @@ fn memchr_newline(s: &[u8]) -> usize {
     memchr::memchr(b'\n', s).unwrap_or(s.len())
 }
 
+/// The pre-flight stops after this many errors.
+pub const MAX_CHECK_ERRORS: usize = 100;
+
 /// Pre-flight: interpret the whole program and collect every error instead of stopping at the
 /// first. After an error, interpretation goes on with the next line from the state the failed
 /// block left (the words executed before the failing one keep their effect, as in LinuxCNC).
@@ -405,7 +412,18 @@ pub fn check_into(program: &str, cfg: Config, sink: &mut impl CanonSink) -> Vec<
             }
             Ok(Flow::Continue) => {}
             Ok(Flow::Jump(to)) => at = to,
-            Err(e) => errors.push(e),
+            Err(e) => {
+                // After a runaway loop or recursion, or enough errors, going on tells nothing
+                // more (and a loop whose counting line fails would go on for ever).
+                let hopeless = matches!(
+                    e.kind,
+                    ErrorKind::RunawayLoop(..) | ErrorKind::CallsTooDeep(_)
+                );
+                errors.push(e);
+                if hopeless || errors.len() >= MAX_CHECK_ERRORS {
+                    return errors;
+                }
+            }
         }
     }
     if let Err(e) = interp.finish(last) {
