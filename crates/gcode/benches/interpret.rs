@@ -63,5 +63,54 @@ fn bench_interpret(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_interpret);
+/// Passes of the loop in the control-flow benchmark.
+const LOOP_PASSES: usize = 100_000;
+
+/// A program dominated by O-word control flow and expressions: a subroutine called in a while
+/// loop, an if/else in the body, and a G1 move computed from parameters on every pass. Each
+/// pass executes 10 lines.
+fn loop_program(passes: usize) -> String {
+    format!(
+        "G21 G90 F1000\n\
+         o100 sub\n\
+         #<r> = [#1 * 0.001 + 10]\n\
+         o100 return [#<r> * COS[#1 * 0.36]]\n\
+         o100 endsub\n\
+         #1 = 0\n\
+         o1 while [#1 LT {passes}]\n\
+         o100 call [#1]\n\
+         o2 if [[#1 MOD 2] EQ 0]\n\
+         G1 X#<_value> Y[#1 * 0.001] Z[-1 - [#1 MOD 7] * 0.01]\n\
+         o2 else\n\
+         G1 X[#<_value> + 0.05] Y[#1 * 0.001]\n\
+         o2 endif\n\
+         #1 = [#1 + 1]\n\
+         o1 endwhile\n\
+         M2\n"
+    )
+}
+
+fn bench_control_flow(c: &mut Criterion) {
+    let program = loop_program(LOOP_PASSES);
+    let mut interp = Interpreter::new(Config::default());
+    interp
+        .run(&program, &mut Discard)
+        .expect("the loop program runs");
+    let mut group = c.benchmark_group("interpret");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(10));
+    // Lines executed, not lines of text: 10 per pass.
+    group.throughput(Throughput::Elements((LOOP_PASSES * 10) as u64));
+    group.bench_function("oword_loop_100k_passes", |b| {
+        b.iter(|| {
+            let mut interp = Interpreter::new(Config::default());
+            interp
+                .run(black_box(&program), &mut Discard)
+                .expect("the loop program runs");
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench_interpret, bench_control_flow);
 criterion_main!(benches);

@@ -39,6 +39,9 @@ pub struct NormLine {
     /// Byte offset in the source line of a `%` that no comment precedes. Lexing stops there:
     /// such a line is either a lone `%` (a program delimiter) or an error.
     pub percent: Option<usize>,
+    /// Whether the line holds a `#` anywhere (a parameter read or write, also in a DEBUG or
+    /// PRINT comment): only then do the interpreter's published values need refreshing.
+    pub mentions_parameters: bool,
 }
 
 impl NormLine {
@@ -50,6 +53,7 @@ impl NormLine {
         self.comments.clear();
         self.percent = None;
         let bytes = raw.as_bytes();
+        self.mentions_parameters = memchr::memchr(b'#', bytes).is_some();
         self.text.reserve(bytes.len());
         self.at.reserve(bytes.len());
         let mut i = 0;

@@ -260,7 +260,9 @@ impl Interpreter {
         if self.control.skipping() {
             return self.skipped_line(line, sink);
         }
-        self.publish_system_values(line.number);
+        if self.norm.mentions_parameters {
+            self.publish_system_values(line.number);
+        }
         let Self { norm, params, .. } = self;
         let to_span = |norm: &NormLine, idx: usize| {
             let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
