@@ -9,6 +9,8 @@ pub mod block;
 pub mod canon;
 pub mod codes;
 pub mod error;
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod interp;
 pub mod lexer;
 pub mod moves;

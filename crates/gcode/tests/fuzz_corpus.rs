@@ -4,25 +4,8 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use tezgah_gcode::{canon::Discard, check, interp::ControlLimits, Config, Interpreter};
-
 fn corpus_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/interpret")
-}
-
-/// What the fuzz target does with one input.
-fn run_input(data: &[u8]) {
-    let text = String::from_utf8_lossy(data);
-    let cfg = Config {
-        limits: ControlLimits {
-            max_loop_iterations: 1_000,
-            max_call_depth: 16,
-        },
-        ..Config::default()
-    };
-    let mut interp = Interpreter::new(cfg.clone());
-    let _ = interp.run(&text, &mut Discard);
-    let _ = check(&text, cfg);
 }
 
 #[test]
@@ -44,7 +27,7 @@ fn fuzz_corpus_never_panics() {
     for path in &files {
         let data =
             std::fs::read(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-        if catch_unwind(AssertUnwindSafe(|| run_input(&data))).is_err() {
+        if catch_unwind(AssertUnwindSafe(|| tezgah_gcode::fuzzing::interpret(&data))).is_err() {
             panicked.push(path.display().to_string());
         }
     }
