@@ -220,6 +220,11 @@ pub enum ErrorKind {
     #[error("Cannot use g53 incremental")]
     G53Incremental,
 
+    #[error("Calculation resulted in 'not a number'")]
+    NotANumber,
+    #[error("Calculation resulted in 'infinity'")]
+    Infinity,
+
     // --- canned cycles ---
     #[error("Cannot feed with zero feed rate")]
     CycleZeroFeed,

@@ -159,7 +159,9 @@ impl Unary {
                 x.ln()
             }
             // C's (int)(x ± 0.5): rounds half away from zero.
-            Round => (x + if x < 0.0 { -0.5 } else { 0.5 }).trunc(),
+            // LinuxCNC rounds through an integer, so −0.4 gives +0, never −0 (which would
+            // turn ATAN[0]/[ROUND[−0.4]] into 180°).
+            Round => (x + if x < 0.0 { -0.5 } else { 0.5 }).trunc() + 0.0,
             Sqrt => {
                 if x < 0.0 {
                     return Err(ErrorKind::SqrtOfNegative);
@@ -310,7 +312,9 @@ impl<'a> Reader<'a> {
         match self.peek() {
             Some(b']') => {
                 self.pos += 1;
-                Ok(v)
+                // A bracket's value must be a finite number; inside it NaN and infinity may
+                // pass through comparisons (`[0 EQ [0 MOD 0]]` is 0), as in LinuxCNC.
+                finite(v).map_err(|k| (k, self.pos - 1))
             }
             None => self.err(ErrorKind::UnclosedExpression),
             Some(_) => self.err(ErrorKind::UnknownOperation),
@@ -426,6 +430,17 @@ impl<'a> Reader<'a> {
         }
         self.pos += 1;
         Ok(if found { 1.0 } else { 0.0 })
+    }
+}
+
+/// An operation's result, refused when it is not a finite number, as LinuxCNC refuses it.
+fn finite(v: f64) -> Result<f64, ErrorKind> {
+    if v.is_nan() {
+        Err(ErrorKind::NotANumber)
+    } else if v.is_infinite() {
+        Err(ErrorKind::Infinity)
+    } else {
+        Ok(v)
     }
 }
 

@@ -205,6 +205,17 @@ enum Item {
         q: Option<f64>,
         ijk: [f64; 3],
     },
+    /// `o<n> repeat [count]` around one incremental G1 (or G0), then back to the distance
+    /// mode in force.
+    Repeat {
+        count: u8,
+        rapid: bool,
+        step: [f64; 3],
+        f: f64,
+    },
+    /// `#<v> = [expression]` then a rapid to `X[#<v>]`: LinuxCNC's arithmetic, precedence and
+    /// functions against ours.
+    Expression(String),
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
@@ -267,6 +278,8 @@ struct Writer {
     tool_offset: bool,
     /// A G43, G43.1 or G49 was written: no M6 from then on.
     tool_length_used: bool,
+    /// O-word labels used so far (each loop gets its own).
+    labels: u32,
 }
 
 impl Writer {
@@ -283,6 +296,7 @@ impl Writer {
             tool_offset: false,
             tool_length_used: false,
             rotation_used: false,
+            labels: 0,
         }
     }
 
@@ -708,6 +722,42 @@ impl Writer {
                 self.block(deco, &words);
                 self.forget();
             }
+            Item::Repeat {
+                count,
+                rapid,
+                step,
+                f,
+            } => {
+                self.labels += 1;
+                let label = 900 + self.labels;
+                self.block(deco, &format!("o{label} repeat [{count}]"));
+                let g = if *rapid { 0 } else { 1 };
+                let feed = if *rapid {
+                    String::new()
+                } else {
+                    self.feed_word(*f, true)
+                };
+                self.text.push_str(&format!(
+                    "G91 G{g} X{} Y{} Z{}{feed}\n",
+                    num(step[0]),
+                    num(step[1]),
+                    num(step[2])
+                ));
+                self.text.push_str(&format!("o{label} endrepeat\n"));
+                if !self.incremental {
+                    self.text.push_str("G90\n");
+                }
+                self.forget();
+            }
+            Item::Expression(e) => {
+                self.block(deco, &format!("#<v> = {e}"));
+                let prefix = if self.incremental { "G90 " } else { "" };
+                self.text.push_str(&format!("{prefix}G0 X[#<v>]\n"));
+                if self.incremental {
+                    self.text.push_str("G91\n");
+                }
+                self.forget();
+            }
             Item::Comment(c) => self.block(deco, COMMENTS[*c]),
             Item::Faulty(k) => self.block(deco, FAULTY[*k]),
         }
@@ -777,6 +827,33 @@ fn cycle() -> impl Strategy<Value = Item> {
             q,
             ijk,
         })
+}
+
+/// A bracketed expression over numbers, the binary operators and the unary functions.
+fn expression() -> impl Strategy<Value = String> {
+    let leaf = prop_oneof![
+        value(100.0).prop_map(num),
+        positive(0.0, 2.0).prop_map(num),
+        Just("#<_x>".to_string()),
+    ];
+    let tree = leaf.prop_recursive(3, 12, 2, |inner| {
+        let ops = [
+            "+", "-", "*", "/", "MOD", "**", "EQ", "NE", "GT", "GE", "LT", "LE", "AND", "OR", "XOR",
+        ];
+        // No TAN: at its pole (TAN[90]) both sides return a huge number from the last bits
+        // of the degree-to-radian conversion, and these differ.
+        let funcs = [
+            "ABS", "COS", "SIN", "SQRT", "FIX", "FUP", "ROUND", "EXP", "LN", "ACOS", "ASIN",
+        ];
+        prop_oneof![
+            (inner.clone(), 0..ops.len(), inner.clone())
+                .prop_map(move |(a, o, b)| format!("{a} {} {b}", ops[o])),
+            (0..funcs.len(), inner.clone()).prop_map(move |(f, a)| format!("{}[{a}]", funcs[f])),
+            (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("ATAN[{a}]/[{b}]")),
+            inner.prop_map(|a| format!("[{a}]")),
+        ]
+    });
+    tree.prop_map(|t| format!("[{t}]"))
 }
 
 fn maybe_axes() -> impl Strategy<Value = Axes> {
@@ -912,6 +989,15 @@ fn item() -> impl Strategy<Value = Item> {
         1 => (1u8..=3, 0u8..3).prop_map(|(t, change)| Item::Tool { t, change }),
         2 => tool_length.prop_map(Item::ToolLength),
         2 => cycle(),
+        1 => (1u8..=4, any::<bool>(), [value(3.0), value(3.0), value(3.0)], feed()).prop_map(
+            |(count, rapid, step, f)| Item::Repeat {
+                count,
+                rapid,
+                step,
+                f
+            }
+        ),
+        2 => expression().prop_map(Item::Expression),
         1 => (0..COMMENTS.len()).prop_map(Item::Comment),
     ];
     // About one program in twelve ends early on an error.
