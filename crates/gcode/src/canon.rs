@@ -58,6 +58,9 @@ pub enum Canon {
     SelectPlane(Option<Plane>),
     SetMotionControlMode(ControlMode),
     SetNaivecamTolerance(f64),
+    /// Fanuc's `G05.1 Q1`/`Q0` (tezgah's own call; LinuxCNC has none): compression of short
+    /// moves into splines on or off.
+    SetSmoothing(bool),
     /// G93 = 1, G94 = 0, G95 = 2 (LinuxCNC's `SET_FEED_MODE(spindle, mode)`).
     SetFeedMode(i32),
     SetFeedRate(f64),
@@ -139,6 +142,7 @@ impl fmt::Display for Canon {
             SetXyRotation(r) => write!(f, "SET_XY_ROTATION({r:.4})"),
             SetFeedReference => f.write_str("SET_FEED_REFERENCE(CANON_XYZ)"),
             OnReset => f.write_str("ON_RESET()"),
+            SetSmoothing(on) => write!(f, "SET_SMOOTHING({})", if *on { "ON" } else { "OFF" }),
             SelectPlane(p) => write!(
                 f,
                 "SELECT_PLANE({})",

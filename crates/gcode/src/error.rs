@@ -272,6 +272,8 @@ pub enum ErrorKind {
     RunawayLoop(String, u64),
     #[error("Subroutine calls nested deeper than {0}")]
     CallsTooDeep(usize),
+    #[error("G05.1 needs Q1 (smoothing on) or Q0 (off)")]
+    SmoothingQ,
     #[error("Found 'm98' code with no P-word")]
     M98WithoutP,
     #[error("M99 outside a subprogram (an endlessly repeated main program) is not supported")]

@@ -105,6 +105,7 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 };
                 self.push(line, MoveKind::FeedMode(mode));
             }
+            Canon::SetSmoothing(on) => self.push(line, MoveKind::Smoothing(on)),
             Canon::SetMotionControlMode(m) => {
                 let mode = match m {
                     ControlMode::ExactStop => PathMode::ExactStop,

@@ -59,6 +59,8 @@ pub enum MoveKind {
     FeedMode(FeedMode),
     /// G61 / G61.1 / G64 P Q.
     PathMode(PathMode),
+    /// Fanuc's `G05.1 Q1` (true) / `Q0`: runs of short moves may be compressed into splines.
+    Smoothing(bool),
     /// M0/M1/M60 pauses and M2/M30 program end.
     Stop(StopKind),
 }

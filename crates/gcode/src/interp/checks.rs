@@ -16,6 +16,16 @@ const MAX_M_CODES: usize = 4;
 pub struct Plan {
     /// The motion the block makes (G code ×10), explicit or modal.
     pub motion: Option<u32>,
+    /// Fanuc's `G05.1 Q1` / `Q0`: path smoothing switched on or off.
+    pub smoothing: Option<bool>,
+}
+
+/// `G5.1` with Q and without I or J is Fanuc's smoothing switch (`G05.1 Q1`), not LinuxCNC's
+/// quadratic spline (which needs I and J).
+fn smoothing_switch(block: &Block) -> Option<f64> {
+    (block.g(ggroup::MOTION) == Some(51) && !block.has(b'i') && !block.has(b'j'))
+        .then(|| block.get(b'q'))
+        .flatten()
 }
 
 /// A check failure and the byte offset (in the line) of the word it concerns.
@@ -33,7 +43,13 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
     // Codes whose axis words are data, not a move (G43.1 takes its offsets from them too).
     let covets_axes = matches!(mode0, Some(100 | 280 | 300 | 520 | 920))
         || block.g(ggroup::TOOL_LENGTH) == Some(431);
-    let motion = match block.g(ggroup::MOTION) {
+    let smoothing = match smoothing_switch(block) {
+        Some(q) if q == 1.0 || q == 0.0 => Some(q == 1.0),
+        Some(_) => return Err((ErrorKind::SmoothingQ, at_g(ggroup::MOTION))),
+        None => None,
+    };
+    let explicit_motion = block.g(ggroup::MOTION).filter(|_| smoothing.is_none());
+    let motion = match explicit_motion {
         Some(800) => {
             if axes && !covets_axes {
                 return Err((ErrorKind::AxisValuesWithG80, at_g(ggroup::MOTION)));
@@ -68,8 +84,8 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
     if block.m_count > MAX_M_CODES {
         return Err((ErrorKind::TooManyMCodes, 0));
     }
-    check_other_words(block, motion)?;
-    Ok(Plan { motion })
+    check_other_words(block, motion, smoothing.is_some())?;
+    Ok(Plan { motion, smoothing })
 }
 
 fn first_axis_at(block: &Block) -> u32 {
@@ -134,7 +150,11 @@ fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<()
 /// Letters whose use `check_other_words` restricts to certain codes.
 const RULED_LETTERS: [u8; 10] = [b'd', b'e', b'h', b'i', b'j', b'k', b'l', b'p', b'q', b'r'];
 
-fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckError> {
+fn check_other_words(
+    block: &Block,
+    motion: Option<u32>,
+    smoothing: bool,
+) -> Result<(), CheckError> {
     if let Some(c) = block.m[mgroup::SUBPROGRAM] {
         if c.code == 98 && !block.has(b'p') {
             return Err((ErrorKind::M98WithoutP, c.at));
@@ -208,6 +228,7 @@ fn check_other_words(block: &Block, motion: Option<u32>) -> Result<(), CheckErro
         || m(mgroup::USER).is_some();
     rule(b'p', p_user, ErrorKind::PWordUnused)?;
     let q_user = g10
+        || smoothing
         || block.g(ggroup::PATH_CONTROL) == Some(640)
         || matches!(motion, Some(50 | 730 | 760 | 830))
         || matches!(m(mgroup::SPINDLE), Some(19))

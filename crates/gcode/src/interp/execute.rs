@@ -27,16 +27,17 @@ impl Interpreter {
         let plan = checks::check(block, &self.state)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.assign_parameters(block);
-        self.execute_words(block, plan.motion, sink)
+        self.execute_words(block, plan, sink)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))
     }
 
     fn execute_words(
         &mut self,
         block: &Block,
-        motion: Option<u32>,
+        plan: checks::Plan,
         sink: &mut impl CanonSink,
     ) -> Exec<Flow> {
+        let motion = plan.motion;
         if let Some(i) = block.comment {
             self.comment(&self.norm.comments[i].text.clone(), sink)?;
         }
@@ -145,6 +146,9 @@ impl Interpreter {
         }
         if let Some(g) = block.g(ggroup::PATH_CONTROL) {
             self.path_control(block, g, sink);
+        }
+        if let Some(on) = plan.smoothing {
+            self.emit(sink, Canon::SetSmoothing(on));
         }
         if let Some(g) = block.g(ggroup::DISTANCE) {
             let incremental = g == 910;

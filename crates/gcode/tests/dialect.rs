@@ -1,0 +1,41 @@
+//! Words of the Fanuc dialect that LinuxCNC lacks: the `G05.1` smoothing switch.
+
+use tezgah_gcode::{program_moves, Config, ErrorKind};
+use tezgah_geom::MoveKind;
+
+#[test]
+fn g05_1_q_switches_smoothing_and_keeps_the_motion_mode() {
+    let moves = program_moves(
+        "G21 G1 X1 F100\nG05.1 Q1\nX2\nG5.1 Q0\nX3\nM2\n",
+        Config::default(),
+    )
+    .unwrap();
+    let kinds: Vec<_> = moves
+        .iter()
+        .filter_map(|m| match m.kind {
+            MoveKind::Smoothing(on) => Some(("smoothing", on as u8 as f64, m.line)),
+            MoveKind::Feed { end } => Some(("feed", end.0[0], m.line)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        kinds,
+        vec![
+            ("feed", 1.0, 1),
+            ("smoothing", 1.0, 2),
+            // G1 stays in force across the switch.
+            ("feed", 2.0, 3),
+            ("smoothing", 0.0, 4),
+            ("feed", 3.0, 5),
+        ]
+    );
+}
+
+#[test]
+fn g05_1_needs_q0_or_q1_and_g5_1_with_ij_is_the_spline() {
+    let err = program_moves("G05.1 Q2\nM2\n", Config::default()).unwrap_err();
+    assert_eq!(err.kind, ErrorKind::SmoothingQ);
+    // With I and J it is LinuxCNC's quadratic spline, which waits for the NURBS moves.
+    let err = program_moves("G21 F10\nG5.1 X1 Y1 I1 J0\nM2\n", Config::default()).unwrap_err();
+    assert_eq!(err.kind, ErrorKind::Unsupported("G5.1".into()));
+}
