@@ -12,11 +12,17 @@ use crate::span::Span;
 pub struct GcodeError {
     pub kind: ErrorKind,
     pub span: Span,
+    /// The subroutine file the error is in, when it is not in the program itself.
+    pub file: Option<String>,
 }
 
 impl GcodeError {
     pub fn new(kind: ErrorKind, span: Span) -> Self {
-        GcodeError { kind, span }
+        GcodeError {
+            kind,
+            span,
+            file: None,
+        }
     }
 }
 

@@ -19,6 +19,12 @@ struct Run {
     counter: bool,
     /// LinuxCNC's script keeps only the MESSAGE lines.
     messages_only: bool,
+    /// The folder's SUBROUTINE_PATH (from its test.ini), relative to the folder.
+    subroutines: Option<&'static str>,
+    /// rs274 runs with `-n 0`: it goes on after an error (as tezgah's pre-flight does).
+    go_on: bool,
+    /// The program must fail (LinuxCNC's script expects rs274 to exit with an error).
+    fails: bool,
 }
 
 const fn run(folder: &'static str, program: &'static str) -> Run {
@@ -28,6 +34,9 @@ const fn run(folder: &'static str, program: &'static str) -> Run {
         table: None,
         counter: false,
         messages_only: false,
+        subroutines: None,
+        go_on: false,
+        fails: false,
     }
 }
 
@@ -67,6 +76,27 @@ const RUNS: &[Run] = &[
     run("flowsnake", "flowsnake.ngc"),
     run("oword-bug315", "test.ngc"),
     run("oword-bug315-p2", "test.ngc"),
+    Run {
+        subroutines: Some("subs"),
+        ..run("sub-call-from-sub", "test.ngc")
+    },
+    Run {
+        subroutines: Some("."),
+        go_on: true,
+        ..run("oword-unwind", "test.ngc")
+    },
+    Run {
+        subroutines: Some("subs"),
+        counter: true,
+        fails: true,
+        ..run("nested-sub-error", "test.ngc")
+    },
+    Run {
+        subroutines: Some("subs"),
+        counter: true,
+        fails: true,
+        ..run("nested-sub-in-file-error", "test.ngc")
+    },
     run("m98m99/01-basics", "test.ngc"),
     run("m98m99/02-variables", "test.ngc"),
     run("m98m99/05-M98-loops", "test.ngc"),
@@ -125,23 +155,18 @@ const FOLDERS_NOT_YET: &[(&str, &str)] = &[
     ("magic_comments", "parameter formatting comments"),
     ("mdi-oword-m66", "MDI and M66, no expected file"),
     (
-        "nested-sub-error, nested-sub-in-file-error",
-        "subroutines in external files (test.ini)",
-    ),
-    (
-        "oword-mdi-sub-update, oword-unwind",
-        "subroutines in external files (SUBROUTINE_PATH of test.ini)",
+        "oword-mdi-sub-update, subroutine-return",
+        "MDI and a tool-change remap with a Python plug-in, no expected file",
     ),
     (
         "plug, pymove, python, python-self",
         "Python plug-ins, out of scope",
     ),
-    ("value-returned", "subroutines in external files (test.ini)"),
-    ("sequence-number", "INI, O-words"),
     (
-        "sub-call-from-sub, subroutine-return",
-        "subroutines in external files (test.ini)",
+        "value-returned",
+        "Python plug-ins (PYTHON section of test.ini), out of scope",
     ),
+    ("sequence-number", "INI, O-words"),
 ];
 
 /// `bad/` programs that need the full-dialect issue (canned cycles, cutter compensation,
@@ -152,6 +177,16 @@ const BAD_NOT_YET: &[(&str, &str)] = &[
     ("g64-m19-r-ambiguous.ngc", "M19 spindle orientation"),
     ("probe-no-axes.ngc", "probing (G38.x) is out of scope"),
 ];
+
+/// Subroutine files `<name>.ngc` in one folder (the tests' SUBROUTINE_PATH).
+#[derive(Debug)]
+struct Folder(PathBuf);
+
+impl tezgah_gcode::interp::SubroutineLibrary for Folder {
+    fn source(&self, name: &str) -> Option<String> {
+        std::fs::read_to_string(self.0.join(format!("{name}.ngc"))).ok()
+    }
+}
 
 fn data_dir() -> Option<PathBuf> {
     let candidates = [
@@ -361,9 +396,26 @@ fn folder_tests_match_linuxcnc() {
         let text = std::fs::read_to_string(base.join(r.program)).unwrap();
         let expected = std::fs::read_to_string(base.join("expected")).unwrap();
         let table = r.table.map(|t| base.join(t));
-        let (mut ours, result) = our_calls_printing(&text, config(table.as_deref()), !r.counter);
-        assert!(result.is_ok(), "{folder}: {result:?}");
+        let mut cfg = config(table.as_deref());
+        if let Some(dir) = r.subroutines {
+            cfg.subroutines = Some(std::sync::Arc::new(Folder(base.join(dir))));
+        }
+        let (mut ours, result) = if r.go_on {
+            let mut calls: Vec<(Origin, Canon)> = Vec::new();
+            tezgah_gcode::check_into(&text, cfg, &mut calls);
+            let out = calls.iter().map(|(_, c)| c.to_string()).collect();
+            (out, Ok(()))
+        } else {
+            our_calls_printing(&text, cfg, !r.counter)
+        };
+        assert_eq!(result.is_err(), r.fails, "{folder}: {result:?}");
+        // How many ON_RESET() close the output depends on how rs274 was started.
         let mut theirs = expected_calls(&expected, r.counter);
+        for list in [&mut ours, &mut theirs] {
+            while list.last().is_some_and(|c| c == "ON_RESET()") {
+                list.pop();
+            }
+        }
         if r.messages_only {
             // The script: `awk '/MESSAGE/ …' | sed 's/-0\.0000/0.0000/g'`.
             ours.retain(|c| c.starts_with("MESSAGE("));

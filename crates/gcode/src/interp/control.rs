@@ -6,6 +6,7 @@
 //! without being executed until the O-word sought turns up, as LinuxCNC does.
 
 use std::collections::HashMap;
+use std::sync::Arc;
 
 use crate::block::{read_o_word, OKeyword, OLabel, OWord};
 use crate::canon::CanonSink;
@@ -16,9 +17,11 @@ use crate::reader::Reader;
 use super::execute::Exec;
 use super::{Flow, Interpreter, LineRef};
 
-/// Where a line starts: its byte offset in the program and its 1-based number.
+/// Where a line starts: the text it is in (0 = the program, k = the k-th subroutine file
+/// loaded), its byte offset there and its 1-based number.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct LinePos {
+    pub file: u16,
     pub start: usize,
     pub number: u32,
 }
@@ -26,9 +29,18 @@ pub struct LinePos {
 impl LinePos {
     /// The first line of a program.
     pub const FIRST: LinePos = LinePos {
+        file: 0,
         start: 0,
         number: 1,
     };
+
+    /// The first line of subroutine file `file`.
+    pub fn start_of(file: u16) -> LinePos {
+        LinePos {
+            file,
+            ..LinePos::FIRST
+        }
+    }
 }
 
 /// Limits that turn a runaway program into an error instead of a hang.
@@ -302,6 +314,10 @@ impl Interpreter {
                 self.control.programs.insert(label.clone(), line.next());
                 self.control.skip = Some(Skip::FanucDefinition);
             }
+            // Subroutines are defined at the program's level, never inside another's body.
+            OKeyword::Sub if !self.control.frames.is_empty() => {
+                return Err((ErrorKind::NestedSubroutine, o.at));
+            }
             OKeyword::Sub => {
                 self.control.subs.insert(label.clone(), line.next());
                 self.control.skip = Some(Skip::Definition(label.clone()));
@@ -335,11 +351,22 @@ impl Interpreter {
                     return Ok(Flow::Jump(body));
                 }
                 None => {
+                    // A subroutine not met yet: from its own file if the library has one (read
+                    // from its first line, skipping to the `sub`), else further on in this text.
+                    let file = self.load_subroutine_file(label);
+                    // A subroutine file holds its one subroutine: nothing further on in it
+                    // may be called (LinuxCNC's rule).
+                    if file.is_none() && line.file != 0 {
+                        return Err((ErrorKind::SubroutineNotFound(label.to_string()), o.at));
+                    }
                     self.control.skip = Some(Skip::Call {
                         label: label.clone(),
                         args: o.args.clone(),
                         return_to: line.next(),
                     });
+                    if let Some(file) = file {
+                        return Ok(Flow::Jump(LinePos::start_of(file)));
+                    }
                 }
             },
             OKeyword::If => {
@@ -558,6 +585,40 @@ impl Interpreter {
         Ok(())
     }
 
+    /// Leave every active call (after an error inside one): the callers' parameters come back
+    /// and control flow resumes after the outermost call, which is returned.
+    pub(super) fn unwind_calls(&mut self) -> Option<LinePos> {
+        let mut resume = None;
+        while let Some(frame) = self.control.frames.pop() {
+            if frame.fanuc.is_none() {
+                self.params.leave_call(frame.saved);
+            }
+            self.control.loops.truncate(frame.loops);
+            resume = Some(frame.return_to);
+        }
+        if resume.is_some() {
+            self.control.skip = None;
+        }
+        resume
+    }
+
+    /// Load the file that defines subroutine `label` from the configured library, once; its
+    /// index among the loaded texts.
+    fn load_subroutine_file(&mut self, label: &OLabel) -> Option<u16> {
+        let OLabel::Name(name) = label else {
+            return None;
+        };
+        if let Some(i) = self.files.iter().position(|f| f.name == *name) {
+            return Some(i as u16 + 1);
+        }
+        let text = self.cfg.subroutines.as_ref()?.source(name)?;
+        self.files.push(SubroutineFile {
+            name: name.clone(),
+            text: text.into(),
+        });
+        u16::try_from(self.files.len()).ok()
+    }
+
     /// Start a call: the caller's `#1`…`#30` are kept, the arguments take their place.
     fn enter_call(&mut self, args: &[f64], return_to: LinePos) -> Exec {
         let depth = self.cfg.limits.max_call_depth;
@@ -585,4 +646,20 @@ fn ends_subprogram(text: &[u8]) -> bool {
                 .get(i + 3)
                 .is_some_and(|c| c.is_ascii_digit() || *c == b'.')
     })
+}
+
+/// Where subroutines that live in their own files come from (LinuxCNC's `SUBROUTINE_PATH`):
+/// `o<name> call` of a subroutine not defined in the program asks for the text of `name`.
+/// The library, not the interpreter, knows about files.
+pub trait SubroutineLibrary: std::fmt::Debug + Send + Sync {
+    /// The text of the file that defines subroutine `name` (lower case), if there is one.
+    fn source(&self, name: &str) -> Option<String>;
+}
+
+/// A subroutine file the interpreter has loaded.
+#[derive(Debug, Clone)]
+pub struct SubroutineFile {
+    /// The subroutine's name (the file is `<name>.ngc`).
+    pub name: String,
+    pub text: Arc<str>,
 }

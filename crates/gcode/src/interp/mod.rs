@@ -15,7 +15,7 @@ mod state;
 mod system;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
-pub use control::{ControlLimits, LinePos};
+pub use control::{ControlLimits, LinePos, SubroutineFile, SubroutineLibrary};
 pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
@@ -38,6 +38,8 @@ pub struct Config {
     pub machine_units: Units,
     /// Guards against runaway loops and recursion.
     pub limits: ControlLimits,
+    /// Subroutines in files of their own (`o<name> call` of a name the program lacks).
+    pub subroutines: Option<std::sync::Arc<dyn SubroutineLibrary>>,
 }
 
 impl Config {
@@ -47,6 +49,7 @@ impl Config {
             tool_table,
             machine_units: Units::Inches,
             limits: ControlLimits::default(),
+            subroutines: None,
         }
     }
 }
@@ -86,6 +89,8 @@ pub struct Interpreter {
     control: control::Control,
     /// M2/M30 ended a `%` program: the rest of the text should hold the closing `%`.
     closing_percent_sought: bool,
+    /// Subroutine files loaded so far; file k of a [`LinePos`] is `files[k - 1]`.
+    files: Vec<SubroutineFile>,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -97,12 +102,15 @@ pub struct LineRef<'a> {
     pub start: usize,
     /// Byte offset of the next line.
     pub end: usize,
+    /// The text the line is in: 0 the program, k the k-th subroutine file loaded.
+    pub file: u16,
 }
 
 impl LineRef<'_> {
     /// Where this line starts.
     pub fn pos(&self) -> LinePos {
         LinePos {
+            file: self.file,
             start: self.start,
             number: self.number,
         }
@@ -111,6 +119,7 @@ impl LineRef<'_> {
     /// Where the line after this one starts.
     pub fn next(&self) -> LinePos {
         LinePos {
+            file: self.file,
             start: self.end,
             number: self.number + 1,
         }
@@ -136,6 +145,7 @@ impl Interpreter {
             origin: Origin::default(),
             control: control::Control::default(),
             closing_percent_sought: false,
+            files: Vec::new(),
         }
     }
 
@@ -173,21 +183,80 @@ impl Interpreter {
     /// Interpret a whole program; stops at the first error. Calls [`Self::start`] first.
     pub fn run(&mut self, program: &str, sink: &mut impl CanonSink) -> Result<(), GcodeError> {
         self.start(sink);
+        let mut failure = None;
+        self.drive(program, sink, |e| {
+            failure = Some(e);
+            false
+        });
+        failure.map_or(Ok(()), Err)
+    }
+
+    /// Read and execute the program from its first line, following jumps into and out of
+    /// subroutine files, until it ends. Each error goes to `on_error`, which says whether to
+    /// go on with the next line (the pre-flight) or stop (a run). Reaching the end of the text
+    /// without M2/M30 or `%` is an error too, as in LinuxCNC.
+    fn drive(
+        &mut self,
+        program: &str,
+        sink: &mut impl CanonSink,
+        mut on_error: impl FnMut(GcodeError) -> bool,
+    ) {
         let mut at = LinePos::FIRST;
-        let mut last = LineRef::default();
-        while let Some(line) = line_at(program, at) {
-            last = line;
+        // The last line of the program read (for the error at its end).
+        let mut last = None;
+        loop {
+            let file = self.file_text(at.file);
+            let text = file.as_deref().unwrap_or(program);
+            let Some(line) = line_at(text, at) else {
+                break;
+            };
+            if line.file == 0 {
+                last = Some(line.pos());
+            }
             at = line.next();
-            match self.execute_line(line, sink)? {
-                Flow::Continue => {}
-                Flow::End => {
-                    self.seek_closing_percent(program, at, sink);
-                    return Ok(());
+            let result = self.execute_line(line, sink);
+            match result.map_err(|e| self.in_file(e, line.file)) {
+                Ok(Flow::Continue) => {}
+                Ok(Flow::Jump(to)) => at = to,
+                Ok(Flow::End) => {
+                    if line.file == 0 {
+                        self.seek_closing_percent(program, at, sink);
+                    }
+                    return;
                 }
-                Flow::Jump(to) => at = to,
+                Err(e) => {
+                    if !on_error(e) {
+                        return;
+                    }
+                    // Going on after an error inside subroutines: leave them all, as
+                    // LinuxCNC unwinds a failed call, and go on after the outermost call.
+                    if let Some(to) = self.unwind_calls() {
+                        at = to;
+                    }
+                }
             }
         }
-        self.finish(last)
+        let last = last.and_then(|p| line_at(program, p)).unwrap_or_default();
+        if let Err(e) = self.finish(last) {
+            on_error(e);
+        }
+    }
+
+    /// The text of subroutine file `file` (`None` for the program itself).
+    fn file_text(&self, file: u16) -> Option<std::sync::Arc<str>> {
+        let k = usize::from(file).checked_sub(1)?;
+        self.files.get(k).map(|f| f.text.clone())
+    }
+
+    /// Name the subroutine file an error comes from.
+    fn in_file(&self, mut e: GcodeError, file: u16) -> GcodeError {
+        if let Some(f) = usize::from(file)
+            .checked_sub(1)
+            .and_then(|k| self.files.get(k))
+        {
+            e.file = Some(format!("{}.ngc", f.name));
+        }
+        e
     }
 
     /// After M2/M30 in a `%` program: note it when no line from `after` on starts with `%`
@@ -376,6 +445,7 @@ pub fn line_at(program: &str, at: LinePos) -> Option<LineRef<'_>> {
     let len = memchr_newline(rest);
     let text = &program[start..start + len];
     Some(LineRef {
+        file: at.file,
         number: at.number,
         text: text.strip_suffix('\r').unwrap_or(text),
         start,
@@ -402,34 +472,15 @@ pub fn check_into(program: &str, cfg: Config, sink: &mut impl CanonSink) -> Vec<
     let mut interp = Interpreter::new(cfg);
     interp.start(sink);
     let mut errors = Vec::new();
-    let mut at = LinePos::FIRST;
-    let mut last = LineRef::default();
-    while let Some(line) = line_at(program, at) {
-        last = line;
-        at = line.next();
-        match interp.execute_line(line, sink) {
-            Ok(Flow::End) => {
-                interp.seek_closing_percent(program, at, sink);
-                return errors;
-            }
-            Ok(Flow::Continue) => {}
-            Ok(Flow::Jump(to)) => at = to,
-            Err(e) => {
-                // After a runaway loop or recursion, or enough errors, going on tells nothing
-                // more (and a loop whose counting line fails would go on for ever).
-                let hopeless = matches!(
-                    e.kind,
-                    ErrorKind::RunawayLoop(..) | ErrorKind::CallsTooDeep(_)
-                );
-                errors.push(e);
-                if hopeless || errors.len() >= MAX_CHECK_ERRORS {
-                    return errors;
-                }
-            }
-        }
-    }
-    if let Err(e) = interp.finish(last) {
+    interp.drive(program, sink, |e| {
+        // After a runaway loop or recursion, or enough errors, going on tells nothing more
+        // (and a loop whose counting line fails would go on for ever).
+        let hopeless = matches!(
+            e.kind,
+            ErrorKind::RunawayLoop(..) | ErrorKind::CallsTooDeep(_)
+        );
         errors.push(e);
-    }
+        !hopeless && errors.len() < MAX_CHECK_ERRORS
+    });
     errors
 }
