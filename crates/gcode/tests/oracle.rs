@@ -216,6 +216,11 @@ enum Item {
     /// `#<v> = [expression]` then a rapid to `X[#<v>]`: LinuxCNC's arithmetic, precedence and
     /// functions against ours.
     Expression(String),
+    /// `o<name> call [a] [b]` of one of `SUBROUTINES`, defined after the program's M2.
+    Call {
+        sub: usize,
+        args: [f64; 2],
+    },
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
@@ -280,6 +285,8 @@ struct Writer {
     tool_length_used: bool,
     /// O-word labels used so far (each loop gets its own).
     labels: u32,
+    /// Which of `SUBROUTINES` the program calls (their bodies follow M2).
+    used_subs: [bool; SUBROUTINES.len()],
 }
 
 impl Writer {
@@ -297,6 +304,7 @@ impl Writer {
             tool_length_used: false,
             rotation_used: false,
             labels: 0,
+            used_subs: [false; SUBROUTINES.len()],
         }
     }
 
@@ -758,11 +766,41 @@ impl Writer {
                 }
                 self.forget();
             }
+            Item::Call { sub, args } => {
+                let (name, _) = SUBROUTINES[*sub];
+                self.used_subs[*sub] = true;
+                self.block(
+                    deco,
+                    &format!("o<{name}> call [{}] [{}]", num(args[0]), num(args[1])),
+                );
+                // The bodies move in G91 and leave G90: restore the caller's mode.
+                if self.incremental {
+                    self.text.push_str("G91\n");
+                }
+                // The returned value (0 unless the subroutine returns one) moves X.
+                let prefix = if self.incremental { "G90 " } else { "" };
+                self.text.push_str(&format!("{prefix}G0 X[#<_value>]\n"));
+                if self.incremental {
+                    self.text.push_str("G91\n");
+                }
+                self.forget();
+            }
             Item::Comment(c) => self.block(deco, COMMENTS[*c]),
             Item::Faulty(k) => self.block(deco, FAULTY[*k]),
         }
     }
 }
+
+/// Subroutines the generated programs call, defined after M2 (LinuxCNC finds them by reading
+/// on): arguments, locals, a loop, return values through `return` and `endsub`.
+const SUBROUTINES: [(&str, &str); 3] = [
+    ("step", "#<d> = [#1 + #2]\nG91 G0 X#<d> Y[#2]\nG90\n"),
+    ("ret", "o101 if [#1 GT #2]\no<ret> return [#1 - #2]\no101 endif\n"),
+    (
+        "walk",
+        "#3 = 0\no102 while [#3 LT 3]\nG91 G0 X[#1 / 3] Z[#2 / 3]\n#3 = [#3 + 1]\no102 endwhile\nG90\n",
+    ),
+];
 
 fn render(items: &[(Item, Deco)]) -> String {
     let mut w = Writer::new();
@@ -770,6 +808,13 @@ fn render(items: &[(Item, Deco)]) -> String {
         w.item(item, deco);
     }
     w.text.push_str("M2\n");
+    for (used, (name, body)) in w.used_subs.iter().zip(SUBROUTINES) {
+        if *used {
+            let end = if name == "ret" { " [#1 * 2]" } else { "" };
+            w.text
+                .push_str(&format!("o<{name}> sub\n{body}o<{name}> endsub{end}\n"));
+        }
+    }
     w.text
 }
 
@@ -837,8 +882,10 @@ fn expression() -> impl Strategy<Value = String> {
         Just("#<_x>".to_string()),
     ];
     let tree = leaf.prop_recursive(3, 12, 2, |inner| {
+        // No `**`: it makes numbers so large (1e15 degrees) that COS and SIN of them differ in
+        // the argument reduction, the last bits of the degree conversion blown up.
         let ops = [
-            "+", "-", "*", "/", "MOD", "**", "EQ", "NE", "GT", "GE", "LT", "LE", "AND", "OR", "XOR",
+            "+", "-", "*", "/", "MOD", "EQ", "NE", "GT", "GE", "LT", "LE", "AND", "OR", "XOR",
         ];
         // No TAN: at its pole (TAN[90]) both sides return a huge number from the last bits
         // of the degree-to-radian conversion, and these differ.
@@ -998,6 +1045,8 @@ fn item() -> impl Strategy<Value = Item> {
             }
         ),
         2 => expression().prop_map(Item::Expression),
+        2 => (0..SUBROUTINES.len(), [value(20.0), value(20.0)])
+            .prop_map(|(sub, args)| Item::Call { sub, args }),
         1 => (0..COMMENTS.len()).prop_map(Item::Comment),
     ];
     // About one program in twelve ends early on an error.

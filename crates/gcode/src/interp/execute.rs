@@ -487,13 +487,15 @@ impl Interpreter {
         for (i, word) in block.axis_words().into_iter().enumerate() {
             if let Some(v) = word {
                 let old = self.state.axis_offset.0[i];
-                let new = if local {
-                    v
+                if local {
+                    self.state.pos.0[i] += old - v;
+                    self.state.axis_offset.0[i] = v;
                 } else {
-                    self.state.pos.0[i] + old - v
-                };
-                self.state.pos.0[i] += old - new;
-                self.state.axis_offset.0[i] = new;
+                    // The point reads exactly as programmed (LinuxCNC sets it, rather than
+                    // computing it back from the offset and losing digits).
+                    self.state.axis_offset.0[i] = self.state.pos.0[i] + old - v;
+                    self.state.pos.0[i] = v;
+                }
             }
         }
         self.set_offset_params(params::G92_OFFSET, self.state.axis_offset);
