@@ -17,6 +17,8 @@ use crate::plot::Trace;
 
 /// The built-in demo program (a rounded pocket outline with a helical entry).
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
+/// The demo's tool table.
+pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
 
 /// Samples after which a progress bar is shown (about a minute of machining at 1 ms).
 const PROGRESS_SAMPLES: u64 = 60_000;
@@ -89,6 +91,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         )
         .into_diagnostic()
         .wrap_err_with(|| format!("in {}", path.display()))?,
+        None if args.program.is_none() => ToolTable::parse(DEMO_TOOLS).into_diagnostic()?,
         None => ToolTable::default(),
     };
     let config = Config {
