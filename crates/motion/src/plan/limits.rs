@@ -34,6 +34,9 @@ pub struct PlanOptions {
     /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
     /// finite differences at the period (Δv/Ts² + Δa/Ts for the jerk).
     pub junction_reserve: f64,
+    /// A junction whose cap is below this share of the slower neighbour's speed limit is
+    /// passed at rest instead (cheaper than keeping the reserve on both sides).
+    pub min_junction_share: f64,
     /// Groups of segments held in the look-ahead window.
     pub window: usize,
     /// Most segments timed by one profile.
@@ -52,6 +55,7 @@ impl Default for PlanOptions {
             chord_share: 0.5,
             curvature_share: 0.5,
             junction_reserve: 0.25,
+            min_junction_share: 0.05,
             window: 64,
             max_group: 256,
             group_ratio: 0.8,
@@ -85,6 +89,7 @@ impl PlanOptions {
         unit("curvature_share", self.curvature_share, true)?;
         unit("junction_reserve", self.junction_reserve, false)?;
         unit("group_ratio", self.group_ratio, true)?;
+        unit("min_junction_share", self.min_junction_share, false)?;
         if self.window == 0 || self.max_group == 0 {
             return Err(PlanError::Option {
                 name: "window/max_group",

@@ -41,7 +41,7 @@ impl Piece {
 /// What the planner emits, in program order.
 #[derive(Debug, Clone)]
 pub enum Planned {
-    Motion(Piece),
+    Motion(Box<Piece>),
     Dwell { seconds: f64, line: u32 },
     Stop { line: u32 },
 }
@@ -146,10 +146,23 @@ impl Planner {
             Some((p, pg, p_jump)) => {
                 let (cap, jump) = match p.end {
                     Junction::Corner | Junction::Stop => (0.0, false),
-                    Junction::Tangent | Junction::Smooth => (
-                        junction_cap(&pg, &geom, &self.machine, &self.options),
-                        has_jump(&pg, &geom, &self.machine),
-                    ),
+                    Junction::Tangent | Junction::Smooth => {
+                        let cap = junction_cap(&pg, &geom, &self.machine, &self.options);
+                        let jump = has_jump(&pg, &geom, &self.machine);
+                        // A jump that allows only a crawl is cheaper as a stop: no reserve
+                        // is then kept on the two segments.
+                        let speed = |s: &Segment, g: &Geometry| {
+                            segment_limits(s, g, &self.machine, &self.options, false)
+                                .map(|l| l.limits.max_velocity())
+                        };
+                        let floor = self.options.min_junction_share
+                            * speed(&p, &pg)?.min(speed(&seg, &geom)?);
+                        if jump && cap < floor {
+                            (0.0, false)
+                        } else {
+                            (cap, jump)
+                        }
+                    }
                 };
                 self.add(p, pg, p_jump || jump, cap)?;
                 jump
@@ -333,13 +346,13 @@ impl Planner {
             offsets.push(acc);
             acc += l;
         }
-        self.out.push_back(Planned::Motion(Piece {
+        self.out.push_back(Planned::Motion(Box::new(Piece {
             segments: g.segments,
             offsets,
             lengths: g.lengths,
             profile,
             limits: g.limits,
-        }));
+        })));
         Ok(())
     }
 }
