@@ -55,6 +55,19 @@ impl Param {
                 scale: 1.0,
             };
         }
+        // Constant parametric speed (lines, circular arcs and helices): u is proportional
+        // to s, no map needed.
+        let sp = |f: f64| seg.curve.speed(a + (b - a) * f);
+        let s0 = sp(0.0);
+        if [0.25, 0.5, 0.75, 1.0]
+            .iter()
+            .all(|&f| (sp(f) - s0).abs() <= 1e-12 * s0)
+        {
+            return Param {
+                map: None,
+                scale: (b - a) / seg.length,
+            };
+        }
         match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
             Ok(m) => {
                 let scale = m.length() / seg.length;
