@@ -21,8 +21,11 @@ struct Out {
 }
 
 fn run_moves(moves: &[Move]) -> Out {
-    let machine = Machine::default_machine();
-    let pm = PlanMachine::from_machine(&machine).unwrap();
+    run_on(&Machine::default_machine(), moves)
+}
+
+fn run_on(machine: &Machine, moves: &[Move]) -> Out {
+    let pm = PlanMachine::from_machine(machine).unwrap();
     let items = build(
         moves,
         Pose::ZERO,
@@ -32,7 +35,7 @@ fn run_moves(moves: &[Move]) -> Out {
         },
     )
     .unwrap();
-    let mut verifier = Verifier::new(&pm, 0.001);
+    let mut verifier = Verifier::new(&pm, machine.motion.period_s);
     let mut samples = vec![];
     let duration = run(
         items,
@@ -361,6 +364,31 @@ fn random_program(seed: u64, n: usize) -> Vec<Move> {
         p = q;
     }
     m
+}
+
+#[test]
+fn linear_delta_lines_arcs_and_rapids() {
+    let machine = Machine::builtin("linear-delta").unwrap();
+    for pm in [
+        PathMode::ExactPath,
+        PathMode::Continuous { tolerance: None },
+    ] {
+        let m = vec![
+            mode(1, pm),
+            rapid(2, -80.0, 0.0, 20.0),
+            f(3, 6000.0),
+            feed(4, -80.0, 0.0, 0.0),
+            arc(5, [-80.0, 0.0, -10.0], [0.0, 0.0], 1),
+            feed(6, 80.0, 40.0, -10.0),
+            arc(7, [60.0, 60.0, -10.0], [60.0, 40.0], 1),
+            rapid(8, 0.0, 0.0, 0.0),
+        ];
+        let out = run_on(&machine, &m);
+        assert_within_limits(&out);
+        assert_eq!(out.samples.last().unwrap().tip, Vec3::zeros());
+    }
+    let out = run_on(&machine, &surfacing(2, 80));
+    assert_within_limits(&out);
 }
 
 proptest! {

@@ -1,10 +1,11 @@
 //! The machine as the planner sees it: for every joint, which path quantity drives it and its
 //! velocity, acceleration and jerk limits in internal units (mm, rad, s).
 //!
-//! Cartesian machines only for now: linear joints x y z follow the tool tip one to one (so a
-//! joint's derivatives along the path are the components of the tip's), extra rotary joints
-//! follow the programmed A B C linearly. Other models are refused with a typed error rather
-//! than planned with limits that are not proven.
+//! Cartesian machines: linear joints x y z follow the tool tip one to one (so a joint's
+//! derivatives along the path are the components of the tip's), extra rotary joints follow the
+//! programmed A B C linearly. Linear-delta machines (3-axis programs): the joints' derivatives
+//! along the path are taken by differences of the inverse kinematics along each segment
+//! (`numeric`). Five-axis models need the tool axis from A/B/C and are refused for now.
 
 use tezgah_kinematics::{Machine, Model};
 
@@ -26,21 +27,27 @@ pub struct PlanMachine {
     pub max_velocity: Vec<f64>,
     pub max_acceleration: Vec<f64>,
     pub max_jerk: Vec<f64>,
+    /// The model, when joint derivatives are taken by differences of its inverse.
+    pub numeric: Option<Model>,
 }
 
 impl PlanMachine {
     /// From a validated machine; refuses models whose joints are not the tip's coordinates.
     pub fn from_machine(machine: &Machine) -> Result<Self, PlanError> {
-        if !matches!(machine.kinematics, Model::Cartesian(_)) {
-            return Err(PlanError::UnsupportedKinematics {
-                kind: machine.kinematics.type_name(),
-                supported: "cartesian",
-            });
-        }
+        let numeric = match machine.kinematics {
+            Model::Cartesian(_) => None,
+            Model::LinearDelta(_) => Some(machine.kinematics.clone()),
+            _ => {
+                return Err(PlanError::UnsupportedKinematics {
+                    kind: machine.kinematics.type_name(),
+                    supported: "cartesian and linear-delta",
+                })
+            }
+        };
         let mut map = Vec::with_capacity(machine.joints.len());
         let (mut v, mut a, mut j) = (vec![], vec![], vec![]);
         for (i, joint) in machine.joints.iter().enumerate() {
-            map.push(if i < 3 {
+            map.push(if i < 3 || numeric.is_some() {
                 JointMap::Tip(i)
             } else {
                 // Cartesian extra joints are named a, b or c (kinematics README).
@@ -61,6 +68,7 @@ impl PlanMachine {
             max_velocity: v,
             max_acceleration: a,
             max_jerk: j,
+            numeric,
         })
     }
 

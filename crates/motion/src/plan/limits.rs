@@ -10,6 +10,7 @@
 //! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
 
 use tezgah_geom::{Curve, Vec3};
+use tezgah_kinematics::{Joints, Kinematics, Model, Tool, ToolPose};
 
 use super::joints::{JointMap, PlanMachine};
 use super::PlanError;
@@ -208,6 +209,10 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
             }
         }
     }
+    if let (Some(model), false) = (&machine.numeric, rotary_only) {
+        numeric_joints(seg, model, n, &mut g);
+        return g;
+    }
     for (j, m) in machine.map.iter().take(n).enumerate() {
         match *m {
             JointMap::Tip(i) => {
@@ -228,6 +233,54 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
         }
     }
     g
+}
+
+/// Joint derivatives by differences of the inverse kinematics at equal steps h along the
+/// segment (lines and arcs have constant parametric speed, so equal steps in u are equal in
+/// s): q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas at the ends.
+/// Margins cover the peaks between samples (the step turns the joint map by little).
+fn numeric_joints(seg: &Segment, model: &Model, n: usize, g: &mut Geometry) {
+    let (ua, ub) = seg.curve.domain();
+    let steps = (16 + (seg.length / 0.5).ceil() as usize).min(512);
+    let h = seg.length / steps as f64;
+    let tool = Tool::default();
+    let mut q: Vec<[f64; MAX_JOINTS]> = Vec::with_capacity(steps + 1);
+    let mut prev = Joints::zeros(n);
+    for k in 0..=steps {
+        let u = ua + (ub - ua) * k as f64 / steps as f64;
+        let tip = seg.curve.point(u);
+        // Unreachable points are the interpolator's error to report, with the line.
+        let Ok(qk) = model.inverse(&ToolPose::vertical(tip), &tool, &prev) else {
+            return;
+        };
+        prev = qk;
+        let mut row = [0.0; MAX_JOINTS];
+        row[..n].copy_from_slice(&qk.as_slice()[..n]);
+        q.push(row);
+    }
+    let m = q.len() - 1;
+    for i in 0..n {
+        let x = |k: usize| q[k][i];
+        let mut g1: f64 = 0.0;
+        let mut g2: f64 = 0.0;
+        let mut g3: f64 = 0.0;
+        for k in 0..m {
+            g1 = g1.max(((x(k + 1) - x(k)) / h).abs());
+        }
+        for k in 1..m {
+            g2 = g2.max(((x(k + 1) - 2.0 * x(k) + x(k - 1)) / (h * h)).abs());
+        }
+        for k in 1..m - 1 {
+            g3 = g3.max(((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs());
+        }
+        g.d1_start[i] = (-3.0 * x(0) + 4.0 * x(1) - x(2)) / (2.0 * h);
+        g.d1_end[i] = (3.0 * x(m) - 4.0 * x(m - 1) + x(m - 2)) / (2.0 * h);
+        g.d2_start[i] = (2.0 * x(0) - 5.0 * x(1) + 4.0 * x(2) - x(3)) / (h * h);
+        g.d2_end[i] = (2.0 * x(m) - 5.0 * x(m - 1) + 4.0 * x(m - 2) - x(m - 3)) / (h * h);
+        g.g1[i] = g1.max(g.d1_start[i].abs()).max(g.d1_end[i].abs()) * 1.01;
+        g.g2[i] = g2.max(g.d2_start[i].abs()).max(g.d2_end[i].abs()) * 1.1;
+        g.g3[i] = g3 * 1.2;
+    }
 }
 
 /// The profile limits of one segment.
