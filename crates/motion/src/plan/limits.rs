@@ -239,6 +239,8 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
 /// segment (lines and arcs have constant parametric speed, so equal steps in u are equal in
 /// s): q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas at the ends.
 /// Margins cover the peaks between samples (the step turns the joint map by little).
+// Joint i indexes several parallel arrays (rows of q, g1…g3, ends): a range loop is clearest.
+#[allow(clippy::needless_range_loop)]
 fn numeric_joints(seg: &Segment, model: &Model, n: usize, g: &mut Geometry) {
     let (ua, ub) = seg.curve.domain();
     let steps = (16 + (seg.length / 0.5).ceil() as usize).min(512);
