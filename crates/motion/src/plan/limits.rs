@@ -401,6 +401,38 @@ pub fn segment_limits(
         v = options.idle_rotary[0].min(feed);
         by = LimitedBy::Idle;
     }
+    if curved && v.is_finite() && a.is_finite() && j.is_finite() {
+        // The split above is a floor: at the speed finally chosen the curvature terms may
+        // need less than their share, and the path gets the rest:
+        // A = minᵢ (budget·Aᵢ − g2ᵢV²)/g1ᵢ, J = minᵢ (budget·Jᵢ − g3ᵢV³ − 3g2ᵢ·V·A)/g1ᵢ.
+        let rest = |aa: f64| {
+            let (mut a2, mut j2) = (f64::INFINITY, f64::INFINITY);
+            for i in 0..n {
+                let g1 = geom.g1[i];
+                if g1 > 0.0 {
+                    a2 = a2.min((budget * machine.max_acceleration[i] - geom.g2[i] * v * v) / g1);
+                    j2 = j2.min(
+                        (budget * machine.max_jerk[i]
+                            - geom.g3[i] * v * v * v
+                            - 3.0 * geom.g2[i] * v * aa)
+                            / g1,
+                    );
+                }
+            }
+            (a2, j2)
+        };
+        let (a_more, _) = rest(a);
+        let a_more = a_more.max(a);
+        let (_, j_with_more) = rest(a_more);
+        if j_with_more >= j {
+            a = a_more;
+            j = j_with_more;
+        } else {
+            // Keep the floor for A; J still gains what the curvature leaves.
+            let (_, j_floor) = rest(a);
+            j = j.max(j_floor);
+        }
+    }
     if !a.is_finite() {
         a = options.idle_rotary[1];
     }
