@@ -97,6 +97,8 @@ impl Param {
 pub struct Interpolator<'m> {
     model: &'m Model,
     map: Vec<JointMap>,
+    /// Program axes of the TCP angles, for non-Cartesian models.
+    tcp: Option<Vec<tezgah_geom::Axis>>,
     tool: Tool,
     period: f64,
     /// Next sample index.
@@ -113,6 +115,7 @@ impl<'m> Interpolator<'m> {
         Interpolator {
             model,
             map: machine.map.clone(),
+            tcp: machine.numeric.as_ref().map(|_| machine.axes.clone()),
             tool: Tool::default(),
             period,
             k: 0,
@@ -153,13 +156,20 @@ impl<'m> Interpolator<'m> {
         } else {
             [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
         };
+        let err = |source| InterpolateError::Kinematics {
+            line: seg.line,
+            source,
+        };
+        if let Some(axes) = &self.tcp {
+            let q = crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
+                .map_err(err)?;
+            self.joints = q;
+            return Ok((tip, rotary, q));
+        }
         let mut q = self
             .model
             .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints)
-            .map_err(|source| InterpolateError::Kinematics {
-                line: seg.line,
-                source,
-            })?;
+            .map_err(err)?;
         for (j, m) in self.map.iter().enumerate() {
             if let (JointMap::Rotary(r), true) = (m, j < q.len()) {
                 q[j] = rotary[*r].to_radians();
@@ -255,10 +265,15 @@ impl<'m> Interpolator<'m> {
         rotary: [f64; 3],
         line: u32,
     ) -> Result<(), InterpolateError> {
-        let q = self
-            .model
-            .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints)
-            .map_err(|source| InterpolateError::Kinematics { line, source })?;
+        let q = match &self.tcp {
+            Some(axes) => {
+                crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
+            }
+            None => self
+                .model
+                .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints),
+        }
+        .map_err(|source| InterpolateError::Kinematics { line, source })?;
         self.joints = q;
         self.last = Some(Sample {
             index: 0,

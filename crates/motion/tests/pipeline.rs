@@ -391,6 +391,51 @@ fn linear_delta_lines_arcs_and_rapids() {
     assert_within_limits(&out);
 }
 
+fn feed6(line: u32, p: [f64; 6]) -> Move {
+    mv(
+        line,
+        MoveKind::Feed {
+            end: Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]),
+        },
+    )
+}
+
+#[test]
+fn five_axis_table_ac_and_yzca() {
+    let ac = Machine::builtin("table-ac").unwrap();
+    let m = vec![
+        f(1, 3000.0),
+        feed6(2, [10.0, 10.0, 5.0, 0.0, 0.0, 0.0]),
+        feed6(3, [20.0, 0.0, 0.0, 30.0, 0.0, 90.0]),
+        mv(
+            4,
+            MoveKind::Arc(ArcMove {
+                plane: Plane::XY,
+                end: Pose::new(0.0, 20.0, 0.0, 30.0, 0.0, 90.0),
+                center: [0.0, 0.0],
+                turn: 1,
+            }),
+        ),
+        // Rotary only: the table tilts and turns under a standing tip.
+        feed6(5, [0.0, 20.0, 0.0, 45.0, 0.0, 200.0]),
+        feed6(6, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+    ];
+    let out = run_on(&ac, &m);
+    assert_within_limits(&out);
+    assert_eq!(out.samples.last().unwrap().tip, Vec3::zeros());
+
+    let yzca = Machine::builtin("yzca").unwrap();
+    let m = vec![
+        f(1, 3000.0),
+        feed(2, 50.0, 0.0, 0.0),
+        arc(3, [0.0, 50.0, -2.0], [0.0, 0.0], 1),
+        feed(4, 0.0, 80.0, -2.0),
+        arc(5, [80.0, 0.0, -2.0], [0.0, 0.0], -1),
+    ];
+    let out = run_on(&yzca, &m);
+    assert_within_limits(&out);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 12, .. ProptestConfig::default() })]
     #[test]

@@ -3,11 +3,14 @@
 //!
 //! Cartesian machines: linear joints x y z follow the tool tip one to one (so a joint's
 //! derivatives along the path are the components of the tip's), extra rotary joints follow the
-//! programmed A B C linearly. Linear-delta machines (3-axis programs): the joints' derivatives
-//! along the path are taken by differences of the inverse kinematics along each segment
-//! (`numeric`). Five-axis models need the tool axis from A/B/C and are refused for now.
+//! programmed A B C linearly. Every other model (delta, trunnions, Y-Z-C-A): the joints are
+//! the tool-centre-point inverse of the program pose (tip + the model's program angles, see
+//! `tezgah_kinematics::tcp`), and their derivatives along the path are taken by differences
+//! of that map along each segment (`numeric`).
 
-use tezgah_kinematics::{Machine, Model};
+use tezgah_geom::{Axis, Pose, Vec3};
+use tezgah_kinematics::tcp::ProgramPose;
+use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, Tool};
 
 use super::PlanError;
 
@@ -27,8 +30,10 @@ pub struct PlanMachine {
     pub max_velocity: Vec<f64>,
     pub max_acceleration: Vec<f64>,
     pub max_jerk: Vec<f64>,
-    /// The model, when joint derivatives are taken by differences of its inverse.
+    /// The model, when joints come from its tool-centre-point inverse (not Cartesian).
     pub numeric: Option<Model>,
+    /// The program axes carrying the model's TCP angles (`Machine::tcp_axes`).
+    pub axes: Vec<Axis>,
 }
 
 impl PlanMachine {
@@ -36,13 +41,16 @@ impl PlanMachine {
     pub fn from_machine(machine: &Machine) -> Result<Self, PlanError> {
         let numeric = match machine.kinematics {
             Model::Cartesian(_) => None,
-            Model::LinearDelta(_) => Some(machine.kinematics.clone()),
-            _ => {
-                return Err(PlanError::UnsupportedKinematics {
+            _ => Some(machine.kinematics.clone()),
+        };
+        let axes = match numeric {
+            Some(_) => machine
+                .tcp_axes()
+                .map_err(|_| PlanError::UnsupportedKinematics {
                     kind: machine.kinematics.type_name(),
-                    supported: "cartesian and linear-delta",
-                })
-            }
+                    supported: "machines whose rotary joints carry program axes",
+                })?,
+            None => vec![],
         };
         let mut map = Vec::with_capacity(machine.joints.len());
         let (mut v, mut a, mut j) = (vec![], vec![], vec![]);
@@ -69,10 +77,24 @@ impl PlanMachine {
             max_acceleration: a,
             max_jerk: j,
             numeric,
+            axes,
         })
     }
 
     pub fn joint_count(&self) -> usize {
         self.map.len()
     }
+}
+
+/// Joints of a non-Cartesian machine for the tip (mm) and A B C (degrees), nearest `previous`.
+pub fn tcp_joints(
+    model: &Model,
+    axes: &[Axis],
+    tip: &Vec3,
+    rotary: &[f64; 3],
+    previous: &Joints,
+) -> Result<Joints, KinematicsError> {
+    let pose = Pose::new(tip.x, tip.y, tip.z, rotary[0], rotary[1], rotary[2]);
+    let p = ProgramPose::from_program(&pose, axes)?;
+    model.tcp_inverse(&p.tip, &p.angles, &Tool::default(), previous)
 }

@@ -9,10 +9,11 @@
 //! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
 //! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
 
+use tezgah_geom::Axis;
 use tezgah_geom::{Curve, Vec3};
-use tezgah_kinematics::{Joints, Kinematics, Model, Tool, ToolPose};
+use tezgah_kinematics::{Joints, Model};
 
-use super::joints::{JointMap, PlanMachine};
+use super::joints::{tcp_joints, JointMap, PlanMachine};
 use super::PlanError;
 use crate::path::{Segment, SegmentFeed};
 use crate::profile::Limits;
@@ -140,7 +141,7 @@ fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
 
 /// Samples the tip path (tangent, curvature vector and its derivative by differences of the
 /// curvature vector between samples) and maps it onto the joints.
-pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
+pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
     let n = machine.joint_count().min(MAX_JOINTS);
     let rotary_only = seg.rotary_only();
     let length = if rotary_only {
@@ -154,7 +155,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
         ..Geometry::default()
     };
     if length <= 0.0 {
-        return g;
+        return Ok(g);
     }
     let rot_rate = |k: usize| (seg.rotary[1][k] - seg.rotary[0][k]).to_radians() / length;
     // Tip samples.
@@ -209,9 +210,9 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
             }
         }
     }
-    if let (Some(model), false) = (&machine.numeric, rotary_only) {
-        numeric_joints(seg, model, n, &mut g);
-        return g;
+    if let Some(model) = &machine.numeric {
+        numeric_joints(seg, model, &machine.axes, n, &mut g)?;
+        return Ok(g);
     }
     for (j, m) in machine.map.iter().take(n).enumerate() {
         match *m {
@@ -232,7 +233,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
             }
         }
     }
-    g
+    Ok(g)
 }
 
 /// Joint derivatives by differences of the inverse kinematics at equal steps h along the
@@ -241,19 +242,34 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Geometry {
 /// Margins cover the peaks between samples (the step turns the joint map by little).
 // Joint i indexes several parallel arrays (rows of q, g1…g3, ends): a range loop is clearest.
 #[allow(clippy::needless_range_loop)]
-fn numeric_joints(seg: &Segment, model: &Model, n: usize, g: &mut Geometry) {
+fn numeric_joints(
+    seg: &Segment,
+    model: &Model,
+    axes: &[Axis],
+    n: usize,
+    g: &mut Geometry,
+) -> Result<(), PlanError> {
     let (ua, ub) = seg.curve.domain();
-    let steps = (16 + (seg.length / 0.5).ceil() as usize).min(512);
-    let h = seg.length / steps as f64;
-    let tool = Tool::default();
+    let length = g.length;
+    let steps = (16 + (length / 0.5).ceil() as usize).min(512);
+    let h = length / steps as f64;
+    let [r0, r1] = seg.rotary;
+    let at = |f: f64| {
+        let tip = if g.rotary_only {
+            seg.curve.point(ua)
+        } else {
+            seg.curve.point(ua + (ub - ua) * f)
+        };
+        (tip, [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f))
+    };
     let mut q: Vec<[f64; MAX_JOINTS]> = Vec::with_capacity(steps + 1);
     let mut prev = Joints::zeros(n);
     for k in 0..=steps {
-        let u = ua + (ub - ua) * k as f64 / steps as f64;
-        let tip = seg.curve.point(u);
+        let f = k as f64 / steps as f64;
+        let (tip, rot) = at(f);
         // Unreachable points are the interpolator's error to report, with the line.
-        let Ok(qk) = model.inverse(&ToolPose::vertical(tip), &tool, &prev) else {
-            return;
+        let Ok(qk) = tcp_joints(model, axes, &tip, &rot, &prev) else {
+            return Ok(());
         };
         prev = qk;
         let mut row = [0.0; MAX_JOINTS];
@@ -263,6 +279,28 @@ fn numeric_joints(seg: &Segment, model: &Model, n: usize, g: &mut Geometry) {
     let m = q.len() - 1;
     for i in 0..n {
         let x = |k: usize| q[k][i];
+        // A joint that jumps (a path through a singular pose, e.g. the C axis centre of a
+        // Y-Z-C-A machine) has no speed that keeps it in its limits: halving the step around
+        // the largest change must halve it, as for any smooth joint.
+        let k = (0..m)
+            .max_by(|&a, &b| (x(a + 1) - x(a)).abs().total_cmp(&(x(b + 1) - x(b)).abs()))
+            .unwrap_or(0);
+        let big = (x(k + 1) - x(k)).abs();
+        if big > 1e-9 {
+            let mut before = Joints::zeros(n);
+            before.as_mut_slice().copy_from_slice(&q[k][..n]);
+            let (tip, rot) = at((k as f64 + 0.5) / steps as f64);
+            if let Ok(mid) = tcp_joints(model, axes, &tip, &rot, &before) {
+                let half = (mid[i] - x(k)).abs().max((x(k + 1) - mid[i]).abs());
+                if half > 0.9 * big {
+                    return Err(PlanError::JointJump {
+                        line: seg.line,
+                        joint: i,
+                        jump: big,
+                    });
+                }
+            }
+        }
         let mut g1: f64 = 0.0;
         let mut g2: f64 = 0.0;
         let mut g3: f64 = 0.0;
@@ -283,6 +321,7 @@ fn numeric_joints(seg: &Segment, model: &Model, n: usize, g: &mut Geometry) {
         g.g2[i] = g2.max(g.d2_start[i].abs()).max(g.d2_end[i].abs()) * 1.1;
         g.g3[i] = g3 * 1.2;
     }
+    Ok(())
 }
 
 /// The profile limits of one segment.

@@ -138,7 +138,7 @@ impl Planner {
     }
 
     fn push_segment(&mut self, seg: Segment) -> Result<(), PlanError> {
-        let geom = analyse(&seg, &self.machine);
+        let geom = analyse(&seg, &self.machine)?;
         if geom.length <= 0.0 {
             return Ok(());
         }

@@ -29,6 +29,11 @@ pub enum PlanError {
         line: u32,
         source: crate::profile::ProfileError,
     },
+    #[error(
+        "line {line}: joint {joint} jumps by {jump} (internal units) along the move: the path \
+         passes through a singular pose of the machine"
+    )]
+    JointJump { line: u32, joint: usize, jump: f64 },
     #[error("bad planner option {name}: {value}")]
     Option { name: &'static str, value: f64 },
 }
