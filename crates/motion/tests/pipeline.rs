@@ -423,6 +423,9 @@ fn five_axis_table_ac_and_yzca() {
     let out = run_on(&ac, &m);
     assert_within_limits(&out);
     assert_eq!(out.samples.last().unwrap().tip, Vec3::zeros());
+    // The rotary joints really moved, and one of them works near its limits.
+    assert!(out.report.joints[3].velocity > 0.0 && out.report.joints[4].velocity > 0.0);
+    assert!(out.report.joints.iter().any(|j| j.worst_ratio() > 0.9));
 
     let yzca = Machine::builtin("yzca").unwrap();
     let m = vec![
@@ -434,6 +437,29 @@ fn five_axis_table_ac_and_yzca() {
     ];
     let out = run_on(&yzca, &m);
     assert_within_limits(&out);
+}
+
+#[test]
+fn a_path_through_a_singular_pose_is_refused() {
+    let yzca = Machine::builtin("yzca").unwrap();
+    let pm = PlanMachine::from_machine(&yzca).unwrap();
+    let m = vec![
+        f(1, 3000.0),
+        feed(2, 0.0, 0.0, -1.0),
+        // Leaving the C axis sideways: C, undefined on the axis, must turn 45° at once.
+        feed(3, 30.0, 30.0, -1.0),
+    ];
+    let items = build(&m, Pose::ZERO, DirectOptions::default()).unwrap();
+    let r = run(
+        items,
+        &yzca.kinematics,
+        pm,
+        PlanOptions::default(),
+        (Vec3::zeros(), [0.0; 3]),
+        |_, _| {},
+    );
+    let e = r.unwrap_err().to_string();
+    assert!(e.contains("line 3") && e.contains("singular"), "{e}");
 }
 
 proptest! {
