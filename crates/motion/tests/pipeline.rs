@@ -470,3 +470,46 @@ proptest! {
         assert_within_limits(&out);
     }
 }
+
+#[test]
+fn planner_streams_with_bounded_memory() {
+    use tezgah_motion::plan::{Planned, Planner};
+    let machine = Machine::default_machine();
+    let options = PlanOptions::default();
+    let bound = options.window * options.max_group + 2;
+    let mut planner = Planner::new(PlanMachine::from_machine(&machine).unwrap(), options).unwrap();
+    let mut direct = tezgah_motion::path::direct::Direct::new(Pose::ZERO, DirectOptions::default());
+    let (mut pushed, mut emitted, mut most_held) = (0usize, 0usize, 0usize);
+    let mut items = vec![];
+    direct.push(&f(1, 3000.0), &mut items).unwrap();
+    for k in 0..20_000u32 {
+        // A gentle zig-zag of 0.2 mm moves (kinks of ~0.02 rad: passed at speed in G64).
+        let x = 0.2 * (k + 1) as f64;
+        let y = if k % 2 == 0 { 0.0 } else { 0.004 };
+        direct.push(&feed(2 + k, x, y, 0.0), &mut items).unwrap();
+        for item in items.drain(..) {
+            pushed += 1;
+            planner.push(item).unwrap();
+        }
+        while let Some(p) = planner.pop() {
+            if let Planned::Motion(piece) = p {
+                emitted += piece.segments.len();
+            }
+        }
+        most_held = most_held.max(pushed - emitted);
+    }
+    assert!(emitted > 15_000, "planned while streaming: {emitted}");
+    assert!(most_held <= bound, "held {most_held} > {bound}");
+    direct.finish(&mut items);
+    for item in items.drain(..) {
+        pushed += 1;
+        planner.push(item).unwrap();
+    }
+    planner.finish().unwrap();
+    while let Some(p) = planner.pop() {
+        if let Planned::Motion(piece) = p {
+            emitted += piece.segments.len();
+        }
+    }
+    assert_eq!(emitted, pushed);
+}
