@@ -17,6 +17,8 @@ pub enum DirectError {
     FeedPerRevolution { line: u32 },
     #[error("line {line}: bad arc: {reason}")]
     BadArc { line: u32, reason: String },
+    #[error("line {line}: dwell of {seconds} s is not a finite, non-negative time")]
+    BadDwell { line: u32, seconds: f64 },
     #[error("line {line}: position is not finite")]
     NotFinite { line: u32 },
 }
@@ -148,11 +150,11 @@ impl Direct {
                 return Ok(());
             }
             MoveKind::Dwell { seconds } => {
+                if !(seconds.is_finite() && seconds >= 0.0) {
+                    return Err(DirectError::BadDwell { line, seconds });
+                }
                 self.flush(Junction::Stop, out);
-                out.push(PathItem::Dwell {
-                    seconds: seconds.max(0.0),
-                    line,
-                });
+                out.push(PathItem::Dwell { seconds, line });
                 return Ok(());
             }
             MoveKind::Stop(kind) => {

@@ -111,6 +111,9 @@ impl Planner {
         match item {
             PathItem::Segment(seg) => self.push_segment(seg),
             PathItem::Dwell { seconds, line } => {
+                if !(seconds.is_finite() && seconds >= 0.0) {
+                    return Err(PlanError::BadDwell { line, seconds });
+                }
                 self.end_here()?;
                 self.window.push_back(Entry::Dwell { seconds, line });
                 self.commit_full()

@@ -34,6 +34,8 @@ pub enum PlanError {
          passes through a singular pose of the machine"
     )]
     JointJump { line: u32, joint: usize, jump: f64 },
+    #[error("line {line}: dwell of {seconds} s is not a finite, non-negative time")]
+    BadDwell { line: u32, seconds: f64 },
     #[error("bad planner option {name}: {value}")]
     Option { name: &'static str, value: f64 },
 }
