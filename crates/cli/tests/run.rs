@@ -95,3 +95,29 @@ fn errors_are_reported_not_panics() {
     let out = tezgah().args(["run", "--period", "0"]).output().unwrap();
     assert!(!out.status.success());
 }
+
+#[test]
+fn five_axis_example_on_table_ac_holds_limits() {
+    let json = tmp("r5.json");
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/five-axis.ngc");
+    let out = tezgah()
+        .args(["run", program, "--machine", "table-ac", "--report"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let joints = report["joints"].as_array().unwrap();
+    assert_eq!(joints.len(), 5);
+    assert_eq!(joints[4]["unit"], "deg");
+    assert!(
+        joints[4]["peak_velocity"].as_f64().unwrap() > 1.0,
+        "C turns"
+    );
+}
