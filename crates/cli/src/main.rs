@@ -3,6 +3,8 @@
 //! Every command is a thin shell over a library call; see the README for the commands.
 
 mod diagnostics;
+mod plot;
+mod run;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -36,6 +38,34 @@ enum Command {
         #[arg(long)]
         tool_table: Option<PathBuf>,
     },
+    /// Plan and run a program on a machine model: samples, report, plots and a summary.
+    Run {
+        /// The G-code program (default: the built-in demo).
+        program: Option<PathBuf>,
+        /// A built-in machine name (see `tezgah machines`) or a machine file.
+        #[arg(long)]
+        machine: Option<String>,
+        /// Write every sample to this CSV file.
+        #[arg(long)]
+        samples: Option<PathBuf>,
+        /// Write the verification report to this JSON file.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// Write plots (SVG and PNG) of feed and joint v/a/j into this directory.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Interpolation period, s (default: the machine file's `period_s`).
+        #[arg(long)]
+        period: Option<f64>,
+        /// Path tolerance, mm (default: the machine file's `tolerance_mm`; G64 P overrides).
+        #[arg(long)]
+        tolerance: Option<f64>,
+        /// A tool table in LinuxCNC's format.
+        #[arg(long)]
+        tool_table: Option<PathBuf>,
+    },
+    /// List the built-in machine definitions.
+    Machines,
 }
 
 fn main() -> ExitCode {
@@ -49,6 +79,26 @@ fn main() -> ExitCode {
             program,
             tool_table,
         } => check(&program, tool_table.as_deref()),
+        Command::Run {
+            program,
+            machine,
+            samples,
+            report,
+            plot,
+            period,
+            tolerance,
+            tool_table,
+        } => run::run(run::RunArgs {
+            program,
+            machine,
+            samples,
+            report,
+            plot,
+            period,
+            tolerance,
+            tool_table,
+        }),
+        Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
     match result {
         Ok(code) => code,

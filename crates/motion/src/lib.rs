@@ -1,11 +1,15 @@
 //! tezgah-motion: path building, jerk-limited feed planning and interpolation.
 //!
-//! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. So far it
-//! holds the time-optimal jerk-limited 1-D [`profile`] along a path; look-ahead, interpolation
-//! and the run loop build on it.
+//! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. Stages:
+//! [`path`] (moves → segments), [`plan`] (speed limits, look-ahead, one [`profile`] per group of
+//! segments), [`interpolate`] (samples at the period, joints by inverse kinematics) and
+//! [`verify`] (the post-run replay).
 
+pub mod interpolate;
 pub mod path;
+pub mod plan;
 pub mod profile;
+pub mod verify;
 
 pub use path::{Junction, PathItem, Segment, SegmentFeed};
 pub use profile::{solve, Limits, Profile, ProfileError, State};

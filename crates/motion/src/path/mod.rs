@@ -4,6 +4,7 @@
 //! segments of the tool-tip path with their feed and junction kinds, smoothing where the
 //! program allows. The feed planner reads only this module's types, never G-code.
 
+pub mod direct;
 pub mod segment;
 
 pub use segment::{Junction, PathItem, Segment, SegmentFeed};

@@ -1,0 +1,313 @@
+//! `tezgah run` and `tezgah machines`: wires gcode → motion (direct path, plan, interpolate,
+//! verify) → the samples CSV, the report JSON, plots and the terminal summary.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use miette::{miette, IntoDiagnostic, Result, WrapErr};
+use tezgah_gcode::{Config, ToolTable};
+use tezgah_geom::{Pose, Vec3};
+use tezgah_kinematics::{builtin_names, Machine};
+use tezgah_motion::interpolate::{run as run_items, Sample};
+use tezgah_motion::path::direct::{build, DirectOptions};
+use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::verify::{Report, Verifier};
+
+use crate::plot::Trace;
+
+/// The built-in demo program (a rounded pocket outline with a helical entry).
+pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
+/// The demo's tool table.
+pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
+
+/// Samples after which a progress bar is shown (about a minute of machining at 1 ms).
+const PROGRESS_SAMPLES: u64 = 60_000;
+
+pub struct RunArgs {
+    pub program: Option<PathBuf>,
+    pub machine: Option<String>,
+    pub samples: Option<PathBuf>,
+    pub report: Option<PathBuf>,
+    pub plot: Option<PathBuf>,
+    pub period: Option<f64>,
+    pub tolerance: Option<f64>,
+    pub tool_table: Option<PathBuf>,
+}
+
+/// A machine by built-in name or file path.
+pub fn load_machine(spec: Option<&str>) -> Result<Machine> {
+    match spec {
+        None => Ok(Machine::default_machine()),
+        Some(s) if builtin_names().any(|n| n == s) => Machine::builtin(s).into_diagnostic(),
+        Some(s) => Machine::from_file(s)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("machine {s}")),
+    }
+}
+
+/// `tezgah machines`.
+pub fn machines() -> Result<()> {
+    for name in builtin_names() {
+        let m = Machine::builtin(name).into_diagnostic()?;
+        let joints: Vec<&str> = m.joints.iter().map(|j| j.name.as_str()).collect();
+        let default = if name == "mill3" { " (default)" } else { "" };
+        println!(
+            "{name:<14} {:<13} joints {}{default}",
+            m.kinematics.type_name(),
+            joints.join(" ")
+        );
+    }
+    Ok(())
+}
+
+fn unit(machine: &Machine, i: usize) -> (&'static str, f64) {
+    let j = &machine.joints[i];
+    if j.to_internal() == 1.0 {
+        ("mm", 1.0)
+    } else {
+        ("deg", 1.0 / j.to_internal())
+    }
+}
+
+pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
+    let machine = load_machine(args.machine.as_deref())?;
+    let (name, text) = match &args.program {
+        Some(p) => (
+            p.display().to_string(),
+            String::from_utf8_lossy(
+                &std::fs::read(p)
+                    .into_diagnostic()
+                    .wrap_err_with(|| format!("cannot read {}", p.display()))?,
+            )
+            .into_owned(),
+        ),
+        None => ("built-in demo".to_owned(), DEMO.to_owned()),
+    };
+    let table = match &args.tool_table {
+        Some(path) => ToolTable::parse(
+            &std::fs::read_to_string(path)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot read {}", path.display()))?,
+        )
+        .into_diagnostic()
+        .wrap_err_with(|| format!("in {}", path.display()))?,
+        None if args.program.is_none() => ToolTable::parse(DEMO_TOOLS).into_diagnostic()?,
+        None => ToolTable::default(),
+    };
+    let config = Config {
+        tool_table: table,
+        ..Config::default()
+    };
+    let moves = match tezgah_gcode::program_moves(&text, config) {
+        Ok(m) => m,
+        Err(e) => {
+            let path = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
+            eprintln!("{:?}", crate::diagnostics::report(&path, &text, &e));
+            return Ok(std::process::ExitCode::FAILURE);
+        }
+    };
+    let period = args.period.unwrap_or(machine.motion.period_s);
+    if !(period > 0.0 && period.is_finite()) {
+        return Err(miette!("--period must be > 0, got {period}"));
+    }
+    let tolerance = args.tolerance.unwrap_or(machine.motion.tolerance_mm);
+    if !(tolerance > 0.0 && tolerance.is_finite()) {
+        return Err(miette!("--tolerance must be > 0, got {tolerance}"));
+    }
+    let start = Pose::ZERO;
+    let items = build(
+        &moves,
+        start,
+        DirectOptions {
+            tolerance,
+            ..DirectOptions::default()
+        },
+    )
+    .map_err(|e| miette!("{e}"))?;
+    let segments = items
+        .iter()
+        .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
+        .count();
+    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
+    let options = PlanOptions {
+        period,
+        ..PlanOptions::default()
+    };
+
+    let mut csv = match &args.samples {
+        Some(p) => {
+            let f = std::fs::File::create(p)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("cannot write {}", p.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            let names: Vec<&str> = machine.joints.iter().map(|j| j.name.as_str()).collect();
+            writeln!(w, "t,line,{},tip_x,tip_y,tip_z", names.join(",")).into_diagnostic()?;
+            Some(w)
+        }
+        None => None,
+    };
+    let scales: Vec<f64> = (0..machine.joints.len())
+        .map(|i| unit(&machine, i).1)
+        .collect();
+    let mut verifier = Verifier::new(&pm, period);
+    let mut trace = args.plot.as_ref().map(|_| Trace::new(machine.joints.len()));
+    let bar = indicatif::ProgressBar::hidden();
+    let mut write_error: Option<std::io::Error> = None;
+    let mut count: u64 = 0;
+    let mut line_buf = String::with_capacity(256);
+    let sink = |s: &Sample, seg: Option<&std::sync::Arc<tezgah_motion::Segment>>| {
+        verifier.push(s, seg);
+        if let Some(t) = trace.as_mut() {
+            t.push(s, &scales);
+        }
+        if let Some(w) = csv.as_mut() {
+            use std::fmt::Write as _;
+            line_buf.clear();
+            let _ = write!(line_buf, "{},{}", s.t, s.line);
+            for (i, q) in s.joints.as_slice().iter().enumerate() {
+                let _ = write!(line_buf, ",{:.12}", q * scales[i]);
+            }
+            let _ = write!(line_buf, ",{:.12},{:.12},{:.12}", s.tip.x, s.tip.y, s.tip.z);
+            if let Err(e) = writeln!(w, "{line_buf}") {
+                write_error.get_or_insert(e);
+            }
+        }
+        count += 1;
+        if count == PROGRESS_SAMPLES {
+            bar.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            bar.set_style(
+                indicatif::ProgressStyle::with_template("{spinner} {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+            );
+        }
+        if count % 10_000 == 0 && count >= PROGRESS_SAMPLES {
+            bar.set_message(format!("{:.1} s of machining planned", s.t));
+            bar.tick();
+        }
+    };
+    let start_tip = Vec3::from(start.xyz());
+    let duration = run_items(
+        items,
+        &machine.kinematics,
+        pm,
+        options,
+        (start_tip, [start.0[3], start.0[4], start.0[5]]),
+        sink,
+    )
+    .map_err(|e| miette!("{e}"))?;
+    bar.finish_and_clear();
+    if let Some(e) = write_error {
+        return Err(e).into_diagnostic().wrap_err("writing the samples");
+    }
+    if let Some(mut w) = csv {
+        w.flush().into_diagnostic()?;
+    }
+    let report = verifier.finish();
+    if let Some(p) = &args.report {
+        let json = report_json(&machine, &report, duration, &name, period, tolerance);
+        std::fs::write(
+            p,
+            serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
+        )
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", p.display()))?;
+    }
+    if let (Some(dir), Some(t)) = (&args.plot, &trace) {
+        std::fs::create_dir_all(dir).into_diagnostic()?;
+        let names: Vec<String> = machine.joints.iter().map(|j| j.name.clone()).collect();
+        let files = crate::plot::write_all(dir, t, &names, period).map_err(|e| miette!("{e}"))?;
+        println!("plots: {} files in {}", files, dir.display());
+    }
+    summary(
+        &machine, &report, duration, &name, segments, period, tolerance,
+    );
+    let over =
+        report.joints.iter().any(|j| j.worst_ratio() > 1.005) || report.max_deviation > tolerance;
+    Ok(if over {
+        std::process::ExitCode::FAILURE
+    } else {
+        std::process::ExitCode::SUCCESS
+    })
+}
+
+fn report_json(
+    machine: &Machine,
+    r: &Report,
+    duration: f64,
+    program: &str,
+    period: f64,
+    tolerance: f64,
+) -> serde_json::Value {
+    let joints: Vec<serde_json::Value> = r
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let (u, k) = unit(machine, i);
+            serde_json::json!({
+                "name": machine.joints[i].name,
+                "unit": u,
+                "peak_velocity": p.velocity * k,
+                "max_velocity": p.max_velocity * k,
+                "peak_velocity_line": p.velocity_line,
+                "peak_acceleration": p.acceleration * k,
+                "max_acceleration": p.max_acceleration * k,
+                "peak_acceleration_line": p.acceleration_line,
+                "peak_jerk": p.jerk * k,
+                "max_jerk": p.max_jerk * k,
+                "peak_jerk_line": p.jerk_line,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "program": program,
+        "machine": machine.name,
+        "period_s": period,
+        "tolerance_mm": tolerance,
+        "cycle_time_s": r.cycle_time,
+        "duration_s": duration,
+        "samples": r.samples,
+        "max_deviation_mm": r.max_deviation,
+        "max_deviation_line": r.max_deviation_line,
+        "joints": joints,
+        "worst_lines": r.worst_lines.iter().map(|(l, x)| serde_json::json!({"line": l, "peak_over_limit": x})).collect::<Vec<_>>(),
+    })
+}
+
+fn summary(
+    machine: &Machine,
+    r: &Report,
+    duration: f64,
+    program: &str,
+    segments: usize,
+    period: f64,
+    tolerance: f64,
+) {
+    println!(
+        "{program} on {} ({}), period {} ms, tolerance {} mm",
+        machine.name,
+        machine.kinematics.type_name(),
+        period * 1e3,
+        tolerance
+    );
+    println!(
+        "cycle time {:.3} s ({} samples, duration {:.6} s), {} segments",
+        r.cycle_time, r.samples, duration, segments
+    );
+    println!("joint   peak v (% of limit)   peak a (%)   peak j (%)");
+    for (i, p) in r.joints.iter().enumerate() {
+        println!(
+            "{:<6} {:>8.1}%  {:>10.1}%  {:>10.1}%",
+            machine.joints[i].name,
+            100.0 * p.velocity / p.max_velocity,
+            100.0 * p.acceleration / p.max_acceleration,
+            100.0 * p.jerk / p.max_jerk
+        );
+    }
+    println!(
+        "max deviation {:.2e} mm (line {}), within tolerance: {}",
+        r.max_deviation,
+        r.max_deviation_line,
+        r.max_deviation <= tolerance
+    );
+}

@@ -1,0 +1,123 @@
+//! `tezgah run` and `tezgah machines` end to end through the binary: the demo on the default
+//! machine, the samples CSV and report JSON per DESIGN.md's contract, plots, and errors.
+
+use std::process::Command;
+
+fn tezgah() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tezgah"))
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("tezgah-run-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+#[test]
+fn demo_run_writes_samples_report_and_plots() {
+    let (csv, json, plots) = (tmp("s.csv"), tmp("r.json"), tmp("plots"));
+    let out = tezgah()
+        .args(["run", "--samples"])
+        .arg(&csv)
+        .arg("--report")
+        .arg(&json)
+        .arg("--plot")
+        .arg(&plots)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("cycle time"), "{stdout}");
+    assert!(stdout.contains("max deviation"), "{stdout}");
+
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next().unwrap(), "t,line,x,y,z,tip_x,tip_y,tip_z");
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    for (k, r) in rows.iter().enumerate() {
+        assert_eq!(r[0], k as f64 * 0.001, "row {k} time");
+        assert_eq!(r.len(), 8);
+    }
+    // First and last rows at rest at the same place (the demo returns home with G28).
+    assert_eq!(rows[0][2..], rows.last().unwrap()[2..]);
+
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(
+        report["cycle_time_s"].as_f64().unwrap(),
+        rows.last().unwrap()[0]
+    );
+    assert_eq!(report["samples"].as_u64().unwrap() as usize, rows.len());
+    let d = report["duration_s"].as_f64().unwrap();
+    assert!(d <= report["cycle_time_s"].as_f64().unwrap() && d > 1.0);
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
+    for j in report["joints"].as_array().unwrap() {
+        for q in ["velocity", "acceleration", "jerk"] {
+            let peak = j[format!("peak_{q}")].as_f64().unwrap();
+            let max = j[format!("max_{q}")].as_f64().unwrap();
+            assert!(peak > 0.0 && peak <= 1.005 * max, "{j}");
+        }
+    }
+    for name in ["feed.svg", "feed.png", "x_jerk.svg", "z_acceleration.png"] {
+        assert!(plots.join(name).exists(), "{name}");
+    }
+}
+
+#[test]
+fn machines_lists_the_builtins() {
+    let out = tezgah().arg("machines").output().unwrap();
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    for name in ["mill3", "yzca", "table-ac", "table-bc", "linear-delta"] {
+        assert!(s.contains(name), "{s}");
+    }
+}
+
+#[test]
+fn errors_are_reported_not_panics() {
+    let bad = tmp("bad.ngc");
+    std::fs::write(&bad, "G1 X10 F100\nG2 X5 Y5 R0.1\n").unwrap();
+    let out = tezgah().arg("run").arg(&bad).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    let out = tezgah()
+        .args(["run", "--machine", "no-such-machine"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let out = tezgah().args(["run", "--period", "0"]).output().unwrap();
+    assert!(!out.status.success());
+}
+
+#[test]
+fn five_axis_example_on_table_ac_holds_limits() {
+    let json = tmp("r5.json");
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/five-axis.ngc");
+    let out = tezgah()
+        .args(["run", program, "--machine", "table-ac", "--report"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let joints = report["joints"].as_array().unwrap();
+    assert_eq!(joints.len(), 5);
+    assert_eq!(joints[4]["unit"], "deg");
+    assert!(
+        joints[4]["peak_velocity"].as_f64().unwrap() > 1.0,
+        "C turns"
+    );
+}

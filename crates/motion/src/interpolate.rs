@@ -1,0 +1,340 @@
+//! Interpolation at the servo period: planned pieces in, one [`Sample`] every Ts out — time,
+//! source line, tool tip (workpiece frame, mm), rotary axes and joints (through the machine's
+//! inverse kinematics). Sits between the planner and the sinks (file, `verify`, executor).
+//!
+//! Sample k is at t = k·Ts exactly; a piece starts where the previous one ended (durations are
+//! summed, never rounded to the grid, so time does not drift), and the final sample, at the
+//! first grid time at or after the end, holds the final position. Dwells hold the position.
+
+use std::sync::Arc;
+
+use tezgah_geom::{ArcLengthMap, Curve, Vec3};
+use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Model, Tool, ToolPose};
+
+use crate::path::Segment;
+use crate::plan::{JointMap, PlanMachine, Planned};
+
+/// Why interpolation failed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum InterpolateError {
+    #[error("line {line}: kinematics: {source}")]
+    Kinematics { line: u32, source: KinematicsError },
+}
+
+/// One set-point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// Sample index k; t = k·Ts.
+    pub index: u64,
+    pub t: f64,
+    /// 1-based source line of the block being executed.
+    pub line: u32,
+    /// Tool tip, workpiece frame, mm.
+    pub tip: Vec3,
+    /// A B C, degrees.
+    pub rotary: [f64; 3],
+    /// Joints in internal units (mm, rad), machine-file order.
+    pub joints: Joints,
+    /// Path speed (mm/s, or deg/s on a rotary-only move).
+    pub feed: f64,
+}
+
+/// s → u on one segment: identity for arc-length parametrised curves (lines), otherwise an
+/// arc-length map built once per segment.
+struct Param {
+    map: Option<ArcLengthMap>,
+    scale: f64,
+}
+
+impl Param {
+    fn new(seg: &Segment) -> Param {
+        let (a, b) = seg.curve.domain();
+        if seg.rotary_only() || (a == 0.0 && b == seg.length) {
+            return Param {
+                map: None,
+                scale: 1.0,
+            };
+        }
+        // Constant parametric speed (lines, circular arcs and helices): u is proportional
+        // to s, no map needed.
+        let sp = |f: f64| seg.curve.speed(a + (b - a) * f);
+        let s0 = sp(0.0);
+        if [0.25, 0.5, 0.75, 1.0]
+            .iter()
+            .all(|&f| (sp(f) - s0).abs() <= 1e-12 * s0)
+        {
+            return Param {
+                map: None,
+                scale: (b - a) / seg.length,
+            };
+        }
+        match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
+            Ok(m) => {
+                let scale = m.length() / seg.length;
+                Param {
+                    map: Some(m),
+                    scale,
+                }
+            }
+            // Fall back to a parameter proportional to length (exact for constant-speed arcs).
+            Err(_) => Param {
+                map: None,
+                scale: (b - a) / seg.length,
+            },
+        }
+    }
+
+    fn u(&self, seg: &Segment, s: f64) -> f64 {
+        let (a, _) = seg.curve.domain();
+        match &self.map {
+            Some(m) => m.u_at(&*seg.curve, s * self.scale),
+            None => a + s * self.scale,
+        }
+    }
+}
+
+/// The interpolator: feed it planned items, it calls the sink for every sample.
+pub struct Interpolator<'m> {
+    model: &'m Model,
+    map: Vec<JointMap>,
+    /// Program axes of the TCP angles, for non-Cartesian models.
+    tcp: Option<Vec<tezgah_geom::Axis>>,
+    tool: Tool,
+    period: f64,
+    /// Next sample index.
+    k: u64,
+    /// Time at which the next item starts.
+    t0: f64,
+    last: Option<Sample>,
+    joints: Joints,
+}
+
+impl<'m> Interpolator<'m> {
+    /// `start` are the joints before the program (internal units).
+    pub fn new(model: &'m Model, machine: &PlanMachine, period: f64, start: Joints) -> Self {
+        Interpolator {
+            model,
+            map: machine.map.clone(),
+            tcp: machine.numeric.as_ref().map(|_| machine.axes.clone()),
+            tool: Tool::default(),
+            period,
+            k: 0,
+            t0: 0.0,
+            last: None,
+            joints: start,
+        }
+    }
+
+    /// Program time so far (unrounded), s.
+    pub fn duration(&self) -> f64 {
+        self.t0
+    }
+
+    fn pose(
+        &mut self,
+        seg: &Segment,
+        param: &Param,
+        s: f64,
+    ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
+        let len = if seg.rotary_only() {
+            seg.rotary_travel()
+        } else {
+            seg.length
+        };
+        let s = s.clamp(0.0, len);
+        let f = if len > 0.0 { s / len } else { 1.0 };
+        let tip = if s >= len {
+            // Block ends exactly: the curve returns its end point bit for bit.
+            let (_, b) = seg.curve.domain();
+            seg.curve.point(b)
+        } else {
+            seg.curve.point(param.u(seg, s))
+        };
+        let [r0, r1] = seg.rotary;
+        let rotary = if f >= 1.0 {
+            r1
+        } else {
+            [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
+        };
+        let err = |source| InterpolateError::Kinematics {
+            line: seg.line,
+            source,
+        };
+        if let Some(axes) = &self.tcp {
+            let q = crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
+                .map_err(err)?;
+            self.joints = q;
+            return Ok((tip, rotary, q));
+        }
+        let mut q = self
+            .model
+            .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints)
+            .map_err(err)?;
+        for (j, m) in self.map.iter().enumerate() {
+            if let (JointMap::Rotary(r), true) = (m, j < q.len()) {
+                q[j] = rotary[*r].to_radians();
+            }
+        }
+        self.joints = q;
+        Ok((tip, rotary, q))
+    }
+
+    fn emit(
+        &mut self,
+        mut s: Sample,
+        sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>),
+        seg: Option<&Arc<Segment>>,
+    ) {
+        s.index = self.k;
+        s.t = self.k as f64 * self.period;
+        sink(&s, seg);
+        self.last = Some(s);
+        self.k += 1;
+    }
+
+    /// Samples one planned item.
+    pub fn push(
+        &mut self,
+        item: &Planned,
+        sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>),
+    ) -> Result<(), InterpolateError> {
+        match item {
+            Planned::Motion(piece) => {
+                let duration = piece.profile.duration();
+                let end = self.t0 + duration;
+                let mut idx = 0;
+                let mut param = Param::new(&piece.segments[0]);
+                while (self.k as f64) * self.period < end {
+                    let tau = (self.k as f64 * self.period - self.t0).max(0.0);
+                    let st = piece.profile.state_at(tau);
+                    let s = st.s.clamp(0.0, piece.length());
+                    while idx + 1 < piece.segments.len() && s > piece.offsets[idx + 1] {
+                        idx += 1;
+                        param = Param::new(&piece.segments[idx]);
+                    }
+                    let seg = &piece.segments[idx];
+                    let (tip, rotary, joints) = self.pose(seg, &param, s - piece.offsets[idx])?;
+                    let sample = Sample {
+                        index: 0,
+                        t: 0.0,
+                        line: seg.line,
+                        tip,
+                        rotary,
+                        joints,
+                        feed: st.v,
+                    };
+                    self.emit(sample, sink, Some(seg));
+                }
+                // The piece's end, exactly (held for the final row and for dwells).
+                let seg = piece.segments.last().expect("a piece has segments");
+                let len = *piece.lengths.last().unwrap_or(&0.0);
+                let (tip, rotary, joints) = self.pose(seg, &param, len)?;
+                self.last = Some(Sample {
+                    index: self.k,
+                    t: end,
+                    line: seg.line,
+                    tip,
+                    rotary,
+                    joints,
+                    feed: 0.0,
+                });
+                self.t0 = end;
+            }
+            Planned::Dwell { seconds, line } => {
+                let end = self.t0 + seconds;
+                while (self.k as f64) * self.period < end {
+                    if let Some(mut s) = self.last {
+                        s.line = *line;
+                        s.feed = 0.0;
+                        self.emit(s, sink, None);
+                    } else {
+                        break;
+                    }
+                }
+                self.t0 = end;
+            }
+            Planned::Stop { .. } => {}
+        }
+        Ok(())
+    }
+
+    /// Emits the start row (before any motion), given the start pose.
+    pub fn start(
+        &mut self,
+        tip: Vec3,
+        rotary: [f64; 3],
+        line: u32,
+    ) -> Result<(), InterpolateError> {
+        let q = match &self.tcp {
+            Some(axes) => {
+                crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
+            }
+            None => self
+                .model
+                .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints),
+        }
+        .map_err(|source| InterpolateError::Kinematics { line, source })?;
+        self.joints = q;
+        self.last = Some(Sample {
+            index: 0,
+            t: 0.0,
+            line,
+            tip,
+            rotary,
+            joints: q,
+            feed: 0.0,
+        });
+        Ok(())
+    }
+
+    /// The final row: the final position at rest, at the first grid time at or after the end.
+    pub fn finish(&mut self, sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>)) {
+        if let Some(mut s) = self.last {
+            s.feed = 0.0;
+            self.emit(s, sink, None);
+        }
+    }
+}
+
+/// Why a run (plan + interpolate) failed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum RunError {
+    #[error(transparent)]
+    Plan(#[from] crate::plan::PlanError),
+    #[error(transparent)]
+    Interpolate(#[from] InterpolateError),
+}
+
+/// Plans and samples a stream of path items from the start pose (tip, A B C), calling `sink`
+/// for every sample; returns the unrounded duration. Memory stays bounded by the planner's
+/// window: items are planned and sampled as they come.
+pub fn run(
+    items: impl IntoIterator<Item = crate::path::PathItem>,
+    model: &Model,
+    machine: PlanMachine,
+    options: crate::plan::PlanOptions,
+    start: (Vec3, [f64; 3]),
+    mut sink: impl FnMut(&Sample, Option<&Arc<Segment>>),
+) -> Result<f64, RunError> {
+    let period = options.period;
+    let mut interp = Interpolator::new(
+        model,
+        &machine,
+        period,
+        Joints::zeros(machine.joint_count()),
+    );
+    let mut planner = crate::plan::Planner::new(machine, options)?;
+    interp.start(start.0, start.1, 1)?;
+    for item in items {
+        planner.push(item)?;
+        while let Some(p) = planner.pop() {
+            interp.push(&p, &mut sink)?;
+        }
+    }
+    planner.finish()?;
+    while let Some(p) = planner.pop() {
+        interp.push(&p, &mut sink)?;
+    }
+    interp.finish(&mut sink);
+    Ok(interp.duration())
+}

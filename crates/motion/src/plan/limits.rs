@@ -1,0 +1,544 @@
+//! Speed limits of one segment and of the junction between two: from the programmed feed, the
+//! rapid speed, curvature (centripetal acceleration and jerk), chord error at the period, and
+//! every joint's velocity, acceleration and jerk limit.
+//!
+//! A joint q(σ) along the path coordinate σ (arc length, or degrees for a rotary-only move) at
+//! path speed v, acceleration a, jerk j moves with
+//!   q̇ = q'v,  q̈ = q''v² + q'a,  q⃛ = q'''v³ + 3q''va + q'j            (chain rule)
+//! so with g1, g2, g3 the largest |q'|, |q''|, |q'''| over the segment the profile limits
+//! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
+//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
+
+use tezgah_geom::Axis;
+use tezgah_geom::{Curve, Vec3};
+use tezgah_kinematics::{Joints, Model};
+
+use super::joints::{tcp_joints, JointMap, PlanMachine};
+use super::PlanError;
+use crate::path::{Segment, SegmentFeed};
+use crate::profile::Limits;
+
+/// Most joints a machine has (as `tezgah_kinematics::Joints`).
+pub const MAX_JOINTS: usize = 6;
+
+/// Planner settings; every tolerance is explicit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanOptions {
+    /// Interpolation period Ts, s.
+    pub period: f64,
+    /// Share of a segment's tolerance given to the chord error at the period (the rest is for
+    /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance.
+    pub chord_share: f64,
+    /// Share of each joint's acceleration and jerk given to curvature on curved segments
+    /// (the rest drives the path's own acceleration and jerk).
+    pub curvature_share: f64,
+    /// Share of each joint's acceleration and jerk kept back on segments next to a junction
+    /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
+    /// finite differences at the period (Δv/Ts² + Δa/Ts for the jerk).
+    pub junction_reserve: f64,
+    /// A junction whose cap is below this share of the slower neighbour's speed limit is
+    /// passed at rest instead (cheaper than keeping the reserve on both sides).
+    pub min_junction_share: f64,
+    /// Groups of segments held in the look-ahead window.
+    pub window: usize,
+    /// Most segments timed by one profile.
+    pub max_group: usize,
+    /// Segments join one group only while their speed limits are within this ratio (0–1].
+    pub group_ratio: f64,
+    /// Rotary-only moves on a machine where no joint follows them (a 3-axis mill given A/B/C):
+    /// rapid speed in deg/s, and A, J in deg/s², deg/s³ for timing them.
+    pub idle_rotary: [f64; 3],
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        PlanOptions {
+            period: 0.001,
+            chord_share: 0.5,
+            curvature_share: 0.5,
+            junction_reserve: 0.25,
+            min_junction_share: 0.05,
+            window: 64,
+            max_group: 256,
+            group_ratio: 0.8,
+            idle_rotary: [3600.0, 36_000.0, 360_000.0],
+        }
+    }
+}
+
+impl PlanOptions {
+    /// Checks every option; the error names the bad one.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        let unit = |name, v: f64, open_low: bool| {
+            let ok = if open_low {
+                v > 0.0 && v <= 1.0
+            } else {
+                (0.0..1.0).contains(&v)
+            };
+            if ok {
+                Ok(())
+            } else {
+                Err(PlanError::Option { name, value: v })
+            }
+        };
+        if !(self.period > 0.0 && self.period.is_finite()) {
+            return Err(PlanError::Option {
+                name: "period",
+                value: self.period,
+            });
+        }
+        unit("chord_share", self.chord_share, true)?;
+        unit("curvature_share", self.curvature_share, true)?;
+        unit("junction_reserve", self.junction_reserve, false)?;
+        unit("group_ratio", self.group_ratio, true)?;
+        unit("min_junction_share", self.min_junction_share, false)?;
+        if self.window == 0 || self.max_group == 0 {
+            return Err(PlanError::Option {
+                name: "window/max_group",
+                value: 0.0,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The joints' derivatives along one segment (internal units per unit of σ).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Geometry {
+    /// Path coordinate length: arc length (mm), or rotary travel (deg) for a rotary-only move.
+    pub length: f64,
+    pub rotary_only: bool,
+    /// Largest |q'|, |q''|, |q'''| per joint over the segment.
+    pub g1: [f64; MAX_JOINTS],
+    pub g2: [f64; MAX_JOINTS],
+    pub g3: [f64; MAX_JOINTS],
+    /// q' and q'' per joint at the start and at the end.
+    pub d1_start: [f64; MAX_JOINTS],
+    pub d1_end: [f64; MAX_JOINTS],
+    pub d2_start: [f64; MAX_JOINTS],
+    pub d2_end: [f64; MAX_JOINTS],
+    /// Largest curvature of the tip path, 1/mm.
+    pub kappa_max: f64,
+}
+
+impl Geometry {
+    pub fn curved(&self) -> bool {
+        self.g2.iter().any(|&g| g > 0.0)
+    }
+}
+
+/// Unit tangent and curvature vector dT/ds at `u`.
+fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
+    let [_, d1, d2, _] = curve.derivs(u);
+    let sp = d1.norm();
+    if sp <= 0.0 {
+        return (Vec3::zeros(), Vec3::zeros());
+    }
+    let t = d1 / sp;
+    let k = (d2 - t * t.dot(&d2)) / (sp * sp);
+    (t, k)
+}
+
+/// Samples the tip path (tangent, curvature vector and its derivative by differences of the
+/// curvature vector between samples) and maps it onto the joints.
+pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
+    let n = machine.joint_count().min(MAX_JOINTS);
+    let rotary_only = seg.rotary_only();
+    let length = if rotary_only {
+        seg.rotary_travel()
+    } else {
+        seg.length
+    };
+    let mut g = Geometry {
+        length,
+        rotary_only,
+        ..Geometry::default()
+    };
+    if length <= 0.0 {
+        return Ok(g);
+    }
+    let rot_rate = |k: usize| (seg.rotary[1][k] - seg.rotary[0][k]).to_radians() / length;
+    // Tip samples.
+    let (ua, ub) = seg.curve.domain();
+    let mut tip_d1_start = Vec3::zeros();
+    let mut tip_d1_end = Vec3::zeros();
+    let mut tip_d2_start = Vec3::zeros();
+    let mut tip_d2_end = Vec3::zeros();
+    let mut g1 = [0.0f64; 3];
+    let mut g2 = [0.0f64; 3];
+    let mut g3 = [0.0f64; 3];
+    if !rotary_only {
+        let curve: &dyn Curve = &*seg.curve;
+        let (t0, k0) = frame(curve, ua);
+        let (t1, k1) = frame(curve, ub);
+        let (tm, km) = frame(curve, 0.5 * (ua + ub));
+        tip_d1_start = t0;
+        tip_d1_end = t1;
+        tip_d2_start = k0;
+        tip_d2_end = k1;
+        let straight = k0.norm() == 0.0 && k1.norm() == 0.0 && km.norm() == 0.0;
+        if straight {
+            for i in 0..3 {
+                g1[i] = t0[i].abs().max(t1[i].abs()).max(tm[i].abs());
+            }
+        } else {
+            // Enough samples that the turning between two is small (≤ ~0.1 rad on arcs):
+            // a difference quotient of a sinusoid then underestimates its peak by < 0.1 %;
+            // the 1.05 below covers it and the curvature between samples.
+            let turning = (k0.norm().max(k1.norm()).max(km.norm())) * seg.length;
+            let samples = ((turning / 0.1).ceil() as usize).clamp(16, 4096);
+            let mut prev: Option<(Vec3, f64)> = None;
+            for s in 0..=samples {
+                let u = ua + (ub - ua) * s as f64 / samples as f64;
+                let (t, k) = frame(curve, u);
+                let sp = curve.speed(u);
+                g.kappa_max = g.kappa_max.max(k.norm());
+                for i in 0..3 {
+                    g1[i] = g1[i].max(t[i].abs());
+                    g2[i] = g2[i].max(k[i].abs() * 1.05);
+                }
+                if let Some((kp, spp)) = prev {
+                    let ds = 0.5 * (sp + spp) * (ub - ua) / samples as f64;
+                    if ds > 0.0 {
+                        let dk = (k - kp) / ds;
+                        for i in 0..3 {
+                            g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                        }
+                    }
+                }
+                prev = Some((k, sp));
+            }
+        }
+    }
+    if let Some(model) = &machine.numeric {
+        numeric_joints(seg, model, &machine.axes, n, &mut g)?;
+        return Ok(g);
+    }
+    for (j, m) in machine.map.iter().take(n).enumerate() {
+        match *m {
+            JointMap::Tip(i) => {
+                g.g1[j] = g1[i];
+                g.g2[j] = g2[i];
+                g.g3[j] = g3[i];
+                g.d1_start[j] = tip_d1_start[i];
+                g.d1_end[j] = tip_d1_end[i];
+                g.d2_start[j] = tip_d2_start[i];
+                g.d2_end[j] = tip_d2_end[i];
+            }
+            JointMap::Rotary(k) => {
+                let r = rot_rate(k);
+                g.g1[j] = r.abs();
+                g.d1_start[j] = r;
+                g.d1_end[j] = r;
+            }
+        }
+    }
+    Ok(g)
+}
+
+/// Joint derivatives by differences of the inverse kinematics at equal steps h along the
+/// segment (lines and arcs have constant parametric speed, so equal steps in u are equal in
+/// s): q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas at the ends.
+/// Margins cover the peaks between samples (the step turns the joint map by little).
+// Joint i indexes several parallel arrays (rows of q, g1…g3, ends): a range loop is clearest.
+#[allow(clippy::needless_range_loop)]
+fn numeric_joints(
+    seg: &Segment,
+    model: &Model,
+    axes: &[Axis],
+    n: usize,
+    g: &mut Geometry,
+) -> Result<(), PlanError> {
+    let (ua, ub) = seg.curve.domain();
+    let length = g.length;
+    let steps = (16 + (length / 0.5).ceil() as usize).min(512);
+    let h = length / steps as f64;
+    let [r0, r1] = seg.rotary;
+    let at = |f: f64| {
+        let tip = if g.rotary_only {
+            seg.curve.point(ua)
+        } else {
+            seg.curve.point(ua + (ub - ua) * f)
+        };
+        (tip, [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f))
+    };
+    let mut q: Vec<[f64; MAX_JOINTS]> = Vec::with_capacity(steps + 1);
+    let mut prev = Joints::zeros(n);
+    for k in 0..=steps {
+        let f = k as f64 / steps as f64;
+        let (tip, rot) = at(f);
+        // Unreachable points are the interpolator's error to report, with the line.
+        let Ok(qk) = tcp_joints(model, axes, &tip, &rot, &prev) else {
+            return Ok(());
+        };
+        prev = qk;
+        let mut row = [0.0; MAX_JOINTS];
+        row[..n].copy_from_slice(&qk.as_slice()[..n]);
+        q.push(row);
+    }
+    let m = q.len() - 1;
+    for i in 0..n {
+        let x = |k: usize| q[k][i];
+        // A joint that jumps (a path through a singular pose, e.g. the C axis centre of a
+        // Y-Z-C-A machine) has no speed that keeps it in its limits: halving the step around
+        // the largest change must halve it, as for any smooth joint.
+        let k = (0..m)
+            .max_by(|&a, &b| (x(a + 1) - x(a)).abs().total_cmp(&(x(b + 1) - x(b)).abs()))
+            .unwrap_or(0);
+        let big = (x(k + 1) - x(k)).abs();
+        if big > 1e-9 {
+            let mut before = Joints::zeros(n);
+            before.as_mut_slice().copy_from_slice(&q[k][..n]);
+            let (tip, rot) = at((k as f64 + 0.5) / steps as f64);
+            if let Ok(mid) = tcp_joints(model, axes, &tip, &rot, &before) {
+                let half = (mid[i] - x(k)).abs().max((x(k + 1) - mid[i]).abs());
+                if half > 0.9 * big {
+                    return Err(PlanError::JointJump {
+                        line: seg.line,
+                        joint: i,
+                        jump: big,
+                    });
+                }
+            }
+        }
+        let mut g1: f64 = 0.0;
+        let mut g2: f64 = 0.0;
+        let mut g3: f64 = 0.0;
+        for k in 0..m {
+            g1 = g1.max(((x(k + 1) - x(k)) / h).abs());
+        }
+        for k in 1..m {
+            g2 = g2.max(((x(k + 1) - 2.0 * x(k) + x(k - 1)) / (h * h)).abs());
+        }
+        for k in 1..m - 1 {
+            g3 = g3.max(((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs());
+        }
+        g.d1_start[i] = (-3.0 * x(0) + 4.0 * x(1) - x(2)) / (2.0 * h);
+        g.d1_end[i] = (3.0 * x(m) - 4.0 * x(m - 1) + x(m - 2)) / (2.0 * h);
+        g.d2_start[i] = (2.0 * x(0) - 5.0 * x(1) + 4.0 * x(2) - x(3)) / (h * h);
+        g.d2_end[i] = (2.0 * x(m) - 5.0 * x(m - 1) + 4.0 * x(m - 2) - x(m - 3)) / (h * h);
+        g.g1[i] = g1.max(g.d1_start[i].abs()).max(g.d1_end[i].abs()) * 1.01;
+        g.g2[i] = g2.max(g.d2_start[i].abs()).max(g.d2_end[i].abs()) * 1.1;
+        g.g3[i] = g3 * 1.2;
+    }
+    Ok(())
+}
+
+/// The profile limits of one segment.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SegmentLimits {
+    /// Path speed, acceleration and jerk (σ units).
+    pub limits: Limits,
+    /// What set the speed limit (for reports).
+    pub by: LimitedBy,
+}
+
+/// The binding speed limit of a segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitedBy {
+    Feed,
+    JointVelocity,
+    Curvature,
+    ChordError,
+    Idle,
+}
+
+/// Largest v ≥ 0 with c3·v³ + c1·v ≤ budget (both terms increase with v).
+fn cubic_cap(c3: f64, c1: f64, budget: f64) -> f64 {
+    if c3 <= 0.0 && c1 <= 0.0 {
+        return f64::INFINITY;
+    }
+    let f = |v: f64| c3 * v * v * v + c1 * v;
+    let mut hi = 1.0;
+    while f(hi) < budget && hi < 1e12 {
+        hi *= 2.0;
+    }
+    let mut lo = 0.0;
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) <= budget {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Speed, acceleration and jerk of the path profile on `seg` (see the module doc). `reserve`
+/// keeps [`PlanOptions::junction_reserve`] of the joint budgets back for junction jumps.
+pub fn segment_limits(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+) -> Result<SegmentLimits, PlanError> {
+    let n = machine.joint_count().min(MAX_JOINTS);
+    let budget = if reserve {
+        1.0 - options.junction_reserve
+    } else {
+        1.0
+    };
+    let curved = geom.curved();
+    let share = if curved {
+        1.0 - options.curvature_share
+    } else {
+        1.0
+    };
+    let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut by = LimitedBy::JointVelocity;
+    for i in 0..n {
+        if geom.g1[i] > 0.0 {
+            v = v.min(machine.max_velocity[i] / geom.g1[i]);
+            a = a.min(share * budget * machine.max_acceleration[i] / geom.g1[i]);
+            j = j.min(share * budget * machine.max_jerk[i] / geom.g1[i]);
+        }
+    }
+    if curved {
+        let mut vc = f64::INFINITY;
+        for i in 0..n {
+            let (g2, g3) = (geom.g2[i], geom.g3[i]);
+            let a_left = (1.0 - share) * budget * machine.max_acceleration[i];
+            let j_left = (1.0 - share) * budget * machine.max_jerk[i];
+            if g2 > 0.0 {
+                // |q''|v² ≤ A_i share: v ≤ √(A/κ) per joint (ref 000 eq. 2.5x).
+                vc = vc.min((a_left / g2).sqrt());
+            }
+            // |q'''|v³ + 3|q''|·v·A ≤ J_i share: v ≤ (J/κ²)^⅓ with the cross term.
+            let aa = if a.is_finite() { a } else { 0.0 };
+            vc = vc.min(cubic_cap(g3, 3.0 * g2 * aa, j_left));
+        }
+        if vc < v {
+            v = vc;
+            by = LimitedBy::Curvature;
+        }
+        // Chord error at the period: the chord of a circle of radius ρ through two samples
+        // v·Ts apart sags δ when v = (2/Ts)·√(2ρδ − δ²) (ref 000 §2.7).
+        if geom.kappa_max > 0.0 {
+            let rho = 1.0 / geom.kappa_max;
+            let delta = (options.chord_share * seg.tolerance).min(rho);
+            let vch = 2.0 / options.period * (2.0 * rho * delta - delta * delta).max(0.0).sqrt();
+            if vch < v {
+                v = vch;
+                by = LimitedBy::ChordError;
+            }
+        }
+    }
+    let feed = match seg.feed {
+        SegmentFeed::Rapid => f64::INFINITY,
+        SegmentFeed::Feed(f) => f,
+        SegmentFeed::InverseTime(t) if t > 0.0 => geom.length / t,
+        SegmentFeed::InverseTime(_) => f64::INFINITY,
+    };
+    if feed < v {
+        v = feed;
+        by = LimitedBy::Feed;
+    }
+    if !v.is_finite() {
+        // Nothing on this machine follows the move (A/B/C on a 3-axis mill).
+        v = options.idle_rotary[0].min(feed);
+        by = LimitedBy::Idle;
+    }
+    if curved && v.is_finite() && a.is_finite() && j.is_finite() {
+        // The split above is a floor: at the speed finally chosen the curvature terms may
+        // need less than their share, and the path gets the rest:
+        // A = minᵢ (budget·Aᵢ − g2ᵢV²)/g1ᵢ, J = minᵢ (budget·Jᵢ − g3ᵢV³ − 3g2ᵢ·V·A)/g1ᵢ.
+        let rest = |aa: f64| {
+            let (mut a2, mut j2) = (f64::INFINITY, f64::INFINITY);
+            for i in 0..n {
+                let g1 = geom.g1[i];
+                if g1 > 0.0 {
+                    a2 = a2.min((budget * machine.max_acceleration[i] - geom.g2[i] * v * v) / g1);
+                    j2 = j2.min(
+                        (budget * machine.max_jerk[i]
+                            - geom.g3[i] * v * v * v
+                            - 3.0 * geom.g2[i] * v * aa)
+                            / g1,
+                    );
+                }
+            }
+            (a2, j2)
+        };
+        let (a_more, _) = rest(a);
+        let a_more = a_more.max(a);
+        let (_, j_with_more) = rest(a_more);
+        if j_with_more >= j {
+            a = a_more;
+            j = j_with_more;
+        } else {
+            // Keep the floor for A; J still gains what the curvature leaves.
+            let (_, j_floor) = rest(a);
+            j = j.max(j_floor);
+        }
+    }
+    if !a.is_finite() {
+        a = options.idle_rotary[1];
+    }
+    if !j.is_finite() {
+        j = options.idle_rotary[2];
+    }
+    let limits = Limits::new(v, a, j).map_err(|e| PlanError::NoLimit {
+        line: seg.line,
+        reason: e.to_string(),
+    })?;
+    Ok(SegmentLimits { limits, by })
+}
+
+/// The highest speed at a junction where the joints' path derivatives jump from `a` (end of the
+/// segment before) to `b` (start of the next): a velocity step Δq'·v and an acceleration step
+/// Δq''·v², seen by third differences at the period as Δq'v/Ts² + Δq''v²/Ts, must stay within
+/// half the reserve of each joint's jerk (the other half covers the path acceleration's step,
+/// see [`inside_group`]); the velocity step's Δq'v/Ts within the reserve of the acceleration.
+pub fn junction_cap(
+    a: &Geometry,
+    b: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+) -> f64 {
+    let ts = options.period;
+    let r = options.junction_reserve;
+    let mut cap = f64::INFINITY;
+    for i in 0..machine.joint_count().min(MAX_JOINTS) {
+        let dv = (b.d1_start[i] - a.d1_end[i]).abs();
+        let dk = (b.d2_start[i] - a.d2_end[i]).abs();
+        let jb = 0.5 * r * machine.max_jerk[i];
+        // dk/Ts·v² + dv/Ts²·v − jb ≤ 0.
+        let (qa, qb) = (dk / ts, dv / (ts * ts));
+        let v = if qa > 0.0 {
+            (-qb + (qb * qb + 4.0 * qa * jb).sqrt()) / (2.0 * qa)
+        } else if qb > 0.0 {
+            jb / qb
+        } else {
+            f64::INFINITY
+        };
+        cap = cap.min(v);
+        if dv > 0.0 {
+            cap = cap.min(r * machine.max_acceleration[i] * ts / dv);
+        }
+    }
+    cap
+}
+
+/// Whether a junction with a tangent jump may lie inside one profile (where the path
+/// acceleration `accel` is not zero): the joint acceleration then steps by Δq'·a, seen as
+/// Δq'·a/Ts in the jerk, which must fit in the other half of the reserve.
+pub fn inside_group(
+    a: &Geometry,
+    b: &Geometry,
+    accel: f64,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+) -> bool {
+    (0..machine.joint_count().min(MAX_JOINTS)).all(|i| {
+        let dv = (b.d1_start[i] - a.d1_end[i]).abs();
+        dv * accel / options.period <= 0.5 * options.junction_reserve * machine.max_jerk[i]
+    })
+}
+
+/// Whether any joint's path derivatives jump at the junction (it needs the reserve).
+pub fn has_jump(a: &Geometry, b: &Geometry, machine: &PlanMachine) -> bool {
+    (0..machine.joint_count().min(MAX_JOINTS)).any(|i| {
+        (b.d1_start[i] - a.d1_end[i]).abs() > 1e-12 || (b.d2_start[i] - a.d2_end[i]).abs() > 1e-12
+    })
+}

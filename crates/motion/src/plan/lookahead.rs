@@ -1,0 +1,382 @@
+//! Look-ahead: segments are grouped, junction speeds chosen by a backward pass (the plan can
+//! always stop by the end of the window) and a forward pass, and each group is timed by one
+//! [`Profile`] from its entry to its exit speed.
+//!
+//! Why groups: a profile has zero acceleration at both ends, so one profile per short segment
+//! would re-ramp the acceleration at every junction and a dense program could hardly speed up.
+//! Consecutive segments whose limits are close (within [`PlanOptions::group_ratio`]) and whose
+//! junctions allow it share one profile under the tightest of their limits; speed may pass many
+//! junctions per period (no per-segment cap). Memory is bounded by `window × max_group`.
+
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+use super::joints::PlanMachine;
+use super::limits::{
+    analyse, has_jump, inside_group, junction_cap, segment_limits, Geometry, PlanOptions,
+};
+use super::PlanError;
+use crate::path::{Junction, PathItem, Segment};
+use crate::profile::{max_reachable_speed, solve, Limits, Profile, ProfileError};
+
+/// A timed group of segments.
+#[derive(Debug, Clone)]
+pub struct Piece {
+    pub segments: Vec<Arc<Segment>>,
+    /// Path coordinate where each segment starts, from 0 at the piece's start.
+    pub offsets: Vec<f64>,
+    /// Path coordinate length of each segment (mm, or degrees for a rotary-only move).
+    pub lengths: Vec<f64>,
+    pub profile: Profile,
+    pub limits: Limits,
+}
+
+impl Piece {
+    /// Total path length.
+    pub fn length(&self) -> f64 {
+        self.offsets.last().copied().unwrap_or(0.0) + self.lengths.last().copied().unwrap_or(0.0)
+    }
+}
+
+/// What the planner emits, in program order.
+#[derive(Debug, Clone)]
+pub enum Planned {
+    Motion(Box<Piece>),
+    Dwell { seconds: f64, line: u32 },
+    Stop { line: u32 },
+}
+
+struct Group {
+    segments: Vec<Arc<Segment>>,
+    lengths: Vec<f64>,
+    length: f64,
+    limits: Limits,
+    end_cap: f64,
+    /// Highest entry speed from which the rest of the window can still stop (backward pass);
+    /// NaN until computed.
+    backward: f64,
+}
+
+enum Entry {
+    Group(Group),
+    Dwell { seconds: f64, line: u32 },
+    Stop { line: u32 },
+}
+
+struct Open {
+    segments: Vec<Arc<Segment>>,
+    lengths: Vec<f64>,
+    v: f64,
+    a: f64,
+    j: f64,
+    last: Geometry,
+    last_end_cap: f64,
+}
+
+/// The streaming planner: `push` path items, take [`Planned`] items with `pop`.
+pub struct Planner {
+    machine: PlanMachine,
+    options: PlanOptions,
+    pending: Option<(Segment, Geometry, bool)>,
+    open: Option<Open>,
+    window: VecDeque<Entry>,
+    out: VecDeque<Planned>,
+    v_start: f64,
+}
+
+fn line_of(seg: &Segment) -> u32 {
+    seg.line
+}
+
+impl Planner {
+    pub fn new(machine: PlanMachine, options: PlanOptions) -> Result<Self, PlanError> {
+        options.validate()?;
+        Ok(Planner {
+            machine,
+            options,
+            pending: None,
+            open: None,
+            window: VecDeque::new(),
+            out: VecDeque::new(),
+            v_start: 0.0,
+        })
+    }
+
+    pub fn options(&self) -> &PlanOptions {
+        &self.options
+    }
+
+    /// Takes one path item.
+    pub fn push(&mut self, item: PathItem) -> Result<(), PlanError> {
+        match item {
+            PathItem::Segment(seg) => self.push_segment(seg),
+            PathItem::Dwell { seconds, line } => {
+                if !(seconds.is_finite() && seconds >= 0.0) {
+                    return Err(PlanError::BadDwell { line, seconds });
+                }
+                self.end_here()?;
+                self.window.push_back(Entry::Dwell { seconds, line });
+                self.commit_full()
+            }
+            PathItem::Stop { line } => {
+                self.end_here()?;
+                self.window.push_back(Entry::Stop { line });
+                self.commit_full()
+            }
+        }
+    }
+
+    /// End of the stream: plan everything to a stop.
+    pub fn finish(&mut self) -> Result<(), PlanError> {
+        self.end_here()?;
+        while !self.window.is_empty() {
+            self.commit_front()?;
+        }
+        Ok(())
+    }
+
+    /// The next planned item, if one is committed.
+    pub fn pop(&mut self) -> Option<Planned> {
+        self.out.pop_front()
+    }
+
+    fn push_segment(&mut self, seg: Segment) -> Result<(), PlanError> {
+        let geom = analyse(&seg, &self.machine)?;
+        if geom.length <= 0.0 {
+            return Ok(());
+        }
+        let start_jump = match self.pending.take() {
+            Some((p, pg, p_jump)) => {
+                let (cap, jump) = match p.end {
+                    Junction::Corner | Junction::Stop => (0.0, false),
+                    Junction::Tangent | Junction::Smooth => {
+                        let cap = junction_cap(&pg, &geom, &self.machine, &self.options);
+                        let jump = has_jump(&pg, &geom, &self.machine);
+                        // A jump that allows only a crawl is cheaper as a stop: no reserve
+                        // is then kept on the two segments.
+                        let speed = |s: &Segment, g: &Geometry| {
+                            segment_limits(s, g, &self.machine, &self.options, false)
+                                .map(|l| l.limits.max_velocity())
+                        };
+                        let floor = self.options.min_junction_share
+                            * speed(&p, &pg)?.min(speed(&seg, &geom)?);
+                        if jump && cap < floor {
+                            (0.0, false)
+                        } else {
+                            (cap, jump)
+                        }
+                    }
+                };
+                self.add(p, pg, p_jump || jump, cap)?;
+                jump
+            }
+            None => false,
+        };
+        self.pending = Some((seg, geom, start_jump));
+        Ok(())
+    }
+
+    /// The motion stops here (dwell, stop, end): the held segment ends at speed 0.
+    fn end_here(&mut self) -> Result<(), PlanError> {
+        if let Some((p, pg, jump)) = self.pending.take() {
+            self.add(p, pg, jump, 0.0)?;
+        }
+        if let Some(open) = self.open.take() {
+            self.close(open, 0.0)?;
+        }
+        Ok(())
+    }
+
+    fn add(
+        &mut self,
+        seg: Segment,
+        geom: Geometry,
+        reserve: bool,
+        end_cap: f64,
+    ) -> Result<(), PlanError> {
+        let sl = segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?;
+        let (v, a, j) = (
+            sl.limits.max_velocity(),
+            sl.limits.max_acceleration(),
+            sl.limits.max_jerk(),
+        );
+        let r = self.options.group_ratio;
+        let joins = |o: &Open| {
+            let vg = o.v.min(v).min(o.last_end_cap);
+            let close = |x: f64, y: f64, m: f64| m >= r * x.max(y);
+            o.segments.len() < self.options.max_group
+                && o.last_end_cap > 0.0
+                && close(o.v, v, vg)
+                && close(o.a, a, o.a.min(a))
+                && close(o.j, j, o.j.min(j))
+                && inside_group(&o.last, &geom, o.a.max(a), &self.machine, &self.options)
+        };
+        let len = geom.length;
+        let seg = Arc::new(seg);
+        match self.open.take() {
+            Some(mut o) if joins(&o) => {
+                o.v = o.v.min(v).min(o.last_end_cap);
+                o.a = o.a.min(a);
+                o.j = o.j.min(j);
+                o.segments.push(seg);
+                o.lengths.push(len);
+                o.last = geom;
+                o.last_end_cap = end_cap;
+                self.open = Some(o);
+            }
+            other => {
+                if let Some(o) = other {
+                    let cap = o.last_end_cap;
+                    self.close(o, cap)?;
+                }
+                self.open = Some(Open {
+                    segments: vec![seg],
+                    lengths: vec![len],
+                    v,
+                    a,
+                    j,
+                    last: geom,
+                    last_end_cap: end_cap,
+                });
+            }
+        }
+        if end_cap <= 0.0 {
+            if let Some(o) = self.open.take() {
+                self.close(o, 0.0)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn close(&mut self, o: Open, end_cap: f64) -> Result<(), PlanError> {
+        let line = o.segments.first().map_or(0, |s| line_of(s));
+        let limits = Limits::new(o.v, o.a, o.j).map_err(|e| PlanError::NoLimit {
+            line,
+            reason: e.to_string(),
+        })?;
+        let length = o.lengths.iter().sum();
+        self.window.push_back(Entry::Group(Group {
+            segments: o.segments,
+            lengths: o.lengths,
+            length,
+            limits,
+            end_cap,
+            backward: f64::NAN,
+        }));
+        self.commit_full()
+    }
+
+    fn commit_full(&mut self) -> Result<(), PlanError> {
+        while self.window.len() > self.options.window {
+            self.commit_front()?;
+        }
+        Ok(())
+    }
+
+    /// Backward pass from the window's end (where the plan stops), stopping early where the
+    /// answer did not change since the last pass (window growth only raises these speeds).
+    fn backward(&mut self) -> Result<(), PlanError> {
+        let mut next = 0.0;
+        for entry in self.window.iter_mut().rev() {
+            match entry {
+                Entry::Group(g) => {
+                    let end = g.end_cap.min(next).min(g.limits.max_velocity());
+                    let reach = max_reachable_speed(end, g.length, &g.limits).map_err(|e| {
+                        PlanError::Profile {
+                            line: g.segments[0].line,
+                            source: e,
+                        }
+                    })?;
+                    let start = reach.min(g.limits.max_velocity());
+                    if start == g.backward {
+                        break;
+                    }
+                    g.backward = start;
+                    next = start;
+                }
+                _ => next = 0.0,
+            }
+        }
+        Ok(())
+    }
+
+    fn commit_front(&mut self) -> Result<(), PlanError> {
+        self.backward()?;
+        let Some(front) = self.window.pop_front() else {
+            return Ok(());
+        };
+        let g = match front {
+            Entry::Dwell { seconds, line } => {
+                self.v_start = 0.0;
+                self.out.push_back(Planned::Dwell { seconds, line });
+                return Ok(());
+            }
+            Entry::Stop { line } => {
+                self.v_start = 0.0;
+                self.out.push_back(Planned::Stop { line });
+                return Ok(());
+            }
+            Entry::Group(g) => g,
+        };
+        let next_start = match self.window.front() {
+            Some(Entry::Group(n)) => n.backward,
+            _ => 0.0,
+        };
+        let line = g.segments[0].line;
+        let err = |source| PlanError::Profile { line, source };
+        let v0 = self.v_start.min(g.limits.max_velocity());
+        let target = g
+            .end_cap
+            .min(next_start)
+            .min(g.limits.max_velocity())
+            .max(0.0);
+        let up = max_reachable_speed(v0, g.length, &g.limits).map_err(err)?;
+        let v1 = target.min(up);
+        let profile = match solve(g.length, v0, v1, &g.limits) {
+            Ok(p) => p,
+            Err(ProfileError::EndSpeedUnreachable { reachable, .. })
+                if reachable <= v1 * (1.0 + 1e-9) + 1e-12 =>
+            {
+                // Lower the junction speed, never raise it.
+                solve(g.length, v0, reachable, &g.limits).map_err(err)?
+            }
+            Err(e) => return Err(err(e)),
+        };
+        self.v_start = profile.end().v.max(0.0);
+        let mut offsets = Vec::with_capacity(g.lengths.len());
+        let mut acc = 0.0;
+        for l in &g.lengths {
+            offsets.push(acc);
+            acc += l;
+        }
+        self.out.push_back(Planned::Motion(Box::new(Piece {
+            segments: g.segments,
+            offsets,
+            lengths: g.lengths,
+            profile,
+            limits: g.limits,
+        })));
+        Ok(())
+    }
+}
+
+/// Plans a whole list of path items.
+pub fn plan_all(
+    items: impl IntoIterator<Item = PathItem>,
+    machine: PlanMachine,
+    options: PlanOptions,
+) -> Result<Vec<Planned>, PlanError> {
+    let mut p = Planner::new(machine, options)?;
+    let mut out = Vec::new();
+    for item in items {
+        p.push(item)?;
+        while let Some(x) = p.pop() {
+            out.push(x);
+        }
+    }
+    p.finish()?;
+    while let Some(x) = p.pop() {
+        out.push(x);
+    }
+    Ok(out)
+}
