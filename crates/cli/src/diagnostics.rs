@@ -11,6 +11,15 @@ use tezgah_gcode::{Canon, CanonSink, GcodeError, Origin};
 pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
     let name = path.display().to_string();
     let span = e.span;
+    if let Some(file) = &e.file {
+        // In a subroutine file: name it; its text is not at hand here.
+        return miette!(
+            "{file}:{}:{}: {} (in a subroutine called from {name})",
+            span.line,
+            span.column,
+            e.kind
+        );
+    }
     let label = LabeledSpan::at_offset(span.offset.min(text.len()), "here");
     miette!(
         labels = vec![label],

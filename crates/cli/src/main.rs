@@ -3,6 +3,7 @@
 //! Every command is a thin shell over a library call; see the README for the commands.
 
 mod diagnostics;
+mod library;
 mod plot;
 mod run;
 
@@ -29,6 +30,9 @@ enum Command {
         /// A tool table in LinuxCNC's format.
         #[arg(long)]
         tool_table: Option<PathBuf>,
+        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
+        #[arg(long = "subroutine-path")]
+        subroutine_path: Vec<PathBuf>,
     },
     /// Pre-flight: check a whole program and report every error, or a short summary.
     Check {
@@ -37,6 +41,9 @@ enum Command {
         /// A tool table in LinuxCNC's format.
         #[arg(long)]
         tool_table: Option<PathBuf>,
+        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
+        #[arg(long = "subroutine-path")]
+        subroutine_path: Vec<PathBuf>,
     },
     /// Plan and run a program on a machine model: samples, report, plots and a summary.
     Run {
@@ -63,6 +70,9 @@ enum Command {
         /// A tool table in LinuxCNC's format.
         #[arg(long)]
         tool_table: Option<PathBuf>,
+        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
+        #[arg(long = "subroutine-path")]
+        subroutine_path: Vec<PathBuf>,
     },
     /// List the built-in machine definitions.
     Machines,
@@ -74,11 +84,13 @@ fn main() -> ExitCode {
         Command::Canon {
             program,
             tool_table,
-        } => canon(&program, tool_table.as_deref()),
+            subroutine_path,
+        } => canon(&program, tool_table.as_deref(), &subroutine_path),
         Command::Check {
             program,
             tool_table,
-        } => check(&program, tool_table.as_deref()),
+            subroutine_path,
+        } => check(&program, tool_table.as_deref(), &subroutine_path),
         Command::Run {
             program,
             machine,
@@ -88,6 +100,7 @@ fn main() -> ExitCode {
             period,
             tolerance,
             tool_table,
+            subroutine_path,
         } => run::run(run::RunArgs {
             program,
             machine,
@@ -97,6 +110,7 @@ fn main() -> ExitCode {
             period,
             tolerance,
             tool_table,
+            subroutine_path,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
@@ -116,20 +130,25 @@ fn read_text(path: &Path) -> Result<String> {
         .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
 }
 
-fn load_config(tool_table: Option<&Path>) -> Result<Config> {
-    let table = match tool_table {
+/// The tool table of `--tool-table`, if given.
+fn load_tool_table(tool_table: Option<&Path>) -> Result<ToolTable> {
+    match tool_table {
         Some(path) => ToolTable::parse(&read_text(path)?)
             .into_diagnostic()
-            .wrap_err_with(|| format!("in {}", path.display()))?,
-        None => ToolTable::default(),
-    };
-    Ok(Config::linuxcnc(table))
+            .wrap_err_with(|| format!("in {}", path.display())),
+        None => Ok(ToolTable::default()),
+    }
 }
 
 /// `tezgah canon`: one call per line; on error the calls made so far, then the error.
-fn canon(program: &Path, tool_table: Option<&Path>) -> Result<ExitCode> {
+fn canon(program: &Path, tool_table: Option<&Path>, subs: &[PathBuf]) -> Result<ExitCode> {
     let text = read_text(program)?;
-    let mut interp = Interpreter::new(load_config(tool_table)?);
+    // As `rs274`: tool table and stored offsets in inches.
+    let config = Config {
+        subroutines: library::folders(Some(program), subs),
+        ..Config::linuxcnc(load_tool_table(tool_table)?)
+    };
+    let mut interp = Interpreter::new(config);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
     let mut sink = Printer { out: &mut out };
     let result = interp.run(&text, &mut sink);
@@ -159,10 +178,16 @@ impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
 }
 
 /// `tezgah check`: every error with its place, or a summary of the program.
-fn check(program: &Path, tool_table: Option<&Path>) -> Result<ExitCode> {
+fn check(program: &Path, tool_table: Option<&Path>, subs: &[PathBuf]) -> Result<ExitCode> {
     let text = read_text(program)?;
     let mut counts = diagnostics::Counts::default();
-    let errors = tezgah_gcode::check_into(&text, load_config(tool_table)?, &mut counts);
+    // As `run`: the machine's units (mm) for the tool table and the stored offsets.
+    let config = Config {
+        tool_table: load_tool_table(tool_table)?,
+        subroutines: library::folders(Some(program), subs),
+        ..Config::default()
+    };
+    let errors = tezgah_gcode::check_into(&text, config, &mut counts);
     if errors.is_empty() {
         println!("{}: OK, {counts}", program.display());
         return Ok(ExitCode::SUCCESS);

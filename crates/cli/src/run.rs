@@ -32,6 +32,7 @@ pub struct RunArgs {
     pub period: Option<f64>,
     pub tolerance: Option<f64>,
     pub tool_table: Option<PathBuf>,
+    pub subroutine_path: Vec<PathBuf>,
 }
 
 /// A machine by built-in name or file path.
@@ -96,6 +97,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let config = Config {
         tool_table: table,
+        subroutines: crate::library::folders(args.program.as_deref(), &args.subroutine_path),
         ..Config::default()
     };
     let moves = match tezgah_gcode::program_moves(&text, config) {
