@@ -7,3 +7,7 @@
 pub mod segment;
 
 pub use segment::{Junction, PathItem, Segment, SegmentFeed};
+pub mod deviation;
+pub mod smooth;
+
+pub use deviation::deviation;

@@ -1,0 +1,241 @@
+//! Corner blending: at a junction of two pieces, trim both back by a leg `ℓ` and insert a
+//! curvature-continuous (G2) quintic micro-spline between the trim points (reference 004 §2.4
+//! Steps 1, 4 and 6; Beudaert, Tulsyan & Altintas' corner smoothing in peers_motion.md).
+//!
+//! The blend is the quintic Hermite of reference 004 Step 6 in a normalised parameter
+//! `u ∈ [0, 1]` (duration 1): at each end it takes the neighbour's point, `λ·t` as first and
+//! `λ²·κn` as second derivative (`t` unit tangent, `κn` curvature vector of the neighbour in
+//! arc length). Then the blend's unit tangent is `t` and its curvature vector
+//! `(C'' − (C''·t)t)/|C'|² = κn`: position, tangent and curvature continue, whatever `λ`.
+//! With `λ = 2ℓ` it is exactly the reference's line–line blend with `T = 2ℓ/v` (§2.5), whose
+//! corner deviation is `δ = (3/8)·ℓ·sin(φ/2)`; so `ℓ = 8ε/(3 sin(φ/2))` puts it at the
+//! tolerance `ε` exactly (reference 004 §2.5 "tolerance-exact leg length").
+
+use tezgah_geom::deviation::{closest_point, maximise, point_segment_distance};
+use tezgah_geom::{Curve, Quintic, State, Vec3};
+
+use super::piece::{Geo, Piece};
+
+/// Largest share of a neighbour's (remaining) length a leg may take: two legs on one piece
+/// then leave at least a fifth of it (`1 − 2·0.4`), so blends never overlap or eat a piece.
+pub(crate) const LEG_SHARE: f64 = 0.4;
+
+/// Below this turning angle (rad) a junction is tangent: no blend is needed (or possible: the
+/// leg `8ε/(3 sin(φ/2))` would be unbounded).
+pub(crate) const TANGENT_ANGLE: f64 = 1e-9;
+
+/// Halvings of the leg tried when a blend between curved pieces is measured outside its share.
+const LEG_HALVINGS: usize = 12;
+
+/// The blend curve: a quintic on `[0, 1]` that returns its end points bit for bit, so the
+/// joints with the trimmed neighbours meet exactly (the polynomial form alone would round).
+#[derive(Debug, Clone, Copy)]
+pub struct Blend {
+    q: Quintic,
+    start: Vec3,
+    end: Vec3,
+}
+
+impl Blend {
+    /// The G2 blend from `p0` (unit tangent `t0`, curvature vector `k0`) to `p1` (`t1`, `k1`)
+    /// with end speeds `λ0`, `λ1` (parametric). `None` if the data are not finite.
+    pub fn g2(
+        p0: Vec3,
+        t0: Vec3,
+        k0: Vec3,
+        l0: f64,
+        p1: Vec3,
+        t1: Vec3,
+        k1: Vec3,
+        l1: f64,
+    ) -> Option<Blend> {
+        let s0 = State {
+            p: p0,
+            v: t0 * l0,
+            a: k0 * (l0 * l0),
+        };
+        let s1 = State {
+            p: p1,
+            v: t1 * l1,
+            a: k1 * (l1 * l1),
+        };
+        let q = Quintic::hermite(s0, s1, 1.0).ok()?;
+        Some(Blend {
+            q,
+            start: p0,
+            end: p1,
+        })
+    }
+
+    /// Length by 8-point Gauss–Legendre on the whole and on the halves; the halves are kept
+    /// when the two agree to 1e-12 relative (a quintic's speed is smooth), else the adaptive map.
+    pub fn arc_length(&self) -> f64 {
+        use tezgah_geom::arclen::gauss_legendre;
+        let whole = gauss_legendre(self, 0.0, 1.0);
+        let halves = gauss_legendre(self, 0.0, 0.5) + gauss_legendre(self, 0.5, 1.0);
+        if (whole - halves).abs() <= 1e-12 * halves.max(1e-300) {
+            halves
+        } else {
+            tezgah_geom::ArcLengthMap::new(self, 1e-12)
+                .map(|m| m.length())
+                .unwrap_or(halves)
+        }
+    }
+}
+
+impl Curve for Blend {
+    fn domain(&self) -> (f64, f64) {
+        (0.0, 1.0)
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        let mut d = self.q.derivs(u);
+        if u <= 0.0 || u.is_nan() {
+            d[0] = self.start;
+        } else if u >= 1.0 {
+            d[0] = self.end;
+        }
+        d
+    }
+}
+
+/// Why a junction is not blended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum NoBlend {
+    /// Tangents agree: `Smooth` if curvature also does, else `Tangent`.
+    Tangent { same_curvature: bool },
+    /// A corner the blender cannot round (zero-length neighbour, reversal, tolerance too
+    /// small for the available length).
+    Corner,
+}
+
+/// A blend ready to insert, with the trim parameters of both neighbours.
+pub(crate) struct Placed {
+    pub curve: Blend,
+    pub length: f64,
+    /// New end parameter of the incoming piece, new start parameter of the outgoing one.
+    pub ua: f64,
+    pub ub: f64,
+    /// Corner deviation achieved (distance from the programmed corner to the blend), mm.
+    pub deviation: f64,
+}
+
+/// Distance from `q` to the piece's geometry over `[u0, u1]`.
+fn distance_to(p: &Piece, q: &Vec3, u0: f64, u1: f64) -> f64 {
+    match &p.geo {
+        Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
+        g => closest_point(g, q, u0, u1, 8).distance,
+    }
+}
+
+/// Place a blend between `a` (incoming, trimmed up to `a.u1`) and `b` (outgoing, from `b.u0`)
+/// within `share` mm of the programmed path; `max_angle` (rad) is the largest turn blended.
+pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<Placed, NoBlend> {
+    if !(a.moves_tip() && b.moves_tip()) {
+        return Err(NoBlend::Corner);
+    }
+    let (ta, ka) = a.frame(a.geo.domain().1).ok_or(NoBlend::Corner)?;
+    let (tb, kb) = b.frame(b.geo.domain().0).ok_or(NoBlend::Corner)?;
+    let phi = ta.dot(&tb).clamp(-1.0, 1.0).acos();
+    if !phi.is_finite() {
+        return Err(NoBlend::Corner);
+    }
+    if phi < TANGENT_ANGLE {
+        let scale = ka.norm().max(kb.norm());
+        let same = (ka - kb).norm() <= 1e-9 * scale.max(1e-300) || scale == 0.0;
+        return Err(NoBlend::Tangent {
+            same_curvature: same,
+        });
+    }
+    if phi > max_angle {
+        return Err(NoBlend::Corner);
+    }
+    let half = (0.5 * phi).sin();
+    // Room on each side: the piece's remaining length times the share, but never past a
+    // blend already placed at the piece's other end.
+    let room_a = a.full_length * LEG_SHARE;
+    let room_b = b.full_length * LEG_SHARE;
+    let room_a = room_a.min(a.s_at(a.u1) - a.s_at(a.u0));
+    let room_b = room_b.min(b.s_at(b.u1) - b.s_at(b.u0));
+    let mut leg = (8.0 * share / (3.0 * half)).min(room_a).min(room_b);
+    if !(leg > 0.0 && leg.is_finite()) {
+        return Err(NoBlend::Corner);
+    }
+    let both_lines = matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
+    let corner = a.geo.point(a.geo.domain().1);
+    for _ in 0..=LEG_HALVINGS {
+        let ua = a.u_at(a.full_length - leg);
+        let ub = b.u_at(leg);
+        let (pa, pb) = (a.geo.point(ua), b.geo.point(ub));
+        let (fa, fb) = match (a.frame(ua), b.frame(ub)) {
+            (Some(fa), Some(fb)) => (fa, fb),
+            _ => return Err(NoBlend::Corner),
+        };
+        let lam = 2.0 * leg;
+        let curve = Blend::g2(pa, fa.0, fa.1, lam, pb, fb.0, fb.1, lam).ok_or(NoBlend::Corner)?;
+        let deviation = if both_lines {
+            // Closed form (reference 004 §2.5): the corner's distance to the blend.
+            0.375 * leg * half
+        } else {
+            // Both directions, measured: the corner to the blend, and the blend to the two
+            // programmed pieces around the corner.
+            let to_corner = closest_point(&curve, &corner, 0.0, 1.0, 16).distance;
+            let away = maximise(
+                |u| {
+                    let q = curve.point(u);
+                    distance_to(a, &q, ua, a.geo.domain().1)
+                        .min(distance_to(b, &q, b.geo.domain().0, ub))
+                },
+                0.0,
+                1.0,
+                16,
+            )
+            .distance;
+            to_corner.max(away)
+        };
+        if deviation <= share {
+            let length = curve.arc_length();
+            if !(length > 0.0 && length.is_finite()) {
+                return Err(NoBlend::Corner);
+            }
+            return Ok(Placed {
+                curve,
+                length,
+                ua,
+                ub,
+                deviation,
+            });
+        }
+        leg *= 0.5;
+    }
+    Err(NoBlend::Corner)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_004_line_line_90() {
+        // §5.4: ℓ = 1, 90°: x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
+        let b = Blend::g2(
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::x(),
+            Vec3::zeros(),
+            2.0,
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::y(),
+            Vec3::zeros(),
+            2.0,
+        )
+        .unwrap();
+        for i in 0..=10 {
+            let tau = 0.02 * i as f64;
+            let p = b.point(tau / 0.2);
+            let x = -1.0 + 10.0 * tau - 250.0 * tau.powi(3) + 625.0 * tau.powi(4);
+            let y = 250.0 * tau.powi(3) - 625.0 * tau.powi(4);
+            assert!((p.x - x).abs() < 1e-12 && (p.y - y).abs() < 1e-12, "{tau}");
+        }
+        let mid = b.point(0.5).norm();
+        assert!((mid - 0.265165).abs() < 5e-7, "{mid}");
+    }
+}
