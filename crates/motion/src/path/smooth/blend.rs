@@ -182,8 +182,12 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             let away = maximise(
                 |u| {
                     let q = curve.point(u);
-                    distance_to(a, &q, ua, a.geo.domain().1)
-                        .min(distance_to(b, &q, b.geo.domain().0, ub))
+                    distance_to(a, &q, ua, a.geo.domain().1).min(distance_to(
+                        b,
+                        &q,
+                        b.geo.domain().0,
+                        ub,
+                    ))
                 },
                 0.0,
                 1.0,

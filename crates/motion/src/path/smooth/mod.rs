@@ -353,8 +353,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
 
     fn flush(&mut self, end: Junction) {
         if let Some(a) = self.pending.take() {
-            self.out
-                .push_back(PathItem::Segment(a.into_segment(end)));
+            self.out.push_back(PathItem::Segment(a.into_segment(end)));
         }
     }
 
@@ -362,7 +361,8 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
     /// blend) and trims `b`'s start.
     fn join(&mut self, mut a: Piece, b: &mut Piece) {
         if a.mode == Mode::ExactStop {
-            self.out.push_back(PathItem::Segment(a.into_segment(Junction::Stop)));
+            self.out
+                .push_back(PathItem::Segment(a.into_segment(Junction::Stop)));
             return;
         }
         let blendable = a.mode == Mode::Continuous

@@ -203,15 +203,20 @@ impl Piece {
     /// The segment for the trimmed range, ending with `end`.
     pub fn into_segment(self, end: Junction) -> Segment {
         let length = self.length();
-        let rotary = [self.rotary_at(self.u0), self.rotary_at(self.u1)];
+        let (a, b) = self.geo.domain();
+        let whole = self.u0 <= a && self.u1 >= b;
+        let rotary = if whole {
+            self.rotary
+        } else {
+            [self.rotary_at(self.u0), self.rotary_at(self.u1)]
+        };
         let feed = match self.feed {
             SegmentFeed::InverseTime(t) if self.full_length > 0.0 => {
                 SegmentFeed::InverseTime(t * length / self.full_length)
             }
             f => f,
         };
-        let (a, b) = self.geo.domain();
-        let curve: Box<dyn Curve + Send + Sync> = if self.u0 <= a && self.u1 >= b {
+        let curve: Box<dyn Curve + Send + Sync> = if whole {
             Box::new(self.geo)
         } else {
             match Trimmed::new(self.geo.clone(), self.u0, self.u1) {
