@@ -135,7 +135,8 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     }
     let (ta, ka) = a.frame(a.geo.domain().1).ok_or(NoBlend::Corner)?;
     let (tb, kb) = b.frame(b.geo.domain().0).ok_or(NoBlend::Corner)?;
-    let phi = ta.dot(&tb).clamp(-1.0, 1.0).acos();
+    // atan2, not acos: acos(t·u) loses every turn below ~1e-8 rad to rounding.
+    let phi = ta.cross(&tb).norm().atan2(ta.dot(&tb));
     if !phi.is_finite() {
         return Err(NoBlend::Corner);
     }
