@@ -99,10 +99,47 @@ fn programmed(start: Pose, moves: &[Move]) -> (Vec<Boxed<Prog>>, Vec<Vec3>) {
 fn prog_distance(p: &Prog, q: &Vec3) -> f64 {
     match p {
         Prog::Line(l) => point_segment_distance(q, &l.start(), &l.end()),
-        Prog::Arc(a) => {
+        Prog::Arc(a) => arc_distance(a, q, 0.0, 1.0).unwrap_or_else(|| {
             let (u0, u1) = a.domain();
-            closest_point(a, q, u0, u1, 32).distance
-        }
+            closest_point(a, q, u0, u1, 16).distance
+        }),
+    }
+}
+
+/// Distance from `q` to the part `u ∈ [u0, u1]` of a plane arc of constant radius, in closed
+/// form: the nearest point is at `q`'s own angle if that lies in the part, else an end.
+/// `None` for helices and arcs of changing radius (no closed form; callers sample).
+pub(crate) fn arc_distance(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<f64> {
+    // A radius mismatch at rounding level (arc ends computed by the program's author) is no
+    // spiral: the closed form is off by at most the mismatch.
+    if a.rise() != 0.0 || (a.radius() - a.end_radius()).abs() > 1e-12 * a.radius() {
+        return None;
+    }
+    let (c, n, r, sweep) = (a.center(), a.normal(), a.radius(), a.sweep());
+    let e1 = (a.point(0.0) - c) / r;
+    let e2 = n.cross(&e1);
+    let d = q - c;
+    let (x, y, h) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
+    let ends = || {
+        let p0 = (a.point(u0) - q).norm();
+        let p1 = (a.point(u1) - q).norm();
+        p0.min(p1)
+    };
+    let rho = x.hypot(y);
+    if rho == 0.0 {
+        return Some(r.hypot(h));
+    }
+    // Angle of q measured in the arc's own sense, in [0, 2π).
+    let theta = y.atan2(x) * sweep.signum();
+    let theta = theta.rem_euclid(std::f64::consts::TAU);
+    let (t0, t1) = (sweep.abs() * u0, sweep.abs() * u1);
+    let inside = (t0..=t1).contains(&theta)
+        || (t0..=t1).contains(&(theta + std::f64::consts::TAU))
+        || t1 - t0 >= std::f64::consts::TAU;
+    if inside {
+        Some((rho - r).hypot(h))
+    } else {
+        Some(ends())
     }
 }
 
@@ -146,11 +183,45 @@ pub fn deviation(start: Pose, moves: &[Move], smoothed: &[PathItem]) -> f64 {
     for v in &vertices {
         let d = nearest(&segs, v, &mut hint, |s| {
             let (a, b) = s.curve.domain();
-            closest_point(s.curve.as_ref(), v, a, b, 32).distance
+            closest_point(s.curve.as_ref(), v, a, b, 16).distance
         });
         if d.is_finite() {
             worst = worst.max(d);
         }
     }
     worst
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arc_distance_matches_sampling() {
+        let a = Arc::new(
+            Vec3::zeros(),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::z(),
+            -4.0,
+            0.0,
+        )
+        .unwrap();
+        let b = Arc::new(Vec3::zeros(), Vec3::new(2.0, 0.0, 0.0), Vec3::z(), 7.0, 0.0).unwrap();
+        for arc in [a, b] {
+            for i in 0..200 {
+                let t = i as f64 * 0.37;
+                let q = Vec3::new(3.0 * t.cos(), 2.5 * (1.3 * t).sin(), 0.3 * (t * 0.7).sin());
+                for (u0, u1) in [(0.0, 1.0), (0.2, 0.7)] {
+                    let exact = arc_distance(&arc, &q, u0, u1).unwrap();
+                    let brute = (0..=20000)
+                        .map(|k| (arc.point(u0 + (u1 - u0) * k as f64 / 20000.0) - q).norm())
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        exact <= brute + 1e-12 && brute - exact < 1e-6,
+                        "{exact} {brute}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -36,34 +36,34 @@ pub struct Blend {
     end: Vec3,
 }
 
+/// One end of a blend: the neighbour's point, unit tangent and curvature vector there, and
+/// the blend's parametric speed at that end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct End {
+    pub p: Vec3,
+    pub t: Vec3,
+    pub k: Vec3,
+    pub speed: f64,
+}
+
+impl End {
+    fn state(&self) -> State {
+        State {
+            p: self.p,
+            v: self.t * self.speed,
+            a: self.k * (self.speed * self.speed),
+        }
+    }
+}
+
 impl Blend {
-    /// The G2 blend from `p0` (unit tangent `t0`, curvature vector `k0`) to `p1` (`t1`, `k1`)
-    /// with end speeds `λ0`, `λ1` (parametric). `None` if the data are not finite.
-    pub fn g2(
-        p0: Vec3,
-        t0: Vec3,
-        k0: Vec3,
-        l0: f64,
-        p1: Vec3,
-        t1: Vec3,
-        k1: Vec3,
-        l1: f64,
-    ) -> Option<Blend> {
-        let s0 = State {
-            p: p0,
-            v: t0 * l0,
-            a: k0 * (l0 * l0),
-        };
-        let s1 = State {
-            p: p1,
-            v: t1 * l1,
-            a: k1 * (l1 * l1),
-        };
-        let q = Quintic::hermite(s0, s1, 1.0).ok()?;
+    /// The G2 blend between two ends; `None` if the data are not finite.
+    pub fn g2(start: End, end: End) -> Option<Blend> {
+        let q = Quintic::hermite(start.state(), end.state(), 1.0).ok()?;
         Some(Blend {
             q,
-            start: p0,
-            end: p1,
+            start: start.p,
+            end: end.p,
         })
     }
 
@@ -123,6 +123,8 @@ pub(crate) struct Placed {
 fn distance_to(p: &Piece, q: &Vec3, u0: f64, u1: f64) -> f64 {
     match &p.geo {
         Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
+        Geo::Arc(a) => crate::path::deviation::arc_distance(a, q, u0, u1)
+            .unwrap_or_else(|| closest_point(a, q, u0, u1, 8).distance),
         g => closest_point(g, q, u0, u1, 8).distance,
     }
 }
@@ -172,7 +174,21 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             _ => return Err(NoBlend::Corner),
         };
         let lam = 2.0 * leg;
-        let curve = Blend::g2(pa, fa.0, fa.1, lam, pb, fb.0, fb.1, lam).ok_or(NoBlend::Corner)?;
+        let curve = Blend::g2(
+            End {
+                p: pa,
+                t: fa.0,
+                k: fa.1,
+                speed: lam,
+            },
+            End {
+                p: pb,
+                t: fb.0,
+                k: fb.1,
+                speed: lam,
+            },
+        )
+        .ok_or(NoBlend::Corner)?;
         let deviation = if both_lines {
             // Closed form (reference 004 §2.5): the corner's distance to the blend.
             0.375 * leg * half
@@ -222,15 +238,20 @@ mod tests {
     #[test]
     fn reference_004_line_line_90() {
         // §5.4: ℓ = 1, 90°: x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
+        let z = Vec3::zeros();
         let b = Blend::g2(
-            Vec3::new(-1.0, 0.0, 0.0),
-            Vec3::x(),
-            Vec3::zeros(),
-            2.0,
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::y(),
-            Vec3::zeros(),
-            2.0,
+            End {
+                p: Vec3::new(-1.0, 0.0, 0.0),
+                t: Vec3::x(),
+                k: z,
+                speed: 2.0,
+            },
+            End {
+                p: Vec3::new(0.0, 1.0, 0.0),
+                t: Vec3::y(),
+                k: z,
+                speed: 2.0,
+            },
         )
         .unwrap();
         for i in 0..=10 {

@@ -23,7 +23,7 @@ use std::collections::VecDeque;
 
 use tezgah_geom::{Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, Vec3};
 
-pub use blend::Blend;
+pub use blend::{Blend, End};
 pub use error::PathError;
 
 use crate::path::{Junction, PathItem, Segment, SegmentFeed};
@@ -133,6 +133,8 @@ pub fn build(
 
 /// A unit between tokenising and blending.
 #[derive(Debug)]
+// Almost every token is a piece: boxing it would allocate once per move for nothing.
+#[allow(clippy::large_enum_variant)]
 pub(crate) enum Tok {
     Piece(Piece),
     Dwell { seconds: f64, line: u32 },
