@@ -86,7 +86,7 @@ fn fit_run(run: &[Piece], share: f64) -> Option<Piece> {
     let tol = share * first.tolerance;
     let fit = approximate(&points, 3, tol, Parameterisation::Centripetal).ok()?;
     let mut piece = Piece::new(
-        Geo::Spline(fit.curve),
+        Geo::Spline(Box::new(fit.curve)),
         first.rotary,
         first.line,
         first.feed,

@@ -26,7 +26,8 @@ pub(crate) enum Mode {
 pub(crate) enum Geo {
     Line(Line),
     Arc(Arc),
-    Spline(Nurbs),
+    /// Boxed: splines are rare next to lines, and a small enum keeps pieces cheap to move.
+    Spline(Box<Nurbs>),
 }
 
 impl Curve for Geo {
@@ -79,7 +80,7 @@ impl Curve for Geo {
 pub(crate) struct Piece {
     pub geo: Geo,
     /// Arc-length map, only where arc length is not linear in the parameter.
-    pub map: Option<ArcLengthMap>,
+    pub map: Option<Box<ArcLengthMap>>,
     /// Length of the untrimmed curve, mm.
     pub full_length: f64,
     pub u0: f64,
@@ -113,7 +114,7 @@ impl Piece {
             Geo::Spline(_) => true,
         };
         let map = if needs_map {
-            ArcLengthMap::new(&geo, MAP_TOLERANCE).ok()
+            ArcLengthMap::new(&geo, MAP_TOLERANCE).ok().map(Box::new)
         } else {
             None
         };
