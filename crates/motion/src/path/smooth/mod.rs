@@ -247,7 +247,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
             MoveKind::Arc(a) => {
                 let arc = Arc::from_move(&m.pos, &a)
                     .map_err(|source| PathError::Curve { line, source })?;
-                (Geo::Arc(arc), a.end)
+                (Geo::Arc(Box::new(arc)), a.end)
             }
         };
         if !end.0.iter().all(|c| c.is_finite()) {

@@ -25,7 +25,8 @@ pub(crate) enum Mode {
 #[derive(Debug, Clone)]
 pub(crate) enum Geo {
     Line(Line),
-    Arc(Arc),
+    /// Boxed like splines: lines, the common case, then set the size of a piece.
+    Arc(Box<Arc>),
     /// Boxed: splines are rare next to lines, and a small enum keeps pieces cheap to move.
     Spline(Box<Nurbs>),
 }
