@@ -143,6 +143,19 @@ pub(crate) fn arc_distance(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<f64> {
     }
 }
 
+/// Distance from `q` to the curve over `[u0, u1]`, searched knot span by knot span: on a
+/// spline whose parameter speed varies a lot between spans (centripetal parameters over very
+/// uneven chords), 16 samples over the whole domain can land the refinement in the wrong basin
+/// (seen: 0.0154 mm reported where 0.0004 mm was true).
+pub(crate) fn closest_on_spans<C: Curve + ?Sized>(c: &C, q: &Vec3, u0: f64, u1: f64) -> f64 {
+    let mut cuts = vec![u0];
+    cuts.extend(c.breakpoints().into_iter().filter(|&b| b > u0 && b < u1));
+    cuts.push(u1);
+    cuts.windows(2)
+        .map(|w| closest_point(c, q, w[0], w[1], 8).distance)
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Largest distance between the built path `smoothed` and the programmed `moves` (starting
 /// at `start`), both directions as described in the module documentation, mm.
 pub fn deviation(start: Pose, moves: &[Move], smoothed: &[PathItem]) -> f64 {
@@ -183,7 +196,7 @@ pub fn deviation(start: Pose, moves: &[Move], smoothed: &[PathItem]) -> f64 {
     for v in &vertices {
         let d = nearest(&segs, v, &mut hint, |s| {
             let (a, b) = s.curve.domain();
-            closest_point(s.curve.as_ref(), v, a, b, 16).distance
+            closest_on_spans(s.curve.as_ref(), v, a, b)
         });
         if d.is_finite() {
             worst = worst.max(d);

@@ -139,7 +139,7 @@ fn distance_to(p: &Piece, q: &Vec3, u0: f64, u1: f64) -> f64 {
         Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
         Geo::Arc(a) => crate::path::deviation::arc_distance(a, q, u0, u1)
             .unwrap_or_else(|| closest_point(a, q, u0, u1, 8).distance),
-        g => closest_point(g, q, u0, u1, 8).distance,
+        g => crate::path::deviation::closest_on_spans(g, q, u0, u1),
     }
 }
 
