@@ -185,3 +185,63 @@ proptest! {
         check(&steps, tol, 512)?;
     }
 }
+
+/// Any move at all, including nonsense: non-finite coordinates, zero and huge values, arcs with
+/// the start on the centre, every mode, feed and stop.
+fn any_move() -> impl Strategy<Value = Move> {
+    use tezgah_geom::{ArcMove, FeedMode, MoveKind, Plane, StopKind};
+    let coord = prop_oneof![
+        6 => -10.0..10.0f64,
+        1 => Just(0.0),
+        1 => Just(f64::NAN),
+        1 => Just(f64::INFINITY),
+        1 => Just(1e300),
+        1 => -1e-12..1e-12f64,
+    ];
+    let pose = prop::array::uniform6(coord.clone()).prop_map(Pose);
+    let kind = prop_oneof![
+        3 => pose.clone().prop_map(|end| MoveKind::Feed { end }),
+        1 => pose.clone().prop_map(|end| MoveKind::Rapid { end }),
+        2 => (pose, coord.clone(), coord.clone(), -3..3i32, 0..3usize).prop_map(|(end, i, j, turn, p)| {
+            MoveKind::Arc(ArcMove {
+                plane: [Plane::XY, Plane::ZX, Plane::YZ][p],
+                end,
+                center: [i, j],
+                turn,
+            })
+        }),
+        1 => coord.clone().prop_map(|value| MoveKind::FeedRate { value }),
+        1 => (0..3usize).prop_map(|k| MoveKind::FeedMode(
+            [FeedMode::InverseTime, FeedMode::UnitsPerMinute, FeedMode::UnitsPerRevolution][k])),
+        1 => prop_oneof![
+            Just(PathMode::ExactStop),
+            Just(PathMode::ExactPath),
+            prop::option::of(coord.clone()).prop_map(|tolerance| PathMode::Continuous { tolerance }),
+        ].prop_map(MoveKind::PathMode),
+        1 => coord.prop_map(|seconds| MoveKind::Dwell { seconds }),
+        1 => Just(MoveKind::Stop(StopKind::End)),
+    ];
+    (1..1000u32, kind).prop_map(|(line, kind)| Move { line, kind })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2000))]
+
+    /// No input panics; a path that is built has no NaN in it.
+    #[test]
+    fn no_input_panics(body in prop::collection::vec(any_move(), 0..25), window in 1..6usize) {
+        let mut moves = vec![feed(1, 600.0)];
+        moves.extend(body);
+        let opts = SmoothOptions { window, ..SmoothOptions::default() };
+        if let Ok(items) = build(moves, &opts) {
+            for s in segments(&items) {
+                let (a, b) = s.curve.domain();
+                prop_assert!(s.length.is_finite() && a.is_finite() && b.is_finite());
+                for k in 0..=4 {
+                    let p = s.curve.point(a + (b - a) * k as f64 / 4.0);
+                    prop_assert!(p.iter().all(|c| c.is_finite()), "{:?}", s);
+                }
+            }
+        }
+    }
+}
