@@ -330,6 +330,18 @@ fn errors_are_typed() {
 /// A raster over the surface `z = 2 sin(x/7) cos(y/5)`: rows 2 mm apart, points 0.05–0.3 mm
 /// apart along each row (a CAM surfacing program), 90° turns at the row ends.
 fn surfacing(rows: usize, row_len: f64, seed: u64) -> (Vec<Move>, Vec<Vec3>) {
+    surfacing_with(rows, row_len, seed, 1.0, None)
+}
+
+/// The same raster over `z = 2 sin(k·x/7) cos(y/5)`, coordinates optionally rounded to
+/// `decimals` places as CAM posts print them (rounding is noise the splines must absorb).
+fn surfacing_with(
+    rows: usize,
+    row_len: f64,
+    seed: u64,
+    k: f64,
+    decimals: Option<i32>,
+) -> (Vec<Move>, Vec<Vec3>) {
     let mut rng = seed;
     let mut rand = move || {
         rng ^= rng << 13;
@@ -337,7 +349,11 @@ fn surfacing(rows: usize, row_len: f64, seed: u64) -> (Vec<Move>, Vec<Vec3>) {
         rng ^= rng << 17;
         (rng >> 11) as f64 / (1u64 << 53) as f64
     };
-    let z = |x: f64, y: f64| 2.0 * (x / 7.0).sin() * (y / 5.0).cos();
+    let round = |c: f64| match decimals {
+        Some(d) => (c * 10f64.powi(d)).round() / 10f64.powi(d),
+        None => c,
+    };
+    let z = |x: f64, y: f64| round(2.0 * (k * x / 7.0).sin() * (y / 5.0).cos());
     let start = v(0.0, 0.0, z(0.0, 0.0));
     let mut moves = vec![
         feed(1, 3000.0),
@@ -355,7 +371,7 @@ fn surfacing(rows: usize, row_len: f64, seed: u64) -> (Vec<Move>, Vec<Vec3>) {
         let mut s = 0.0;
         loop {
             s = (s + 0.05 + 0.25 * rand()).min(row_len);
-            let x = if r % 2 == 0 { s } else { row_len - s };
+            let x = round(if r % 2 == 0 { s } else { row_len - s });
             let p = v(x, y, z(x, y));
             moves.push(g1(line, p));
             verts.push(p);
@@ -375,33 +391,54 @@ fn surfacing(rows: usize, row_len: f64, seed: u64) -> (Vec<Move>, Vec<Vec3>) {
     (moves, verts)
 }
 
-#[test]
-fn compression_ratio_on_dense_surfacing() {
-    let (moves, verts) = surfacing(6, 60.0, 7);
+/// Segments in, pieces out (splines + lines, blends not counted), and the measured deviation.
+fn ratio(moves: &[Move], verts: &[Vec3]) -> (usize, usize, usize, f64) {
     let mut start = Pose::ZERO;
     start.0[2] = verts[0].z;
     let opts = SmoothOptions {
         start,
         ..SmoothOptions::default()
     };
-    let mut sm = Smoother::new(moves.clone().into_iter(), opts.clone()).unwrap();
+    let mut sm = Smoother::new(moves.iter().copied(), opts).unwrap();
     let items: Vec<PathItem> = sm.by_ref().collect::<Result<_, _>>().unwrap();
     let stats = sm.stats();
-    let segs = segments(&items);
-    let n_in = stats.moves;
-    let pieces = segs.len() - stats.blends;
-    println!(
-        "surfacing: {n_in} segments in, {pieces} pieces out ({} splines, {} blends, {} corners), ratio {:.1}",
-        stats.splines,
-        stats.blends,
-        stats.corners,
-        n_in as f64 / pieces as f64
-    );
-    check_path(&items, &verts).unwrap();
-    let d = deviation(start, &moves, &items);
-    println!("surfacing: max deviation {d:.6} mm (tolerance 0.01, compression+blend share 0.008)");
-    assert!(d <= 0.008 + 1e-9, "{d}");
-    assert!(n_in as f64 / pieces as f64 >= 10.0);
+    check_path(&items, verts).unwrap();
+    let pieces = segments(&items).len() - stats.blends;
+    (
+        stats.moves,
+        pieces,
+        stats.control_points,
+        deviation(start, moves, &items),
+    )
+}
+
+#[test]
+fn compression_ratio_on_dense_surfacing() {
+    // Segments 0.05–0.3 mm, tolerance 0.01 mm (compression share 0.004 mm).
+    let cases = [
+        // (name, waviness, decimals, least segments per control point)
+        ("smooth surface, exact coordinates", 1.0, None, 10.0),
+        ("smooth surface, 4 decimals", 1.0, Some(4), 10.0),
+        ("smooth surface, 3 decimals", 1.0, Some(3), 10.0),
+        ("5x wavier surface, 3 decimals", 5.0, Some(3), 1.5),
+    ];
+    for (name, k, decimals, min_ratio) in cases {
+        let (moves, verts) = surfacing_with(6, 60.0, 7, k, decimals);
+        let (n_in, pieces, ctrl, d) = ratio(&moves, &verts);
+        let r = n_in as f64 / pieces as f64;
+        println!(
+            "surfacing ({name}): {n_in} segments in, {pieces} pieces out (ratio {r:.1}), \
+             {ctrl} spline control points ({:.1} segments per control point), \
+             max deviation {d:.6} mm (budget 0.008)",
+            n_in as f64 / ctrl as f64
+        );
+        assert!(d <= 0.008 + 1e-9, "{name}: {d}");
+        assert!(r >= 50.0, "{name}: ratio {r}");
+        assert!(
+            n_in as f64 / ctrl as f64 >= min_ratio,
+            "{name}: {ctrl} control points"
+        );
+    }
 }
 
 #[test]

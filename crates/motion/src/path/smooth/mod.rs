@@ -173,6 +173,8 @@ pub struct Stats {
     pub compressed_moves: usize,
     /// Splines made.
     pub splines: usize,
+    /// Control points of those splines (the data a compressed run is reduced to).
+    pub control_points: usize,
     /// Blends inserted.
     pub blends: usize,
     /// Junctions left as corners (G61, or where blending was impossible).
@@ -323,6 +325,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 if let Tok::Piece(p) = t {
                     if p.moves > 1 {
                         self.stats.splines += 1;
+                        self.stats.control_points += p.control_points();
                         self.stats.compressed_moves += p.moves;
                     }
                 }

@@ -192,6 +192,14 @@ impl Piece {
         std::array::from_fn(|i| r0[i] + (r1[i] - r0[i]) * f)
     }
 
+    /// Control points of a spline piece (0 for lines and arcs).
+    pub fn control_points(&self) -> usize {
+        match &self.geo {
+            Geo::Spline(n) => n.control_points().len(),
+            _ => 0,
+        }
+    }
+
     /// Whether the tip moves at all.
     pub fn moves_tip(&self) -> bool {
         self.full_length > 0.0
