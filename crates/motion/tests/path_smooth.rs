@@ -458,3 +458,25 @@ fn small_windows_give_a_valid_path() {
         assert!(d <= 0.008 + 1e-9, "window {window}: {d}");
     }
 }
+
+#[test]
+fn streams_an_endless_program() {
+    // A zigzag that never ends: the builder must hand out items after reading one window, so
+    // a planner can start before the program is read (and memory stays bounded).
+    let zigzag = (0u32..).map(|i| {
+        let x = f64::from(i);
+        g1(i + 2, v(x, if i % 2 == 0 { 0.0 } else { 1.0 }, 0.0))
+    });
+    let moves = std::iter::once(feed(1, 600.0)).chain(zigzag);
+    let opts = SmoothOptions {
+        window: 64,
+        ..SmoothOptions::default()
+    };
+    let items: Vec<_> = Smoother::new(moves, opts).unwrap().take(1000).collect();
+    assert_eq!(items.len(), 1000);
+    let ends = items.iter().filter_map(|i| match i {
+        Ok(PathItem::Segment(s)) => Some(s.end),
+        _ => None,
+    });
+    assert!(ends.take(999).all(|e| e == Junction::Smooth));
+}
