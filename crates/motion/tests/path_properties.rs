@@ -17,8 +17,13 @@ use tezgah_motion::path::smooth::{build, SmoothOptions};
 /// One step of a random program.
 #[derive(Debug, Clone)]
 enum Step {
-    /// Turn the heading by `turn` (rad, in XY), go `len` mm, climbing `dz`.
-    Line { turn: f64, len: f64, dz: f64 },
+    /// Turn the heading by `turn` (rad, in XY), go `len` mm, climbing `dz`, turning A by `da`°.
+    Line {
+        turn: f64,
+        len: f64,
+        dz: f64,
+        da: f64,
+    },
     /// An arc of radius `r` and signed sweep, starting at `offset` rad off the tangent
     /// direction (0 = tangent to the previous move), rising `dz` (a helix).
     Arc {
@@ -48,13 +53,15 @@ fn program(steps: &[Step], tol: f64) -> (Vec<Move>, Vec<Vec3>) {
     let mut pos = Vec3::zeros();
     let mut heading = Vec3::x();
     let mut verts = vec![pos];
+    let mut a = 0.0;
     for (i, s) in steps.iter().enumerate() {
         let line = i as u32 + 3;
         match *s {
-            Step::Line { turn, len, dz } => {
+            Step::Line { turn, len, dz, da } => {
                 heading = rot(heading, turn);
                 let end = pos + heading * len + Vec3::new(0.0, 0.0, dz);
-                moves.push(g1(line, end));
+                a += da;
+                moves.push(g1a(line, end, a));
                 pos = end;
             }
             Step::Arc {
@@ -68,7 +75,11 @@ fn program(steps: &[Step], tol: f64) -> (Vec<Move>, Vec<Vec3>) {
                 let mut end = c + rot(pos - c, sweep);
                 end.z = pos.z + dz;
                 let turn = if sweep > 0.0 { 1 } else { -1 };
-                moves.push(arc_xy(line, end, [c.x, c.y], turn));
+                let mut mv = arc_xy(line, end, [c.x, c.y], turn);
+                if let tezgah_geom::MoveKind::Arc(ref mut am) = mv.kind {
+                    am.end.0[3] = a;
+                }
+                moves.push(mv);
                 let radial = end - c;
                 let tangent = rot(Vec3::new(radial.x, radial.y, 0.0), side);
                 heading = tangent.normalize();
@@ -104,8 +115,9 @@ fn line_step() -> impl Strategy<Value = Step> {
         turn(),
         length(),
         prop_oneof![3 => Just(0.0), 1 => -1.0..1.0f64],
+        prop_oneof![3 => Just(0.0), 1 => -20.0..20.0f64],
     )
-        .prop_map(|(turn, len, dz)| Step::Line { turn, len, dz })
+        .prop_map(|(turn, len, dz, da)| Step::Line { turn, len, dz, da })
 }
 
 fn arc_step() -> impl Strategy<Value = Step> {
@@ -176,7 +188,7 @@ proptest! {
         steps in prop::collection::vec(
             prop_oneof![
                 8 => (-0.2..0.2f64, 0.05..0.3f64, -0.02..0.02f64)
-                    .prop_map(|(turn, len, dz)| Step::Line { turn, len, dz }),
+                    .prop_map(|(turn, len, dz)| Step::Line { turn, len, dz, da: 0.0 }),
                 1 => line_step(),
             ],
             4..120),

@@ -103,6 +103,14 @@ pub fn check_path(items: &[PathItem], vertices: &[Vec3]) -> Result<(), String> {
     }
     for (i, w) in segs.windows(2).enumerate() {
         let (s, t) = (w[0], w[1]);
+        // The rotary axes never jump, at any kind of joint.
+        let jump = |k: usize| (s.rotary[1][k] - t.rotary[0][k]).abs();
+        if (0..3).any(|k| jump(k) > 1e-9 * (1.0 + s.rotary[1][k].abs())) {
+            return Err(format!(
+                "joint {i}: rotary jump {:?} {:?}",
+                s.rotary[1], t.rotary[0]
+            ));
+        }
         let (pe, ps) = (end_point(s), start_point(t));
         let scale = 1.0 + pe.norm();
         match s.end {
@@ -134,11 +142,6 @@ pub fn check_path(items: &[PathItem], vertices: &[Vec3]) -> Result<(), String> {
                             ));
                         }
                     }
-                }
-                if s.rotary[1] != t.rotary[0]
-                    && (0..3).any(|k| (s.rotary[1][k] - t.rotary[0][k]).abs() > 1e-9)
-                {
-                    return Err(format!("joint {i}: rotary jump"));
                 }
             }
             Junction::Corner | Junction::Stop => {
