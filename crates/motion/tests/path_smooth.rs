@@ -480,3 +480,50 @@ fn streams_an_endless_program() {
     });
     assert!(ends.take(999).all(|e| e == Junction::Smooth));
 }
+
+#[test]
+fn blends_never_eat_more_than_their_share_of_a_neighbour() {
+    // Tolerance 1 mm would want legs of 1.5 mm at 90°; the 1 mm moves allow 0.4 mm each side,
+    // leaving 0.2 mm of the middle move.
+    let m = vec![
+        feed(1, 600.0),
+        mode(
+            2,
+            PathMode::Continuous {
+                tolerance: Some(1.0),
+            },
+        ),
+        g1(3, v(1.0, 0.0, 0.0)),
+        g1(4, v(1.0, 1.0, 0.0)),
+        g1(5, v(0.0, 1.0, 0.0)),
+    ];
+    let opts = SmoothOptions {
+        compress: false,
+        ..SmoothOptions::default()
+    };
+    let items = build(m, &opts).unwrap();
+    let segs = segments(&items);
+    assert_eq!(segs.len(), 5);
+    assert!((segs[0].length - 0.6).abs() < 1e-12);
+    assert!((segs[2].length - 0.2).abs() < 1e-12);
+    assert!((segs[4].length - 0.6).abs() < 1e-12);
+}
+
+#[test]
+fn compression_off_keeps_every_move() {
+    let (moves, verts) = surfacing(1, 10.0, 5);
+    let mut start = Pose::ZERO;
+    start.0[2] = verts[0].z;
+    let opts = SmoothOptions {
+        start,
+        compress: false,
+        ..SmoothOptions::default()
+    };
+    let mut sm = Smoother::new(moves.clone().into_iter(), opts).unwrap();
+    let items: Vec<PathItem> = sm.by_ref().collect::<Result<_, _>>().unwrap();
+    let stats = sm.stats();
+    assert_eq!(stats.splines, 0);
+    assert_eq!(segments(&items).len(), stats.moves + stats.blends);
+    check_path(&items, &verts).unwrap();
+    assert!(deviation(start, &moves, &items) <= 0.004 + 1e-12);
+}
