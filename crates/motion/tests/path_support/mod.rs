@@ -97,6 +97,16 @@ pub fn check_path(items: &[PathItem], vertices: &[Vec3]) -> Result<(), String> {
                 return Err(format!("segment {i}: non-finite at u={u}"));
             }
         }
+        // The planner times `length`: it must be the curve's arc length.
+        let len = tezgah_geom::ArcLengthMap::new(s.curve.as_ref(), 1e-10)
+            .map(|m| m.length())
+            .unwrap_or(f64::NAN);
+        if (len - s.length).abs() > 1e-8 * (1.0 + len) {
+            return Err(format!(
+                "segment {i}: length {} but arc length {len}",
+                s.length
+            ));
+        }
         if s.rotary.iter().flatten().any(|c| !c.is_finite()) {
             return Err(format!("segment {i}: rotary NaN"));
         }

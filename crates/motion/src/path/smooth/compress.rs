@@ -46,14 +46,35 @@ pub(crate) fn compress(toks: Vec<Tok>, short: f64, max_turn: f64, share: f64) ->
     let mut out: Vec<Tok> = Vec::with_capacity(toks.len());
     let mut run: Vec<Piece> = Vec::new();
     let flush = |run: &mut Vec<Piece>, out: &mut Vec<Tok>| {
-        if run.len() >= MIN_RUN {
-            if let Some(p) = fit_run(run, share) {
-                out.push(Tok::Piece(p));
-                run.clear();
-                return;
+        // A fit that hooks at an end is retried without that end's move (kept as a line,
+        // which the blender then joins to the spline), a few times.
+        let (mut lo, mut hi) = (0, run.len());
+        let mut fitted = None;
+        for _ in 0..HOOK_RETRIES {
+            if hi - lo < MIN_RUN {
+                break;
+            }
+            match fit_run(&run[lo..hi], share) {
+                Fit::Spline(p) => {
+                    fitted = Some(p);
+                    break;
+                }
+                Fit::Hook { start, end } => {
+                    lo += usize::from(start);
+                    hi -= usize::from(end);
+                }
+                Fit::Failed => break,
             }
         }
-        out.extend(run.drain(..).map(Tok::Piece));
+        match fitted {
+            Some(p) => {
+                let mut rest = run.drain(..);
+                out.extend(rest.by_ref().take(lo).map(Tok::Piece));
+                out.push(Tok::Piece(p));
+                out.extend(rest.skip(hi - lo).map(Tok::Piece));
+            }
+            None => out.extend(run.drain(..).map(Tok::Piece)),
+        }
     };
     for tok in toks {
         match tok {
@@ -75,16 +96,54 @@ pub(crate) fn compress(toks: Vec<Tok>, short: f64, max_turn: f64, share: f64) ->
     out
 }
 
-/// The spline of one run, or `None` if the fit fails.
-fn fit_run(run: &[Piece], share: f64) -> Option<Piece> {
-    let first = run.first()?;
+/// Fits tried per run when the spline hooks at an end.
+const HOOK_RETRIES: usize = 4;
+
+/// What fitting a run gave.
+enum Fit {
+    Spline(Piece),
+    /// The spline leaves backwards at its start and/or end (see [`fit_run`]).
+    Hook {
+        start: bool,
+        end: bool,
+    },
+    Failed,
+}
+
+/// The spline of one run.
+fn fit_run(run: &[Piece], share: f64) -> Fit {
+    let Some(first) = run.first() else {
+        return Fit::Failed;
+    };
     let mut points: Vec<Vec3> = Vec::with_capacity(run.len() + 1);
     points.push(first.geo.point(first.geo.domain().0));
     for p in run {
         points.push(p.geo.point(p.geo.domain().1));
     }
     let tol = share * first.tolerance;
-    let fit = approximate(&points, 3, tol, Parameterisation::Centripetal).ok()?;
+    let Ok(fit) = approximate(&points, 3, tol, Parameterisation::Centripetal) else {
+        return Fit::Failed;
+    };
+    // Least squares pins the end points but not the end tangents: on a short first or last
+    // move the spline can leave backwards and hook round within the tolerance (seen after a
+    // reversal: a near-cusp, whose arc length even geom's quadrature misjudges). Such a spline
+    // would hide a curvature spike (or a reversal) in the spline; the caller refits without
+    // that end's move. Only a backward end tangent (more than 90° off the end move) counts.
+    let (u0, u1) = fit.curve.domain();
+    let n = points.len();
+    let ok_end = |u: f64, a: Vec3, b: Vec3| {
+        let d = fit.curve.d1(u);
+        let chord = b - a;
+        let cos = d.dot(&chord) / (d.norm() * chord.norm());
+        cos.is_finite() && cos > 0.0
+    };
+    let (start, end) = (
+        !ok_end(u0, points[0], points[1]),
+        !ok_end(u1, points[n - 2], points[n - 1]),
+    );
+    if start || end {
+        return Fit::Hook { start, end };
+    }
     let mut piece = Piece::new(
         Geo::Spline(Box::new(fit.curve)),
         first.rotary,
@@ -94,8 +153,8 @@ fn fit_run(run: &[Piece], share: f64) -> Option<Piece> {
         first.mode,
     );
     if !(piece.full_length.is_finite() && piece.full_length > 0.0) {
-        return None;
+        return Fit::Failed;
     }
     piece.moves = run.len();
-    Some(piece)
+    Fit::Spline(piece)
 }
