@@ -70,7 +70,7 @@ pub(crate) fn compress(toks: Vec<Tok>, short: f64, max_turn: f64, share: f64) ->
             Some(p) => {
                 let mut rest = run.drain(..);
                 out.extend(rest.by_ref().take(lo).map(Tok::Piece));
-                out.push(Tok::Piece(p));
+                out.push(Tok::Piece(*p));
                 out.extend(rest.skip(hi - lo).map(Tok::Piece));
             }
             None => out.extend(run.drain(..).map(Tok::Piece)),
@@ -101,7 +101,7 @@ const HOOK_RETRIES: usize = 4;
 
 /// What fitting a run gave.
 enum Fit {
-    Spline(Piece),
+    Spline(Box<Piece>),
     /// The spline leaves backwards at its start and/or end (see [`fit_run`]).
     Hook {
         start: bool,
@@ -156,5 +156,5 @@ fn fit_run(run: &[Piece], share: f64) -> Fit {
         return Fit::Failed;
     }
     piece.moves = run.len();
-    Fit::Spline(piece)
+    Fit::Spline(Box::new(piece))
 }
