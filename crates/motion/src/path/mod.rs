@@ -8,3 +8,7 @@ pub mod direct;
 pub mod segment;
 
 pub use segment::{Junction, PathItem, Segment, SegmentFeed};
+pub mod deviation;
+pub mod smooth;
+
+pub use deviation::deviation;

@@ -1,0 +1,374 @@
+//! Corner blending: at a junction of two pieces, trim both back by a leg `ℓ` and insert a
+//! curvature-continuous (G2) quintic micro-spline between the trim points (reference 004 §2.4
+//! Steps 1, 4 and 6; Beudaert, Tulsyan & Altintas' corner smoothing in peers_motion.md).
+//!
+//! The blend is the quintic Hermite of reference 004 Step 6 in a normalised parameter
+//! `u ∈ [0, 1]` (duration 1): at each end it takes the neighbour's point, `λ·t` as first and
+//! `λ²·κn` as second derivative (`t` unit tangent, `κn` curvature vector of the neighbour in
+//! arc length). Then the blend's unit tangent is `t` and its curvature vector
+//! `(C'' − (C''·t)t)/|C'|² = κn`: position, tangent and curvature continue, whatever `λ`.
+//! With `λ = 2ℓ` it is exactly the reference's line–line blend with `T = 2ℓ/v` (§2.5), whose
+//! corner deviation is `δ = (3/8)·ℓ·sin(φ/2)`; so `ℓ = 8ε/(3 sin(φ/2))` puts it at the
+//! tolerance `ε` exactly (reference 004 §2.5 "tolerance-exact leg length").
+
+use tezgah_geom::arclen::gauss_legendre;
+use tezgah_geom::deviation::{closest_point, maximise, point_segment_distance};
+use tezgah_geom::{Curve, Quintic, State, Vec3};
+
+use super::piece::{Geo, Piece};
+
+/// Largest share of a neighbour's (remaining) length a leg may take: two legs on one piece
+/// then leave at least a fifth of it (`1 − 2·0.4`), so blends never overlap or eat a piece.
+pub(crate) const LEG_SHARE: f64 = 0.4;
+
+/// Below this turning angle (rad) a junction is tangent: no blend is needed (or possible: the
+/// leg `8ε/(3 sin(φ/2))` would be unbounded).
+pub(crate) const TANGENT_ANGLE: f64 = 1e-9;
+
+/// Acceptance of a panel of the blend-length quadrature (relative difference of the whole
+/// and its halves), and the splits always made first. A looser 1e-7 without the forced splits
+/// accepted by coincidence on a 172.5° blend, 1.7e-6 relative off (caught by the property
+/// tests against geom's map).
+const LENGTH_RTOL: f64 = 1e-10;
+const MIN_DEPTH: u32 = 2;
+
+/// Halvings of the leg tried when a blend between curved pieces is measured outside its share.
+const LEG_HALVINGS: usize = 12;
+
+/// The blend curve: a quintic on `[0, 1]` that returns its end points bit for bit, so the
+/// joints with the trimmed neighbours meet exactly (the polynomial form alone would round).
+#[derive(Debug, Clone, Copy)]
+pub struct Blend {
+    q: Quintic,
+    start: Vec3,
+    end: Vec3,
+}
+
+/// One end of a blend: the neighbour's point, unit tangent and curvature vector there, and
+/// the blend's parametric speed at that end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct End {
+    pub p: Vec3,
+    pub t: Vec3,
+    pub k: Vec3,
+    pub speed: f64,
+}
+
+impl End {
+    fn state(&self) -> State {
+        State {
+            p: self.p,
+            v: self.t * self.speed,
+            a: self.k * (self.speed * self.speed),
+        }
+    }
+}
+
+impl Blend {
+    /// The G2 blend between two ends; `None` if the data are not finite.
+    pub fn g2(start: End, end: End) -> Option<Blend> {
+        let q = Quintic::hermite(start.state(), end.state(), 1.0).ok()?;
+        Some(Blend {
+            q,
+            start: start.p,
+            end: end.p,
+        })
+    }
+
+    /// Length by adaptive 8-point Gauss–Legendre: a panel is split in halves until the halves
+    /// agree with the whole to [`LENGTH_RTOL`], after at least [`MIN_DEPTH`] splits; the kept
+    /// halves are far better than that (tested
+    /// against geom's 1e-13 map to 1e-9 relative, also on a 170° blend whose speed dips to cos 85°). No table
+    /// is built (the planner builds its own map if it needs one).
+    pub fn arc_length(&self) -> f64 {
+        let whole = gauss_legendre(self, 0.0, 1.0);
+        self.panel(0.0, 1.0, whole, 0)
+    }
+
+    fn panel(&self, a: f64, b: f64, whole: f64, depth: u32) -> f64 {
+        let m = 0.5 * (a + b);
+        let (l, r) = (gauss_legendre(self, a, m), gauss_legendre(self, m, b));
+        if (depth >= MIN_DEPTH && (whole - (l + r)).abs() <= LENGTH_RTOL * (l + r)) || depth >= 24 {
+            l + r
+        } else {
+            self.panel(a, m, l, depth + 1) + self.panel(m, b, r, depth + 1)
+        }
+    }
+}
+
+impl Curve for Blend {
+    fn domain(&self) -> (f64, f64) {
+        (0.0, 1.0)
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        let mut d = self.q.derivs(u);
+        if u <= 0.0 || u.is_nan() {
+            d[0] = self.start;
+        } else if u >= 1.0 {
+            d[0] = self.end;
+        }
+        d
+    }
+    /// Velocity only (the arc-length quadrature's integrand): one Horner instead of four.
+    fn d1(&self, u: f64) -> Vec3 {
+        let t = if u.is_nan() { 0.0 } else { u.clamp(0.0, 1.0) };
+        let c = self.q.coefficients();
+        (((c[5] * 5.0 * t + c[4] * 4.0) * t + c[3] * 3.0) * t + c[2] * 2.0) * t + c[1]
+    }
+    fn speed(&self, u: f64) -> f64 {
+        self.d1(u).norm()
+    }
+}
+
+/// 8-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; the rule is symmetric).
+const GL_X: [f64; 4] = [
+    0.183_434_642_495_649_8,
+    0.525_532_409_916_329,
+    0.796_666_477_413_626_7,
+    0.960_289_856_497_536_3,
+];
+const GL_W: [f64; 4] = [
+    0.362_683_783_378_362,
+    0.313_706_645_877_887_3,
+    0.222_381_034_453_374_5,
+    0.101_228_536_290_376_3,
+];
+
+fn gl8(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let mut sum = 0.0;
+    for (x, w) in GL_X.iter().zip(GL_W.iter()) {
+        sum += w * (f(m - h * x) + f(m + h * x));
+    }
+    sum * h
+}
+
+fn adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, whole: f64, depth: u32) -> f64 {
+    let m = 0.5 * (a + b);
+    let (l, r) = (gl8(f, a, m), gl8(f, m, b));
+    if (depth >= MIN_DEPTH && (whole - (l + r)).abs() <= LENGTH_RTOL * (l + r)) || depth >= 24 {
+        l + r
+    } else {
+        adaptive(f, a, m, l, depth + 1) + adaptive(f, m, b, r, depth + 1)
+    }
+}
+
+/// Length of the line–line blend with legs `ℓ` and turn `φ`, in closed form up to a scalar
+/// quadrature: `C'(u) = 2ℓ (t0 + (t1 − t0) w)`, `w = 3u² − 2u³` (reference 004 §2.5), so
+/// `|C'| = 2ℓ √(1 − 2w(1−w)(1 − cos φ))`, symmetric about `u = ½`. Same rule and acceptance as
+/// [`Blend::arc_length`], on a scalar instead of a vector integrand (the bench's hot spot).
+pub(crate) fn line_line_length(leg: f64, cos_phi: f64) -> f64 {
+    let g = |u: f64| {
+        let w = u * u * (3.0 - 2.0 * u);
+        (1.0 - 2.0 * w * (1.0 - w) * (1.0 - cos_phi))
+            .max(0.0)
+            .sqrt()
+    };
+    let whole = gl8(&g, 0.0, 0.5);
+    4.0 * leg * adaptive(&g, 0.0, 0.5, whole, 0)
+}
+
+/// Why a junction is not blended.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum NoBlend {
+    /// Tangents agree: `Smooth` if curvature also does, else `Tangent`.
+    Tangent { same_curvature: bool },
+    /// A corner the blender cannot round (zero-length neighbour, reversal, tolerance too
+    /// small for the available length).
+    Corner,
+}
+
+/// A blend ready to insert, with the trim parameters of both neighbours.
+pub(crate) struct Placed {
+    pub curve: Blend,
+    pub length: f64,
+    /// New end parameter of the incoming piece, new start parameter of the outgoing one.
+    pub ua: f64,
+    pub ub: f64,
+    /// Corner deviation achieved (distance from the programmed corner to the blend), mm.
+    pub deviation: f64,
+}
+
+/// Distance from `q` to the piece's geometry over `[u0, u1]`.
+fn distance_to(p: &Piece, q: &Vec3, u0: f64, u1: f64) -> f64 {
+    match &p.geo {
+        Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
+        Geo::Arc(a) => crate::path::deviation::arc_distance(a, q, u0, u1)
+            .unwrap_or_else(|| closest_point(a, q, u0, u1, 8).distance),
+        g => crate::path::deviation::closest_on_spans(g, q, u0, u1),
+    }
+}
+
+/// Place a blend between `a` (incoming, trimmed up to `a.u1`) and `b` (outgoing, from `b.u0`)
+/// within `share` mm of the programmed path; `max_angle` (rad) is the largest turn blended.
+pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<Placed, NoBlend> {
+    if !(a.moves_tip() && b.moves_tip()) {
+        return Err(NoBlend::Corner);
+    }
+    let (ta, ka) = a.frame(a.geo.domain().1).ok_or(NoBlend::Corner)?;
+    let (tb, kb) = b.frame(b.geo.domain().0).ok_or(NoBlend::Corner)?;
+    // atan2, not acos: acos(t·u) loses every turn below ~1e-8 rad to rounding.
+    let phi = ta.cross(&tb).norm().atan2(ta.dot(&tb));
+    if !phi.is_finite() {
+        return Err(NoBlend::Corner);
+    }
+    if phi < TANGENT_ANGLE {
+        let scale = ka.norm().max(kb.norm());
+        let same = (ka - kb).norm() <= 1e-9 * scale.max(1e-300) || scale == 0.0;
+        return Err(NoBlend::Tangent {
+            same_curvature: same,
+        });
+    }
+    if phi > max_angle {
+        return Err(NoBlend::Corner);
+    }
+    let half = (0.5 * phi).sin();
+    // Room on each side: the piece's remaining length times the share, but never past a
+    // blend already placed at the piece's other end.
+    let room_a = a.full_length * LEG_SHARE;
+    let room_b = b.full_length * LEG_SHARE;
+    let room_a = room_a.min(a.s_at(a.u1) - a.s_at(a.u0));
+    let room_b = room_b.min(b.s_at(b.u1) - b.s_at(b.u0));
+    let mut leg = (8.0 * share / (3.0 * half)).min(room_a).min(room_b);
+    if !(leg > 0.0 && leg.is_finite()) {
+        return Err(NoBlend::Corner);
+    }
+    let both_lines = matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
+    let corner = a.geo.point(a.geo.domain().1);
+    for _ in 0..=LEG_HALVINGS {
+        let ua = a.u_at(a.full_length - leg);
+        let ub = b.u_at(leg);
+        let (pa, pb) = (a.geo.point(ua), b.geo.point(ub));
+        let (fa, fb) = match (a.frame(ua), b.frame(ub)) {
+            (Some(fa), Some(fb)) => (fa, fb),
+            _ => return Err(NoBlend::Corner),
+        };
+        let lam = 2.0 * leg;
+        let curve = Blend::g2(
+            End {
+                p: pa,
+                t: fa.0,
+                k: fa.1,
+                speed: lam,
+            },
+            End {
+                p: pb,
+                t: fb.0,
+                k: fb.1,
+                speed: lam,
+            },
+        )
+        .ok_or(NoBlend::Corner)?;
+        let deviation = if both_lines {
+            // Closed form (reference 004 §2.5): the corner's distance to the blend.
+            0.375 * leg * half
+        } else {
+            // Both directions, measured: the corner to the blend, and the blend to the two
+            // programmed pieces around the corner.
+            let to_corner = closest_point(&curve, &corner, 0.0, 1.0, 16).distance;
+            let away = maximise(
+                |u| {
+                    let q = curve.point(u);
+                    distance_to(a, &q, ua, a.geo.domain().1).min(distance_to(
+                        b,
+                        &q,
+                        b.geo.domain().0,
+                        ub,
+                    ))
+                },
+                0.0,
+                1.0,
+                16,
+            )
+            .distance;
+            to_corner.max(away)
+        };
+        if deviation <= share {
+            let length = if both_lines {
+                line_line_length(leg, ta.dot(&tb))
+            } else {
+                curve.arc_length()
+            };
+            if !(length > 0.0 && length.is_finite()) {
+                return Err(NoBlend::Corner);
+            }
+            return Ok(Placed {
+                curve,
+                length,
+                ua,
+                ub,
+                deviation,
+            });
+        }
+        leg *= 0.5;
+    }
+    Err(NoBlend::Corner)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_004_line_line_90() {
+        // §5.4: ℓ = 1, 90°: x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
+        let z = Vec3::zeros();
+        let b = Blend::g2(
+            End {
+                p: Vec3::new(-1.0, 0.0, 0.0),
+                t: Vec3::x(),
+                k: z,
+                speed: 2.0,
+            },
+            End {
+                p: Vec3::new(0.0, 1.0, 0.0),
+                t: Vec3::y(),
+                k: z,
+                speed: 2.0,
+            },
+        )
+        .unwrap();
+        for i in 0..=10 {
+            let tau = 0.02 * i as f64;
+            let p = b.point(tau / 0.2);
+            let x = -1.0 + 10.0 * tau - 250.0 * tau.powi(3) + 625.0 * tau.powi(4);
+            let y = 250.0 * tau.powi(3) - 625.0 * tau.powi(4);
+            assert!((p.x - x).abs() < 1e-12 && (p.y - y).abs() < 1e-12, "{tau}");
+        }
+        let mid = b.point(0.5).norm();
+        assert!((mid - 0.265165).abs() < 5e-7, "{mid}");
+        let exact = tezgah_geom::ArcLengthMap::new(&b, 1e-13).unwrap().length();
+        assert!(
+            (b.arc_length() - exact).abs() < 1e-11,
+            "{} {exact}",
+            b.arc_length()
+        );
+        // A near-reversal (170°): the speed dips to cos 85° at mid-blend.
+        let t1 = Vec3::new(
+            (170f64).to_radians().cos(),
+            (170f64).to_radians().sin(),
+            0.0,
+        );
+        let c = Blend::g2(
+            End {
+                p: Vec3::new(-1.0, 0.0, 0.0),
+                t: Vec3::x(),
+                k: z,
+                speed: 2.0,
+            },
+            End {
+                p: t1,
+                t: t1,
+                k: z,
+                speed: 2.0,
+            },
+        )
+        .unwrap();
+        let exact = tezgah_geom::ArcLengthMap::new(&c, 1e-13).unwrap().length();
+        assert!(
+            (c.arc_length() - exact).abs() < 1e-10,
+            "{} {exact}",
+            c.arc_length()
+        );
+    }
+}

@@ -1,0 +1,30 @@
+//! Typed errors of the smoothing path builder: a move that cannot become a segment (a bad arc,
+//! a feed it cannot time, an invalid tolerance) is reported with its source line, never a panic.
+
+use thiserror::Error;
+
+use tezgah_geom::CurveError;
+
+/// Why the path builder could not turn a move into segments.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum PathError {
+    /// The move's geometry is invalid (arc with zero radius, non-finite coordinates, …).
+    #[error("line {line}: {source}")]
+    Curve {
+        line: u32,
+        #[source]
+        source: CurveError,
+    },
+    /// A feed move with a feed that is not finite and positive.
+    #[error("line {line}: feed {value} is not a positive finite number")]
+    Feed { line: u32, value: f64 },
+    /// G95 (feed per revolution) needs the spindle speed, which the path stage does not know.
+    #[error("line {line}: feed per revolution (G95) is not supported by the path stage")]
+    FeedPerRevolution { line: u32 },
+    /// A tolerance (options or `G64 P`) that is not finite and positive.
+    #[error("line {line}: path tolerance {value} mm is not a positive finite number")]
+    Tolerance { line: u32, value: f64 },
+    /// An option of [`super::SmoothOptions`] out of its range.
+    #[error("smoothing option {name} = {value} is out of range")]
+    Option { name: &'static str, value: f64 },
+}

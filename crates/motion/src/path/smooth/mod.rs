@@ -1,0 +1,496 @@
+//! The smoothing path builder (G64): typed moves in, [`PathItem`]s out, with short G1 runs
+//! compressed into C² splines ([`compress`]) and every remaining corner rounded by a G2 quintic
+//! micro-spline ([`blend`]), all within the path tolerance. G61 and G61.1 pass through unblended.
+//!
+//! **Streaming, bounded memory.** [`Smoother`] pulls at most [`SmoothOptions::window`] moves at
+//! a time, compresses and blends them, and holds back only the last piece (its end junction
+//! depends on the next move). Memory is O(window) whatever the program's length; a compressed
+//! run never spans two windows (the join of the two splines is then blended like any corner).
+//!
+//! **Tolerance budget** (DESIGN.md "Tolerance"): with `ε` the tolerance in force, compression
+//! keeps its splines within `compression_share·ε` (default 0.4) of the programmed polyline, a
+//! blend stays within `blend_share·ε` (0.4) of the curves it joins, and the planner's chord
+//! error gets the rest, at least [`CHORD_SHARE`]`·ε` (0.2). A blend next to a spline is measured
+//! against the spline, so by the triangle inequality the path stays within
+//! `(compression_share + blend_share)·ε` of the program, and the samples within `ε`.
+
+pub mod blend;
+mod compress;
+mod error;
+mod piece;
+
+use std::collections::VecDeque;
+
+use tezgah_geom::{Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, Vec3};
+
+pub use blend::{Blend, End};
+pub use error::PathError;
+
+use crate::path::{Junction, PathItem, Segment, SegmentFeed};
+use blend::NoBlend;
+use piece::{Geo, Mode, Piece};
+
+/// The share of the tolerance left to the feed planner's chord error (and interpolation):
+/// the planner must keep its chords within `CHORD_SHARE · segment.tolerance`.
+pub const CHORD_SHARE: f64 = 0.2;
+
+/// What the smoothing builder may do, and within what. Every field has a documented default.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SmoothOptions {
+    /// Path tolerance, mm, used until a `G64 P` gives one (the machine file's `tolerance_mm`).
+    /// Default 0.01 mm.
+    pub tolerance: f64,
+    /// Compress runs of short G1 moves into splines (G64; `G05.1 Q1` will set the same flag).
+    /// Default on.
+    pub compress: bool,
+    /// Longest G1 move (mm) counted as "short" for compression. Default 1 mm: CAM surfacing
+    /// output is 0.05–0.5 mm; longer moves are the programmer's intent and are only blended.
+    pub short_segment: f64,
+    /// Largest turn (rad) between consecutive moves inside a compressed run; a sharper vertex
+    /// ends the run and stays a corner (to be blended). Default 30°.
+    pub compress_corner_angle: f64,
+    /// Largest turn (rad) that is blended; sharper (near-reversal) corners stay `Corner`: the
+    /// quintic's speed dips to `cos(φ/2)` at mid-blend (reference 004 §2.5), a cusp at 180°.
+    /// Default 175°.
+    pub blend_max_angle: f64,
+    /// Share of the tolerance for compression. Default 0.4.
+    pub compression_share: f64,
+    /// Share of the tolerance for corner blends. Default 0.4.
+    pub blend_share: f64,
+    /// Largest deviation (degrees) of a rotary axis across a blend from its programmed value
+    /// at the corner (5-axis). Default 0.1°.
+    pub angular_tolerance: f64,
+    /// Where the tool stands before the first move (work frame, mm and degrees).
+    pub start: Pose,
+    /// Moves read and processed at a time (bounded memory). Default 512.
+    pub window: usize,
+}
+
+impl Default for SmoothOptions {
+    fn default() -> Self {
+        SmoothOptions {
+            tolerance: 0.01,
+            compress: true,
+            short_segment: 1.0,
+            compress_corner_angle: 30f64.to_radians(),
+            blend_max_angle: 175f64.to_radians(),
+            compression_share: 0.4,
+            blend_share: 0.4,
+            angular_tolerance: 0.1,
+            start: Pose::ZERO,
+            window: 512,
+        }
+    }
+}
+
+impl SmoothOptions {
+    /// Check every field; the shares must leave at least [`CHORD_SHARE`] to the planner.
+    pub fn validate(&self) -> Result<(), PathError> {
+        let pos = |name, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(PathError::Option { name, value: v })
+            }
+        };
+        pos("tolerance", self.tolerance)?;
+        pos("short_segment", self.short_segment)?;
+        pos("compress_corner_angle", self.compress_corner_angle)?;
+        pos("blend_max_angle", self.blend_max_angle)?;
+        pos("compression_share", self.compression_share)?;
+        pos("blend_share", self.blend_share)?;
+        pos("angular_tolerance", self.angular_tolerance)?;
+        let shares = self.compression_share + self.blend_share;
+        if shares > 1.0 - CHORD_SHARE + 1e-12 {
+            return Err(PathError::Option {
+                name: "compression_share + blend_share",
+                value: shares,
+            });
+        }
+        if self.blend_max_angle > std::f64::consts::PI {
+            return Err(PathError::Option {
+                name: "blend_max_angle",
+                value: self.blend_max_angle,
+            });
+        }
+        if !self.start.0.iter().all(|c| c.is_finite()) {
+            return Err(PathError::Option {
+                name: "start",
+                value: f64::NAN,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Build the whole smoothed path (collects [`Smoother`]).
+pub fn build(
+    moves: impl IntoIterator<Item = Move>,
+    opts: &SmoothOptions,
+) -> Result<Vec<PathItem>, PathError> {
+    Smoother::new(moves.into_iter(), opts.clone())?.collect()
+}
+
+/// A unit between tokenising and blending.
+#[derive(Debug)]
+// Almost every token is a piece: boxing it would allocate once per move for nothing.
+#[allow(clippy::large_enum_variant)]
+pub(crate) enum Tok {
+    Piece(Piece),
+    Dwell { seconds: f64, line: u32 },
+    Stop { line: u32 },
+}
+
+/// The modal state the moves run under.
+#[derive(Debug, Clone, Copy)]
+struct Modal {
+    pos: Pose,
+    feed: Option<f64>,
+    feed_mode: FeedMode,
+    mode: Mode,
+    tolerance: f64,
+}
+
+/// The streaming smoothing builder: an iterator of `Result<PathItem, PathError>`; after an
+/// error it ends.
+pub struct Smoother<I> {
+    moves: I,
+    opts: SmoothOptions,
+    modal: Modal,
+    pending: Option<Piece>,
+    out: VecDeque<PathItem>,
+    done: bool,
+    /// Programmed moves folded into splines, and splines made (for reports).
+    stats: Stats,
+}
+
+/// Counts for reports and the compression ratio.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    /// Motion moves read (G0, G1, G2/G3 that move).
+    pub moves: usize,
+    /// Moves replaced by splines.
+    pub compressed_moves: usize,
+    /// Splines made.
+    pub splines: usize,
+    /// Control points of those splines (the data a compressed run is reduced to).
+    pub control_points: usize,
+    /// Blends inserted.
+    pub blends: usize,
+    /// Junctions left as corners (G61, or where blending was impossible).
+    pub corners: usize,
+    /// Largest corner deviation of a blend, mm (closed form for line–line, measured otherwise).
+    pub max_blend_deviation: f64,
+}
+
+impl<I: Iterator<Item = Move>> Smoother<I> {
+    pub fn new(moves: I, opts: SmoothOptions) -> Result<Self, PathError> {
+        opts.validate()?;
+        Ok(Smoother {
+            moves,
+            modal: Modal {
+                pos: opts.start,
+                feed: None,
+                feed_mode: FeedMode::UnitsPerMinute,
+                mode: Mode::Continuous,
+                tolerance: opts.tolerance,
+            },
+            opts,
+            pending: None,
+            out: VecDeque::new(),
+            done: false,
+            stats: Stats::default(),
+        })
+    }
+
+    /// Counts so far.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// Turn one move into a token (or nothing: modal changes, moves that go nowhere).
+    fn tokenise(&mut self, mv: Move) -> Result<Option<Tok>, PathError> {
+        let line = mv.line;
+        let m = &mut self.modal;
+        let (geo, end) = match mv.kind {
+            MoveKind::FeedRate { value } => {
+                m.feed = Some(value);
+                return Ok(None);
+            }
+            MoveKind::FeedMode(f) => {
+                m.feed_mode = f;
+                return Ok(None);
+            }
+            MoveKind::PathMode(p) => {
+                match p {
+                    PathMode::ExactStop => m.mode = Mode::ExactStop,
+                    PathMode::ExactPath => m.mode = Mode::ExactPath,
+                    PathMode::Continuous { tolerance } => {
+                        m.mode = Mode::Continuous;
+                        let t = tolerance.unwrap_or(self.opts.tolerance);
+                        if !(t.is_finite() && t > 0.0) {
+                            return Err(PathError::Tolerance { line, value: t });
+                        }
+                        m.tolerance = t;
+                    }
+                }
+                return Ok(None);
+            }
+            // Fanuc's G05.1 Q1/Q0 switches compression of short moves on and off.
+            MoveKind::Smoothing(on) => {
+                self.opts.compress = on;
+                return Ok(None);
+            }
+            MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
+            MoveKind::Stop(StopKind::Pause)
+            | MoveKind::Stop(StopKind::OptionalPause)
+            | MoveKind::Stop(StopKind::PalletPause)
+            | MoveKind::Stop(StopKind::End) => return Ok(Some(Tok::Stop { line })),
+            MoveKind::Rapid { end } | MoveKind::Feed { end } => {
+                let l = Line::new(Vec3::from(m.pos.xyz()), Vec3::from(end.xyz()))
+                    .map_err(|source| PathError::Curve { line, source })?;
+                (Geo::Line(l), end)
+            }
+            MoveKind::Arc(a) => {
+                let arc = Arc::from_move(&m.pos, &a)
+                    .map_err(|source| PathError::Curve { line, source })?;
+                (Geo::Arc(Box::new(arc)), a.end)
+            }
+        };
+        if !end.0.iter().all(|c| c.is_finite()) {
+            return Err(PathError::Curve {
+                line,
+                source: tezgah_geom::CurveError::NotFinite,
+            });
+        }
+        let rotary = [
+            [m.pos.0[3], m.pos.0[4], m.pos.0[5]],
+            [end.0[3], end.0[4], end.0[5]],
+        ];
+        let feed = match mv.kind {
+            MoveKind::Rapid { .. } => SegmentFeed::Rapid,
+            _ => {
+                let v = m.feed.unwrap_or(0.0);
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(PathError::Feed { line, value: v });
+                }
+                match m.feed_mode {
+                    FeedMode::UnitsPerMinute => SegmentFeed::Feed(v / 60.0),
+                    FeedMode::InverseTime => SegmentFeed::InverseTime(60.0 / v),
+                    FeedMode::UnitsPerRevolution => {
+                        return Err(PathError::FeedPerRevolution { line })
+                    }
+                }
+            }
+        };
+        m.pos = end;
+        let piece = Piece::new(geo, rotary, line, feed, m.tolerance, m.mode);
+        if !piece.moves_tip() && rotary[0] == rotary[1] {
+            // Goes nowhere: nothing to run.
+            return Ok(None);
+        }
+        if !piece.full_length.is_finite() {
+            return Err(PathError::Curve {
+                line,
+                source: tezgah_geom::CurveError::NotFinite,
+            });
+        }
+        self.stats.moves += 1;
+        Ok(Some(Tok::Piece(piece)))
+    }
+
+    /// Read and process one window; returns false at the end of input.
+    fn fill(&mut self) -> Result<bool, PathError> {
+        let mut toks = Vec::with_capacity(self.opts.window.min(4096));
+        let mut read = 0;
+        let mut more = true;
+        while read < self.opts.window.max(1) {
+            match self.moves.next() {
+                Some(mv) => {
+                    read += 1;
+                    if let Some(t) = self.tokenise(mv)? {
+                        toks.push(t);
+                    }
+                }
+                None => {
+                    more = false;
+                    break;
+                }
+            }
+        }
+        if self.opts.compress {
+            let before = toks.len();
+            toks = compress::compress(
+                toks,
+                self.opts.short_segment,
+                self.opts.compress_corner_angle,
+                self.opts.compression_share,
+            );
+            for t in &toks {
+                if let Tok::Piece(p) = t {
+                    if p.moves > 1 {
+                        self.stats.splines += 1;
+                        self.stats.control_points += p.control_points();
+                        self.stats.compressed_moves += p.moves;
+                    }
+                }
+            }
+            debug_assert!(toks.len() <= before);
+        }
+        for t in toks {
+            match t {
+                Tok::Piece(mut b) => {
+                    if let Some(a) = self.pending.take() {
+                        self.join(a, &mut b);
+                    }
+                    self.pending = Some(b);
+                }
+                Tok::Dwell { seconds, line } => {
+                    self.flush(Junction::Stop);
+                    self.out.push_back(PathItem::Dwell { seconds, line });
+                }
+                Tok::Stop { line } => {
+                    self.flush(Junction::Stop);
+                    self.out.push_back(PathItem::Stop { line });
+                }
+            }
+        }
+        if !more {
+            self.flush(Junction::Stop);
+        }
+        Ok(more)
+    }
+
+    fn flush(&mut self, end: Junction) {
+        if let Some(a) = self.pending.take() {
+            self.out.push_back(PathItem::Segment(a.into_segment(end)));
+        }
+    }
+
+    /// Decide the junction between `a` and `b`, blending where allowed; emits `a` (and the
+    /// blend) and trims `b`'s start.
+    fn join(&mut self, mut a: Piece, b: &mut Piece) {
+        if a.mode == Mode::ExactStop {
+            self.out
+                .push_back(PathItem::Segment(a.into_segment(Junction::Stop)));
+            return;
+        }
+        let blendable = a.mode == Mode::Continuous
+            && b.mode == Mode::Continuous
+            && feeds_compatible(a.feed, b.feed);
+        let share = self.opts.blend_share * a.tolerance.min(b.tolerance);
+        let max_angle = if blendable {
+            self.opts.blend_max_angle
+        } else {
+            // Only the tangent test: every real turn stays a corner.
+            0.0
+        };
+        let mut placed = blend::place(&a, b, share, max_angle);
+        // 5-axis: the rotary axes run linearly across the blend; keep their deviation from the
+        // programmed value at the corner within the angular tolerance by shortening the legs.
+        if let Ok(p) = &placed {
+            if !self.rotary_ok(&a, b, p.ua, p.ub) {
+                placed = Err(NoBlend::Corner);
+                let mut s = share;
+                for _ in 0..20 {
+                    s *= 0.5;
+                    match blend::place(&a, b, s, max_angle) {
+                        Ok(q) if self.rotary_ok(&a, b, q.ua, q.ub) => {
+                            placed = Ok(q);
+                            break;
+                        }
+                        Ok(_) => {}
+                        Err(e) => {
+                            placed = Err(e);
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+        match placed {
+            Ok(p) => {
+                let rotary = [a.rotary_at(p.ua), b.rotary_at(p.ub)];
+                let feed = blend_feed(&a, b, p.ua, p.ub);
+                let seg = Segment {
+                    curve: Box::new(p.curve),
+                    length: p.length,
+                    rotary,
+                    line: a.line,
+                    feed,
+                    end: Junction::Smooth,
+                    tolerance: a.tolerance.min(b.tolerance),
+                };
+                a.u1 = p.ua;
+                b.u0 = p.ub;
+                self.stats.blends += 1;
+                self.stats.max_blend_deviation = self.stats.max_blend_deviation.max(p.deviation);
+                self.out
+                    .push_back(PathItem::Segment(a.into_segment(Junction::Smooth)));
+                self.out.push_back(PathItem::Segment(seg));
+            }
+            Err(NoBlend::Tangent { same_curvature }) => {
+                let end = if same_curvature {
+                    Junction::Smooth
+                } else {
+                    Junction::Tangent
+                };
+                self.out.push_back(PathItem::Segment(a.into_segment(end)));
+            }
+            Err(NoBlend::Corner) => {
+                self.stats.corners += 1;
+                self.out
+                    .push_back(PathItem::Segment(a.into_segment(Junction::Corner)));
+            }
+        }
+    }
+
+    fn rotary_ok(&self, a: &Piece, b: &Piece, ua: f64, ub: f64) -> bool {
+        let corner = a.rotary[1];
+        let (ra, rb) = (a.rotary_at(ua), b.rotary_at(ub));
+        (0..3).all(|i| (corner[i] - 0.5 * (ra[i] + rb[i])).abs() <= self.opts.angular_tolerance)
+    }
+}
+
+/// Blending across a change between inverse time and a feed rate would mix two timing rules.
+fn feeds_compatible(a: SegmentFeed, b: SegmentFeed) -> bool {
+    matches!(a, SegmentFeed::InverseTime(_)) == matches!(b, SegmentFeed::InverseTime(_))
+}
+
+/// The blend runs at the lower of the two feeds (a rapid next to a feed takes the feed); in
+/// inverse time it takes the time of the two legs it replaces.
+fn blend_feed(a: &Piece, b: &Piece, ua: f64, ub: f64) -> SegmentFeed {
+    match (a.feed, b.feed) {
+        (SegmentFeed::InverseTime(ta), SegmentFeed::InverseTime(tb)) => {
+            let la = a.full_length - a.s_at(ua);
+            let lb = b.s_at(ub);
+            SegmentFeed::InverseTime(ta * la / a.full_length + tb * lb / b.full_length)
+        }
+        (SegmentFeed::Feed(x), SegmentFeed::Feed(y)) => SegmentFeed::Feed(x.min(y)),
+        (SegmentFeed::Feed(x), _) | (_, SegmentFeed::Feed(x)) => SegmentFeed::Feed(x),
+        _ => SegmentFeed::Rapid,
+    }
+}
+
+impl<I: Iterator<Item = Move>> Iterator for Smoother<I> {
+    type Item = Result<PathItem, PathError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(item) = self.out.pop_front() {
+                return Some(Ok(item));
+            }
+            if self.done {
+                return None;
+            }
+            match self.fill() {
+                Ok(more) => self.done = !more,
+                Err(e) => {
+                    self.done = true;
+                    self.out.clear();
+                    return Some(Err(e));
+                }
+            }
+        }
+    }
+}

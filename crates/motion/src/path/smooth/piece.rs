@@ -1,0 +1,261 @@
+//! One programmed (or compressed) piece of the tool-tip path while the smoothing builder works
+//! on it: its curve, the parameter range left after the blends either side trimmed it, and the
+//! move's feed, rotary axes, line and mode. Becomes one [`Segment`] when emitted.
+
+use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, Trimmed, Vec3};
+
+use crate::path::{Junction, Segment, SegmentFeed};
+
+/// Arc-length tolerance for the pieces that need a map (splines, arcs of changing radius): far
+/// below any path tolerance, so leg lengths and segment lengths are exact for the planner.
+pub(crate) const MAP_TOLERANCE: f64 = 1e-9;
+
+/// The path mode a piece was programmed under.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Mode {
+    /// G61.1: stop at the end of every block.
+    ExactStop,
+    /// G61: corners sharp, passed at zero speed.
+    ExactPath,
+    /// G64: blend (and compress, if on) within the tolerance.
+    Continuous,
+}
+
+/// The curve kinds a piece can be; one enum so a trimmed piece is `Trimmed<Geo>`.
+#[derive(Debug, Clone)]
+pub(crate) enum Geo {
+    Line(Line),
+    /// Boxed like splines: lines, the common case, then set the size of a piece.
+    Arc(Box<Arc>),
+    /// Boxed: splines are rare next to lines, and a small enum keeps pieces cheap to move.
+    Spline(Box<Nurbs>),
+}
+
+impl Curve for Geo {
+    fn domain(&self) -> (f64, f64) {
+        match self {
+            Geo::Line(c) => c.domain(),
+            Geo::Arc(c) => c.domain(),
+            Geo::Spline(c) => c.domain(),
+        }
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        match self {
+            Geo::Line(c) => c.derivs(u),
+            Geo::Arc(c) => c.derivs(u),
+            Geo::Spline(c) => c.derivs(u),
+        }
+    }
+    fn point(&self, u: f64) -> Vec3 {
+        match self {
+            Geo::Line(c) => c.point(u),
+            Geo::Arc(c) => c.point(u),
+            Geo::Spline(c) => c.point(u),
+        }
+    }
+    fn curvature(&self, u: f64) -> f64 {
+        match self {
+            Geo::Line(c) => c.curvature(u),
+            Geo::Arc(c) => c.curvature(u),
+            Geo::Spline(c) => c.curvature(u),
+        }
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        match self {
+            Geo::Line(c) => c.breakpoints(),
+            Geo::Arc(c) => c.breakpoints(),
+            Geo::Spline(c) => c.breakpoints(),
+        }
+    }
+    fn length(&self) -> f64 {
+        match self {
+            Geo::Line(c) => c.length(),
+            Geo::Arc(c) => c.length(),
+            Geo::Spline(c) => c.length(),
+        }
+    }
+}
+
+/// A piece of the path with its trim range `[u0, u1]`.
+#[derive(Debug, Clone)]
+pub(crate) struct Piece {
+    pub geo: Geo,
+    /// Arc-length map, only where arc length is not linear in the parameter.
+    pub map: Option<Box<ArcLengthMap>>,
+    /// Length of the untrimmed curve, mm.
+    pub full_length: f64,
+    pub u0: f64,
+    pub u1: f64,
+    /// A B C at the untrimmed start and end (they move in proportion to arc length).
+    pub rotary: [[f64; 3]; 2],
+    /// First source line of the piece (a compressed spline reports its first move's line).
+    pub line: u32,
+    /// Feed of the untrimmed piece (inverse time is scaled to the trimmed length on emission).
+    pub feed: SegmentFeed,
+    pub tolerance: f64,
+    pub mode: Mode,
+    /// Number of programmed moves this piece stands for (1, or the run length of a spline).
+    pub moves: usize,
+}
+
+impl Piece {
+    /// A piece over the whole curve; builds an arc-length map where one is needed.
+    pub fn new(
+        geo: Geo,
+        rotary: [[f64; 3]; 2],
+        line: u32,
+        feed: SegmentFeed,
+        tolerance: f64,
+        mode: Mode,
+    ) -> Self {
+        let needs_map = match &geo {
+            Geo::Line(_) => false,
+            // A mismatch at rounding level keeps arc length linear in u to ~1e-12 relative.
+            Geo::Arc(a) => (a.radius() - a.end_radius()).abs() > 1e-12 * a.radius(),
+            Geo::Spline(_) => true,
+        };
+        let map = if needs_map {
+            ArcLengthMap::new(&geo, MAP_TOLERANCE).ok().map(Box::new)
+        } else {
+            None
+        };
+        let full_length = match &map {
+            Some(m) => m.length(),
+            None => geo.length(),
+        };
+        let (u0, u1) = geo.domain();
+        Piece {
+            geo,
+            map,
+            full_length,
+            u0,
+            u1,
+            rotary,
+            line,
+            feed,
+            tolerance,
+            mode,
+            moves: 1,
+        }
+    }
+
+    /// Arc length from the curve's start to `u`.
+    pub fn s_at(&self, u: f64) -> f64 {
+        match &self.map {
+            Some(m) => m.s_at(&self.geo, u),
+            None => {
+                let (a, b) = self.geo.domain();
+                if b > a {
+                    (u - a) / (b - a) * self.full_length
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// Parameter at arc length `s` from the curve's start.
+    pub fn u_at(&self, s: f64) -> f64 {
+        let (a, b) = self.geo.domain();
+        match &self.map {
+            Some(m) => m.u_at(&self.geo, s),
+            None => {
+                if self.full_length > 0.0 {
+                    a + (b - a) * (s / self.full_length).clamp(0.0, 1.0)
+                } else {
+                    a
+                }
+            }
+        }
+    }
+
+    /// Length of the trimmed range, mm.
+    pub fn length(&self) -> f64 {
+        (self.s_at(self.u1) - self.s_at(self.u0)).max(0.0)
+    }
+
+    /// Rotary axes at parameter `u`, in proportion to arc length.
+    pub fn rotary_at(&self, u: f64) -> [f64; 3] {
+        let [r0, r1] = self.rotary;
+        let (a, b) = self.geo.domain();
+        if u <= a {
+            return r0;
+        }
+        if u >= b {
+            return r1;
+        }
+        let f = if self.full_length > 0.0 {
+            self.s_at(u) / self.full_length
+        } else {
+            0.0
+        };
+        std::array::from_fn(|i| r0[i] + (r1[i] - r0[i]) * f)
+    }
+
+    /// Control points of a spline piece (0 for lines and arcs).
+    pub fn control_points(&self) -> usize {
+        match &self.geo {
+            Geo::Spline(n) => n.control_points().len(),
+            _ => 0,
+        }
+    }
+
+    /// Whether the tip moves at all.
+    pub fn moves_tip(&self) -> bool {
+        self.full_length > 0.0
+    }
+
+    /// Unit tangent and curvature vector (in arc length) at `u`; `None` where the curve
+    /// stands still.
+    pub fn frame(&self, u: f64) -> Option<(Vec3, Vec3)> {
+        frame(&self.geo, u)
+    }
+
+    /// The segment for the trimmed range, ending with `end`.
+    pub fn into_segment(self, end: Junction) -> Segment {
+        let length = self.length();
+        let (a, b) = self.geo.domain();
+        let whole = self.u0 <= a && self.u1 >= b;
+        let rotary = if whole {
+            self.rotary
+        } else {
+            [self.rotary_at(self.u0), self.rotary_at(self.u1)]
+        };
+        let feed = match self.feed {
+            SegmentFeed::InverseTime(t) if self.full_length > 0.0 => {
+                SegmentFeed::InverseTime(t * length / self.full_length)
+            }
+            f => f,
+        };
+        let curve: Box<dyn Curve + Send + Sync> = if whole {
+            Box::new(self.geo)
+        } else {
+            match Trimmed::new(self.geo.clone(), self.u0, self.u1) {
+                Ok(t) => Box::new(t),
+                // u0 <= u1 always holds (blends never overlap); keep the curve if not.
+                Err(_) => Box::new(self.geo),
+            }
+        };
+        Segment {
+            curve,
+            length,
+            rotary,
+            line: self.line,
+            feed,
+            end,
+            tolerance: self.tolerance,
+        }
+    }
+}
+
+/// Unit tangent `t = C'/|C'|` and curvature vector `κn = (C'' − (C''·t)t)/|C'|²` at `u`.
+pub(crate) fn frame<C: Curve + ?Sized>(c: &C, u: f64) -> Option<(Vec3, Vec3)> {
+    let [_, d1, d2, _] = c.derivs(u);
+    let speed = d1.norm();
+    if !(speed > 0.0 && speed.is_finite()) {
+        return None;
+    }
+    let t = d1 / speed;
+    let k = (d2 - t * d2.dot(&t)) / (speed * speed);
+    Some((t, k))
+}
