@@ -9,7 +9,7 @@ use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
 use tezgah_kinematics::{builtin_names, Machine};
 use tezgah_motion::interpolate::{run as run_items, Sample};
-use tezgah_motion::path::direct::{build, DirectOptions};
+use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::verify::{Report, Verifier};
 
@@ -117,12 +117,14 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
     let start = Pose::ZERO;
-    let items = build(
-        &moves,
-        start,
-        DirectOptions {
+    // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
+    // G61 keeps corners, G61.1 stops at every block end.
+    let items = smooth::build(
+        moves.iter().copied(),
+        &SmoothOptions {
             tolerance,
-            ..DirectOptions::default()
+            start,
+            ..SmoothOptions::default()
         },
     )
     .map_err(|e| miette!("{e}"))?;
@@ -133,6 +135,8 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     let options = PlanOptions {
         period,
+        // The chord error gets what compression and blending leave of the tolerance.
+        chord_share: smooth::CHORD_SHARE,
         ..PlanOptions::default()
     };
 
