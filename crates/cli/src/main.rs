@@ -21,29 +21,32 @@ struct Cli {
     command: Command,
 }
 
+/// What a program may read besides its own text.
+#[derive(clap::Args)]
+struct Inputs {
+    /// A tool table in LinuxCNC's format.
+    #[arg(long)]
+    tool_table: Option<PathBuf>,
+    /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
+    #[arg(long = "subroutine-path")]
+    subroutine_path: Vec<PathBuf>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Print the canonical machining calls of a program, as LinuxCNC's `rs274` prints them.
     Canon {
         /// The G-code program.
         program: PathBuf,
-        /// A tool table in LinuxCNC's format.
-        #[arg(long)]
-        tool_table: Option<PathBuf>,
-        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
-        #[arg(long = "subroutine-path")]
-        subroutine_path: Vec<PathBuf>,
+        #[command(flatten)]
+        inputs: Inputs,
     },
     /// Pre-flight: check a whole program and report every error, or a short summary.
     Check {
         /// The G-code program.
         program: PathBuf,
-        /// A tool table in LinuxCNC's format.
-        #[arg(long)]
-        tool_table: Option<PathBuf>,
-        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
-        #[arg(long = "subroutine-path")]
-        subroutine_path: Vec<PathBuf>,
+        #[command(flatten)]
+        inputs: Inputs,
     },
     /// Plan and run a program on a machine model: samples, report, plots and a summary.
     Run {
@@ -67,12 +70,8 @@ enum Command {
         /// Path tolerance, mm (default: the machine file's `tolerance_mm`; G64 P overrides).
         #[arg(long)]
         tolerance: Option<f64>,
-        /// A tool table in LinuxCNC's format.
-        #[arg(long)]
-        tool_table: Option<PathBuf>,
-        /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
-        #[arg(long = "subroutine-path")]
-        subroutine_path: Vec<PathBuf>,
+        #[command(flatten)]
+        inputs: Inputs,
     },
     /// List the built-in machine definitions.
     Machines,
@@ -81,16 +80,8 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Canon {
-            program,
-            tool_table,
-            subroutine_path,
-        } => canon(&program, tool_table.as_deref(), &subroutine_path),
-        Command::Check {
-            program,
-            tool_table,
-            subroutine_path,
-        } => check(&program, tool_table.as_deref(), &subroutine_path),
+        Command::Canon { program, inputs } => canon(&program, &inputs),
+        Command::Check { program, inputs } => check(&program, &inputs),
         Command::Run {
             program,
             machine,
@@ -99,8 +90,7 @@ fn main() -> ExitCode {
             plot,
             period,
             tolerance,
-            tool_table,
-            subroutine_path,
+            inputs,
         } => run::run(run::RunArgs {
             program,
             machine,
@@ -109,8 +99,8 @@ fn main() -> ExitCode {
             plot,
             period,
             tolerance,
-            tool_table,
-            subroutine_path,
+            tool_table: inputs.tool_table,
+            subroutine_path: inputs.subroutine_path,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
@@ -141,12 +131,12 @@ fn load_tool_table(tool_table: Option<&Path>) -> Result<ToolTable> {
 }
 
 /// `tezgah canon`: one call per line; on error the calls made so far, then the error.
-fn canon(program: &Path, tool_table: Option<&Path>, subs: &[PathBuf]) -> Result<ExitCode> {
+fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
     // As `rs274`: tool table and stored offsets in inches.
     let config = Config {
-        subroutines: library::folders(Some(program), subs),
-        ..Config::linuxcnc(load_tool_table(tool_table)?)
+        subroutines: library::folders(Some(program), &inputs.subroutine_path),
+        ..Config::linuxcnc(load_tool_table(inputs.tool_table.as_deref())?)
     };
     let mut interp = Interpreter::new(config);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
@@ -178,13 +168,13 @@ impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
 }
 
 /// `tezgah check`: every error with its place, or a summary of the program.
-fn check(program: &Path, tool_table: Option<&Path>, subs: &[PathBuf]) -> Result<ExitCode> {
+fn check(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
     let mut counts = diagnostics::Counts::default();
     // As `run`: the machine's units (mm) for the tool table and the stored offsets.
     let config = Config {
-        tool_table: load_tool_table(tool_table)?,
-        subroutines: library::folders(Some(program), subs),
+        tool_table: load_tool_table(inputs.tool_table.as_deref())?,
+        subroutines: library::folders(Some(program), &inputs.subroutine_path),
         ..Config::default()
     };
     let errors = tezgah_gcode::check_into(&text, config, &mut counts);

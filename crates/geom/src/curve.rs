@@ -83,60 +83,40 @@ pub(crate) fn clamp_param(u: f64, a: f64, b: f64) -> f64 {
     }
 }
 
-impl<C: Curve + ?Sized> Curve for &C {
-    fn domain(&self) -> (f64, f64) {
-        (**self).domain()
-    }
-    fn derivs(&self, u: f64) -> [Vec3; 4] {
-        (**self).derivs(u)
-    }
-    fn point(&self, u: f64) -> Vec3 {
-        (**self).point(u)
-    }
-    fn d1(&self, u: f64) -> Vec3 {
-        (**self).d1(u)
-    }
-    fn speed(&self, u: f64) -> f64 {
-        (**self).speed(u)
-    }
-    fn curvature(&self, u: f64) -> f64 {
-        (**self).curvature(u)
-    }
-    fn breakpoints(&self) -> Vec<f64> {
-        (**self).breakpoints()
-    }
-    fn length(&self) -> f64 {
-        (**self).length()
-    }
+/// References and boxes of curves are curves: every method forwards (so the overrides of the
+/// curve behind them are kept).
+macro_rules! forward_curve {
+    ($($t:ty),*) => {$(
+        impl<C: Curve + ?Sized> Curve for $t {
+            fn domain(&self) -> (f64, f64) {
+                (**self).domain()
+            }
+            fn derivs(&self, u: f64) -> [Vec3; 4] {
+                (**self).derivs(u)
+            }
+            fn point(&self, u: f64) -> Vec3 {
+                (**self).point(u)
+            }
+            fn d1(&self, u: f64) -> Vec3 {
+                (**self).d1(u)
+            }
+            fn speed(&self, u: f64) -> f64 {
+                (**self).speed(u)
+            }
+            fn curvature(&self, u: f64) -> f64 {
+                (**self).curvature(u)
+            }
+            fn breakpoints(&self) -> Vec<f64> {
+                (**self).breakpoints()
+            }
+            fn length(&self) -> f64 {
+                (**self).length()
+            }
+        }
+    )*};
 }
 
-/// A path is a list of `Box<dyn Curve>`; boxes are curves too.
-impl<C: Curve + ?Sized> Curve for Box<C> {
-    fn domain(&self) -> (f64, f64) {
-        (**self).domain()
-    }
-    fn derivs(&self, u: f64) -> [Vec3; 4] {
-        (**self).derivs(u)
-    }
-    fn point(&self, u: f64) -> Vec3 {
-        (**self).point(u)
-    }
-    fn d1(&self, u: f64) -> Vec3 {
-        (**self).d1(u)
-    }
-    fn speed(&self, u: f64) -> f64 {
-        (**self).speed(u)
-    }
-    fn curvature(&self, u: f64) -> f64 {
-        (**self).curvature(u)
-    }
-    fn breakpoints(&self) -> Vec<f64> {
-        (**self).breakpoints()
-    }
-    fn length(&self) -> f64 {
-        (**self).length()
-    }
-}
+forward_curve!(&C, Box<C>);
 
 #[cfg(test)]
 mod tests {

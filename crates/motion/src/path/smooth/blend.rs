@@ -120,27 +120,8 @@ impl Curve for Blend {
     }
 }
 
-/// 8-point Gauss–Legendre nodes and weights on [−1, 1] (positive half; the rule is symmetric).
-const GL_X: [f64; 4] = [
-    0.183_434_642_495_649_8,
-    0.525_532_409_916_329,
-    0.796_666_477_413_626_7,
-    0.960_289_856_497_536_3,
-];
-const GL_W: [f64; 4] = [
-    0.362_683_783_378_362,
-    0.313_706_645_877_887_3,
-    0.222_381_034_453_374_5,
-    0.101_228_536_290_376_3,
-];
-
 fn gl8(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
-    let mut sum = 0.0;
-    for (x, w) in GL_X.iter().zip(GL_W.iter()) {
-        sum += w * (f(m - h * x) + f(m + h * x));
-    }
-    sum * h
+    tezgah_geom::arclen::gauss_legendre_8(f, a, b)
 }
 
 fn adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, whole: f64, depth: u32) -> f64 {
