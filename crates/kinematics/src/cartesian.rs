@@ -5,7 +5,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::KinematicsError;
-use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
+use crate::kinematics::{
+    check_input, check_pose, check_tip, check_vertical_axis, Jacobian, Kinematics, Tolerances,
+};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 
 /// X Y Z plus independent axes; the tool axis is always workpiece +Z.
@@ -53,17 +55,7 @@ impl Kinematics for Cartesian {
     ) -> Result<Joints, KinematicsError> {
         check_pose(pose)?;
         check_input(previous, self.limits.len())?;
-        // The only axis this machine makes is +Z; the sine of the angle to it is the
-        // horizontal part of the unit axis.
-        let horizontal = (pose.axis.x * pose.axis.x + pose.axis.y * pose.axis.y).sqrt();
-        if pose.axis.z <= 0.0 || horizontal > self.axis_sin {
-            return Err(KinematicsError::AxisUnreachable {
-                reason: format!(
-                    "a Cartesian machine's tool axis is +Z; requested ({:.6}, {:.6}, {:.6})",
-                    pose.axis.x, pose.axis.y, pose.axis.z
-                ),
-            });
-        }
+        check_vertical_axis(pose, self.axis_sin, "a Cartesian machine")?;
         let mut q = *previous;
         q[0] = pose.tip.x;
         q[1] = pose.tip.y;

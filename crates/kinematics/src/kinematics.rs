@@ -207,3 +207,23 @@ pub(crate) fn check_pose(p: &ToolPose) -> Result<(), KinematicsError> {
         })
     }
 }
+
+/// Checks the tool axis of a machine that only translates the tool: +Z, within `axis_sin`
+/// (the sine of the angle tolerated). `machine` says which kind of machine, for the message.
+pub(crate) fn check_vertical_axis(
+    pose: &ToolPose,
+    axis_sin: f64,
+    machine: &str,
+) -> Result<(), KinematicsError> {
+    let a = &pose.axis;
+    // The sine of the angle to +Z is the horizontal part of the unit axis.
+    if a.z <= 0.0 || (a.x * a.x + a.y * a.y).sqrt() > axis_sin {
+        return Err(KinematicsError::AxisUnreachable {
+            reason: format!(
+                "{machine}: the tool axis is +Z; requested ({:.6}, {:.6}, {:.6})",
+                a.x, a.y, a.z
+            ),
+        });
+    }
+    Ok(())
+}

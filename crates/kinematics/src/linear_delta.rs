@@ -10,7 +10,9 @@
 use nalgebra::{Matrix3, Vector3};
 
 use crate::error::KinematicsError;
-use crate::kinematics::{check_input, check_pose, Jacobian, Kinematics, Tolerances};
+use crate::kinematics::{
+    check_input, check_pose, check_vertical_axis, Jacobian, Kinematics, Tolerances,
+};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
 
 /// Geometry of a linear delta.
@@ -297,17 +299,6 @@ impl LinearDelta {
         }
         Ok(m)
     }
-
-    fn check_axis(&self, pose: &ToolPose) -> Result<(), KinematicsError> {
-        if pose.axis.z <= 0.0
-            || (pose.axis.x * pose.axis.x + pose.axis.y * pose.axis.y).sqrt() > self.axis_sin
-        {
-            return Err(KinematicsError::AxisUnreachable {
-                reason: "a linear delta only translates; the tool axis is +Z".into(),
-            });
-        }
-        Ok(())
-    }
 }
 
 impl Kinematics for LinearDelta {
@@ -334,7 +325,7 @@ impl Kinematics for LinearDelta {
         check_pose(pose)?;
         // A delta has one solution; `previous` is only checked, for a uniform API.
         check_input(previous, 3)?;
-        self.check_axis(pose)?;
+        check_vertical_axis(pose, self.axis_sin, "a linear delta only translates")?;
         let p = Vector3::new(pose.tip.x, pose.tip.y, pose.tip.z + tool.length);
         let q = Joints::new(self.inverse_platform_checked(&p)?);
         check_limits(&q, &self.limits)?;

@@ -28,30 +28,3 @@ pub fn tilt_keeping_c(k: &Vector3<f64>, c: f64) -> f64 {
     let (sc, cc) = c.sin_cos();
     (-k.x * cc + k.y * sc).atan2(k.z)
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Both solutions give back the axis, and keeping C at the exact pole gives tilt 0.
-    #[test]
-    fn solutions_reproduce_the_axis() {
-        for (t, c) in [
-            (0.3, 0.2),
-            (1.2, -2.5),
-            (-0.7, 3.0),
-            (2.0, 1.0),
-            (0.01, -0.01),
-        ] {
-            let k = axis(t, c);
-            for (ts, cs) in solutions(&k) {
-                assert!((axis(ts, cs) - k).norm() < 1e-14, "{t} {c} → {ts} {cs}");
-            }
-            let (t0, c0) = solutions(&k)[0];
-            assert!(t0 >= 0.0 && ((t0 - t.abs()).abs() < 1e-14));
-            // the tilt that keeps a given C reproduces the axis when C is one of the solutions
-            assert!((axis(tilt_keeping_c(&k, c0), c0) - k).norm() < 1e-14);
-        }
-        assert_eq!(tilt_keeping_c(&Vector3::z(), 1.234), 0.0);
-    }
-}

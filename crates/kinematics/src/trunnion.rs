@@ -281,3 +281,49 @@ impl Kinematics for Trunnion {
         Ok(j)
     }
 }
+
+#[cfg(test)]
+mod axis_maps {
+    use nalgebra::Vector3;
+
+    type Axis = fn(f64, f64) -> Vector3<f64>;
+    type Solutions = fn(&Vector3<f64>) -> [(f64, f64); 2];
+    type TiltKeepingC = fn(&Vector3<f64>, f64) -> f64;
+
+    /// For both trunnions: both solutions give back the axis, and keeping C at the exact pole
+    /// gives tilt 0.
+    #[test]
+    fn solutions_reproduce_the_axis() {
+        let maps: [(Axis, Solutions, TiltKeepingC); 2] = [
+            (
+                super::table_ac::axis,
+                super::table_ac::solutions,
+                super::table_ac::tilt_keeping_c,
+            ),
+            (
+                super::table_bc::axis,
+                super::table_bc::solutions,
+                super::table_bc::tilt_keeping_c,
+            ),
+        ];
+        for (axis, solutions, tilt_keeping_c) in maps {
+            for (t, c) in [
+                (0.3, 0.2),
+                (1.2, -2.5),
+                (-0.7, 3.0),
+                (2.0, 1.0),
+                (0.01, -0.01),
+            ] {
+                let k = axis(t, c);
+                for (ts, cs) in solutions(&k) {
+                    assert!((axis(ts, cs) - k).norm() < 1e-14, "{t} {c} → {ts} {cs}");
+                }
+                let (t0, c0) = solutions(&k)[0];
+                assert!(t0 >= 0.0 && ((t0 - t.abs()).abs() < 1e-14));
+                // the tilt that keeps a given C reproduces the axis when C is one of the solutions
+                assert!((axis(tilt_keeping_c(&k, c0), c0) - k).norm() < 1e-14);
+            }
+            assert_eq!(tilt_keeping_c(&Vector3::z(), 1.234), 0.0);
+        }
+    }
+}

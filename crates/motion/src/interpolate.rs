@@ -208,8 +208,13 @@ impl<'m> Interpolator<'m> {
                     let tau = (self.k as f64 * self.period - self.t0).max(0.0);
                     let st = piece.profile.state_at(tau);
                     let s = st.s.clamp(0.0, piece.length());
+                    // Several segments may pass within one period: build the s → u map only
+                    // for the one the sample lands on.
+                    let before = idx;
                     while idx + 1 < piece.segments.len() && s > piece.offsets[idx + 1] {
                         idx += 1;
+                    }
+                    if idx != before {
                         param = Param::new(&piece.segments[idx]);
                     }
                     let seg = &piece.segments[idx];

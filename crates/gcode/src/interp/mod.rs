@@ -15,7 +15,8 @@ mod state;
 mod system;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
-pub use control::{ControlLimits, LinePos, SubroutineFile, SubroutineLibrary};
+use control::SubroutineFile;
+pub use control::{ControlLimits, LinePos, SubroutineLibrary};
 pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
@@ -428,17 +429,8 @@ impl Interpreter {
     }
 }
 
-/// Split a program into lines with their numbers and byte offsets (`\n`, `\r\n` or `\r`).
-pub fn lines(program: &str) -> impl Iterator<Item = LineRef<'_>> {
-    let mut at = LinePos::FIRST;
-    std::iter::from_fn(move || {
-        let line = line_at(program, at)?;
-        at = line.next();
-        Some(line)
-    })
-}
-
-/// The line that starts at `at`, if the program goes on that far.
+/// The line that starts at `at`, if the program goes on that far (lines end with `\n` or
+/// `\r\n`).
 pub fn line_at(program: &str, at: LinePos) -> Option<LineRef<'_>> {
     let start = at.start;
     let rest = program.as_bytes().get(start..).filter(|r| !r.is_empty())?;

@@ -14,6 +14,7 @@ use std::sync::Arc;
 use super::joints::PlanMachine;
 use super::limits::{
     analyse, has_jump, inside_group, junction_cap, segment_limits, Geometry, PlanOptions,
+    SegmentLimits,
 };
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
@@ -73,11 +74,22 @@ struct Open {
     last_end_cap: f64,
 }
 
+/// The last segment pushed, held until the next one decides its end junction.
+struct Held {
+    seg: Segment,
+    geom: Geometry,
+    /// A jump at its start costs it a jerk reserve.
+    jump: bool,
+    /// Its limits without a reserve, once computed (a junction check needs them, and `add`
+    /// can reuse them when no reserve is kept).
+    free: Option<SegmentLimits>,
+}
+
 /// The streaming planner: `push` path items, take [`Planned`] items with `pop`.
 pub struct Planner {
     machine: PlanMachine,
     options: PlanOptions,
-    pending: Option<(Segment, Geometry, bool)>,
+    pending: Option<Held>,
     open: Option<Open>,
     window: VecDeque<Entry>,
     out: VecDeque<Planned>,
@@ -145,21 +157,28 @@ impl Planner {
         if geom.length <= 0.0 {
             return Ok(());
         }
+        let mut free = None;
         let start_jump = match self.pending.take() {
-            Some((p, pg, p_jump)) => {
-                let (cap, jump) = match p.end {
+            Some(mut held) => {
+                let (cap, jump) = match held.seg.end {
                     Junction::Corner | Junction::Stop => (0.0, false),
                     Junction::Tangent | Junction::Smooth => {
-                        let cap = junction_cap(&pg, &geom, &self.machine, &self.options);
-                        let jump = has_jump(&pg, &geom, &self.machine);
+                        let cap = junction_cap(&held.geom, &geom, &self.machine, &self.options);
+                        let jump = has_jump(&held.geom, &geom, &self.machine);
                         // A jump that allows only a crawl is cheaper as a stop: no reserve
                         // is then kept on the two segments.
-                        let speed = |s: &Segment, g: &Geometry| {
-                            segment_limits(s, g, &self.machine, &self.options, false)
-                                .map(|l| l.limits.max_velocity())
+                        let before = match held.free {
+                            Some(l) => l,
+                            None => self.free_limits(&held.seg, &held.geom)?,
                         };
+                        let after = self.free_limits(&seg, &geom)?;
+                        held.free = Some(before);
+                        free = Some(after);
                         let floor = self.options.min_junction_share
-                            * speed(&p, &pg)?.min(speed(&seg, &geom)?);
+                            * before
+                                .limits
+                                .max_velocity()
+                                .min(after.limits.max_velocity());
                         if jump && cap < floor {
                             (0.0, false)
                         } else {
@@ -167,19 +186,26 @@ impl Planner {
                         }
                     }
                 };
-                self.add(p, pg, p_jump || jump, cap)?;
+                let reserve = held.jump || jump;
+                self.add(held, reserve, cap)?;
                 jump
             }
             None => false,
         };
-        self.pending = Some((seg, geom, start_jump));
+        self.pending = Some(Held {
+            seg,
+            geom,
+            jump: start_jump,
+            free,
+        });
         Ok(())
     }
 
     /// The motion stops here (dwell, stop, end): the held segment ends at speed 0.
     fn end_here(&mut self) -> Result<(), PlanError> {
-        if let Some((p, pg, jump)) = self.pending.take() {
-            self.add(p, pg, jump, 0.0)?;
+        if let Some(held) = self.pending.take() {
+            let reserve = held.jump;
+            self.add(held, reserve, 0.0)?;
         }
         if let Some(open) = self.open.take() {
             self.close(open, 0.0)?;
@@ -187,14 +213,19 @@ impl Planner {
         Ok(())
     }
 
-    fn add(
-        &mut self,
-        seg: Segment,
-        geom: Geometry,
-        reserve: bool,
-        end_cap: f64,
-    ) -> Result<(), PlanError> {
-        let sl = segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?;
+    /// A segment's limits when no jerk reserve is kept at its junctions.
+    fn free_limits(&self, seg: &Segment, geom: &Geometry) -> Result<SegmentLimits, PlanError> {
+        segment_limits(seg, geom, &self.machine, &self.options, false)
+    }
+
+    fn add(&mut self, held: Held, reserve: bool, end_cap: f64) -> Result<(), PlanError> {
+        let Held {
+            seg, geom, free, ..
+        } = held;
+        let sl = match free {
+            Some(l) if !reserve => l,
+            _ => segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?,
+        };
         let (v, a, j) = (
             sl.limits.max_velocity(),
             sl.limits.max_acceleration(),
