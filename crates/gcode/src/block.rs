@@ -340,7 +340,6 @@ impl Block {
             b's' if negative => Some(ErrorKind::NegativeSpindleSpeed),
             b't' if negative => Some(ErrorKind::NegativeTool),
             b'l' if negative => Some(ErrorKind::NegativeL),
-            b'd' if negative => Some(ErrorKind::NegativeD),
             _ => None,
         };
         if let Some(kind) = kind {

@@ -143,8 +143,6 @@ pub enum ErrorKind {
     NegativeTool,
     #[error("Negative l word used")]
     NegativeL,
-    #[error("Negative d word tool radius index used")]
-    NegativeD,
 
     // --- expressions and parameters ---
     #[error("Unclosed expression")]
@@ -296,6 +294,8 @@ pub enum ErrorKind {
     G10POutOfRange(i64),
     #[error("R not allowed in G10 L20")]
     G10L20Rotation,
+    #[error(transparent)]
+    CutterComp(#[from] crate::interp::CompError),
     #[error("Requested tool {0} not found in the tool table")]
     ToolNotFound(i64),
 

@@ -58,6 +58,9 @@ impl Interpreter {
         if self.state.feed_mode == FeedMode::InverseTime {
             return err(ErrorKind::CycleInverseTime);
         }
+        if self.comp.side.is_some() {
+            return err(super::comp::CompError::CannedCycle.into());
+        }
         let Some(plane) = self.state.plane else {
             return err(ErrorKind::Unsupported(
                 "canned cycles in the U V W planes".into(),

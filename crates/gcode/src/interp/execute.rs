@@ -10,6 +10,7 @@ use crate::codes::{g_name, ggroup, mgroup};
 use crate::error::{ErrorKind, GcodeError};
 use crate::params::{self, coord_system_base};
 
+use super::comp::CompError;
 use super::{checks, state};
 use super::{Flow, Interpreter, LineRef};
 
@@ -106,6 +107,9 @@ impl Interpreter {
         if block.g(ggroup::NON_MODAL) == Some(40) {
             self.emit(sink, Canon::Dwell(block.get(b'p').unwrap_or(0.0)));
         }
+        if let Some(c) = block.g[ggroup::PLANE] {
+            self.refuse_plane_change(c.code).map_err(|k| (k, c.at))?;
+        }
         if let Some(g) = block.g(ggroup::PLANE) {
             self.state.plane = match g {
                 170 => Some(Plane::XY),
@@ -129,23 +133,28 @@ impl Interpreter {
             if diameter != self.state.lathe_diameter {
                 self.state.lathe_diameter = diameter;
                 let what = if diameter { "diameter" } else { "radius" };
-                self.comment_call(sink, format!("Lathe diameter mode changed to {what}"));
+                // LinuxCNC sends this one at once, even past moves compensation holds.
+                let text = format!("interpreter: Lathe diameter mode changed to {what}");
+                sink.call(self.origin, Canon::Comment(text));
             }
         }
         if let Some(c) = block.g[ggroup::CUTTER_COMP] {
-            if c.code != 400 {
-                return Err(unsupported(c.code, c.at));
-            }
-            self.comment_call(sink, "cutter radius compensation off".into());
+            self.cutter_compensation(block, c.code, c.at, sink)?;
         }
         if let Some(c) = block.g[ggroup::TOOL_LENGTH] {
+            self.refuse_with_comp(CompError::ToolOffset)
+                .map_err(|k| (k, c.at))?;
             self.tool_length(block, c.code, c.at, sink)?;
         }
-        if let Some(g) = block.g(ggroup::COORD_SYSTEM) {
-            self.select_coordinate_system(coord_index(g), sink);
+        if let Some(c) = block.g[ggroup::COORD_SYSTEM] {
+            self.refuse_with_comp(CompError::ChangeCoordinateSystem)
+                .map_err(|k| (k, c.at))?;
+            self.select_coordinate_system(coord_index(c.code), sink);
         }
-        if let Some(g) = block.g(ggroup::PATH_CONTROL) {
-            self.path_control(block, g, sink);
+        if let Some(c) = block.g[ggroup::PATH_CONTROL] {
+            self.refuse_with_comp(CompError::ChangeControlMode)
+                .map_err(|k| (k, c.at))?;
+            self.path_control(block, c.code, sink);
         }
         if let Some(on) = plan.smoothing {
             self.emit(sink, Canon::SetSmoothing(on));
@@ -174,6 +183,10 @@ impl Interpreter {
                 self.comment_call(sink, format!("IJK distance mode changed to {what}"));
             }
         }
+        if let Some(c) = block.g[ggroup::RETRACT] {
+            self.refuse_with_comp(CompError::ChangeRetractMode)
+                .map_err(|k| (k, c.at))?;
+        }
         if let Some(g) = block.g(ggroup::RETRACT) {
             self.state.retract_r_plane = g == 990;
             let what = if g == 980 { "old_z" } else { "r_plane" };
@@ -188,8 +201,9 @@ impl Interpreter {
         if let Some(m) = block.m[mgroup::SUBPROGRAM] {
             return self.subprogram(block, m.code, m.at);
         }
-        if let Some(m) = block.m(mgroup::STOP) {
-            return Ok(self.stop(m, sink));
+        if let Some(m) = block.m[mgroup::STOP] {
+            self.flush_comp(sink).map_err(|k| (k, m.at))?;
+            return Ok(self.stop(m.code, sink));
         }
         Ok(Flow::Continue)
     }
@@ -253,7 +267,7 @@ impl Interpreter {
     }
 
     /// `COMMENT("interpreter: …")`, the notes LinuxCNC makes on mode changes.
-    pub(super) fn comment_call(&self, sink: &mut impl CanonSink, what: String) {
+    pub(super) fn comment_call(&mut self, sink: &mut impl CanonSink, what: String) {
         self.emit(sink, Canon::Comment(format!("interpreter: {what}")));
     }
 
@@ -290,7 +304,10 @@ impl Interpreter {
 
     fn tool_change(&mut self, block: &Block, m: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
         if m == 6 {
+            self.refuse_with_comp(CompError::ToolChange)
+                .map_err(|k| (k, at))?;
             let tool = self.state.selected_tool.unwrap_or(0);
+            self.state.spindle_tool = tool;
             self.emit(sink, Canon::StartChange);
             self.state.spindle = None;
             self.emit(sink, Canon::StopSpindle);
@@ -309,6 +326,7 @@ impl Interpreter {
         if tool != 0 && self.cfg.tool_table.get(tool).is_none() {
             return Err((ErrorKind::ToolNotFound(tool), at));
         }
+        self.state.spindle_tool = tool;
         self.emit(sink, Canon::ChangeToolNumber(self.pocket_of(tool)));
         Ok(())
     }
@@ -349,6 +367,7 @@ impl Interpreter {
         s.tool_offset = s.tool_offset.scale_linear(k);
         s.spindle_tool_offset = s.spindle_tool_offset.scale_linear(k);
         s.units = units;
+        self.comp.scale(k);
     }
 
     /// G54 … G59.3: the tool stays where it is and its point is re-expressed in the new system.
@@ -410,6 +429,15 @@ impl Interpreter {
 
     /// G10, G28, G28.1, G30, G30.1, G52, G92, G92.1, G92.2, G92.3 (G4 and G53 are elsewhere).
     fn non_modal(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        let refusal = match g {
+            280 | 300 => Some(CompError::Home),
+            281 | 301 => Some(CompError::SetHome),
+            520 | 920..=923 => Some(CompError::ChangeAxisOffsets),
+            _ => None,
+        };
+        if let Some(e) = refusal {
+            self.refuse_with_comp(e).map_err(|k| (k, at))?;
+        }
         match g {
             100 => self.set_coordinate_system(block, at, sink)?,
             280 | 300 => self.go_home(block, g, sink)?,
@@ -456,6 +484,10 @@ impl Interpreter {
         // LinuxCNC checks round(P) but uses the truncated P.
         let p = block.get(b'p').unwrap_or(0.0).trunc() as usize;
         let index = if p == 0 { self.state.origin_index } else { p };
+        if index == self.state.origin_index {
+            self.refuse_with_comp(CompError::ChangeActiveCoordinateSystem)
+                .map_err(|k| (k, at))?;
+        }
         let (mut offset, mut rotation) = self.coordinate_system(index);
         if let Some(r) = block.get(b'r') {
             rotation = r;

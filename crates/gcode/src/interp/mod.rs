@@ -7,6 +7,7 @@
 
 mod arc;
 mod checks;
+mod comp;
 mod control;
 mod cycles;
 mod execute;
@@ -15,6 +16,7 @@ mod state;
 mod system;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
+pub use comp::CompError;
 use control::SubroutineFile;
 pub use control::{ControlLimits, LinePos, SubroutineLibrary};
 pub use state::{rotate_xy as state_rotate_xy, State};
@@ -88,6 +90,8 @@ pub struct Interpreter {
     /// Source line being executed, for the canonical calls' origin.
     origin: Origin,
     control: control::Control,
+    /// Cutter radius compensation and the moves it holds back.
+    comp: comp::CutterComp,
     /// M2/M30 ended a `%` program: the rest of the text should hold the closing `%`.
     closing_percent_sought: bool,
     /// Subroutine files loaded so far; file k of a [`LinePos`] is `files[k - 1]`.
@@ -145,6 +149,7 @@ impl Interpreter {
             ended: false,
             origin: Origin::default(),
             control: control::Control::default(),
+            comp: comp::CutterComp::default(),
             closing_percent_sought: false,
             files: Vec::new(),
         }
@@ -396,8 +401,9 @@ impl Interpreter {
         }
     }
 
-    fn emit(&self, sink: &mut impl CanonSink, call: Canon) {
-        sink.call(self.origin, call);
+    /// Send a call, or hold it behind moves that cutter compensation holds back.
+    fn emit(&mut self, sink: &mut impl CanonSink, call: Canon) {
+        self.emit_or_hold(sink, call);
     }
 
     /// A pose in the machine's units (tool table, parameters) in the program's units

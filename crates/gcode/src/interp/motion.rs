@@ -12,6 +12,7 @@ use crate::error::ErrorKind;
 use crate::params;
 
 use super::arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
+use super::comp::{CompError, ProgrammedArc};
 use super::execute::{unsupported, Exec};
 use super::Interpreter;
 
@@ -39,10 +40,20 @@ impl Interpreter {
             let m = block.axes_over(s.to_machine(s.pos) + s.tool_offset);
             return s.from_machine(m - s.tool_offset);
         }
+        // While compensating, axes of the compensation plane not named continue from the
+        // programmed point, not from the offset tool (LinuxCNC's `comp && middle`).
         let mut end = s.pos;
+        if self.comp.in_progress() {
+            let normal = s.plane.map_or(2, |p| p.axes().2);
+            for i in 0..3 {
+                if i == 0 || (i == 1 && normal == 2) || (i == 2 && normal == 1) {
+                    end.0[i] = self.comp.programmed[i];
+                }
+            }
+        }
         for (i, word) in block.axis_words().into_iter().enumerate() {
             if let Some(v) = word {
-                end.0[i] = if s.incremental { s.pos.0[i] + v } else { v };
+                end.0[i] = if s.incremental { end.0[i] + v } else { v };
             }
         }
         end
@@ -81,7 +92,20 @@ impl Interpreter {
     }
 
     fn straight(&mut self, block: &Block, rapid: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
+        self.comp.arc_not_allowed = false;
         let end = self.find_ends(block);
+        if self.comp.active() {
+            if !rapid {
+                if let Some(f) = self.feed_for_move(block, false, at)? {
+                    let length = straight_length(end - self.comp_start());
+                    self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
+                }
+            }
+            if block.g(ggroup::NON_MODAL) == Some(530) {
+                return Err((CompError::G53.into(), at));
+            }
+            return self.straight_comp(rapid, end, sink).map_err(|k| (k, at));
+        }
         if rapid {
             self.emit(sink, Canon::StraightTraverse(end));
         } else {
@@ -131,6 +155,9 @@ impl Interpreter {
     }
 
     fn arc(&mut self, block: &Block, clockwise: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if self.comp.arc_not_allowed {
+            return Err((CompError::ArcAfterExit.into(), at));
+        }
         let Some(plane) = self.state.plane else {
             return Err((
                 ErrorKind::Unsupported("arcs in the U V W planes".into()),
@@ -169,7 +196,7 @@ impl Interpreter {
             Some(p) if p.round() < 1.0 => return Err((ErrorKind::ArcTurnsBelowOne, at)),
             Some(p) => p.round() as i32,
         };
-        let start = self.state.pos;
+        let start = self.comp_start();
         let end = self.find_ends(block);
         let s2 = [start.0[first], start.0[second]];
         let e2 = [end.0[first], end.0[second]];
@@ -183,6 +210,9 @@ impl Interpreter {
             (AXIS_LETTERS[first] as char).to_ascii_uppercase(),
             (AXIS_LETTERS[second] as char).to_ascii_uppercase(),
         );
+        let turn = sense.turn(turns);
+        self.check_entry_arc(end, radius, turn)
+            .map_err(|k| (k, at))?;
         let center = match radius {
             Some(r) => center_from_radius(s2, e2, r, sense, tol),
             None => {
@@ -206,11 +236,19 @@ impl Interpreter {
             }
         }
         .map_err(|kind| (kind, at))?;
+        if radius.is_none() {
+            self.check_entry_arc_center(s2, center, turn)
+                .map_err(|k| (k, at))?;
+        }
         if let Some(f) = inverse_feed {
             let radius = (s2[0] - center[0]).hypot(s2[1] - center[1]);
             let planar = radius * sweep(s2, e2, center, sense, turns as u32);
             let length = planar.hypot(end.0[normal] - start.0[normal]);
             self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
+        }
+        if self.comp.active() {
+            let arc = ProgrammedArc::new(plane.axes(), end, center, turn);
+            return self.arc_comp(arc, sink).map_err(|k| (k, at));
         }
         self.emit(
             sink,
@@ -219,7 +257,7 @@ impl Interpreter {
                 second_end: e2[1],
                 first_axis: center[0],
                 second_axis: center[1],
-                rotation: sense.turn(turns),
+                rotation: turn,
                 axis_end: end.0[normal],
                 abc: [end.0[3], end.0[4], end.0[5]],
             },

@@ -37,6 +37,8 @@ pub struct State {
     pub selected_tool: Option<i64>,
     /// Offsets of the tool in the spindle (LinuxCNC's pocket 0), used by G43 without H.
     pub spindle_tool_offset: Pose,
+    /// Number of the tool in the spindle (M6, M61), whose diameter G41/G42 use without D.
+    pub spindle_tool: i64,
     pub mist: bool,
     pub flood: bool,
     pub lathe_diameter: bool,
@@ -71,6 +73,7 @@ impl Default for State {
             tool_offset: Pose::ZERO,
             selected_tool: None,
             spindle_tool_offset: Pose::ZERO,
+            spindle_tool: 0,
             mist: false,
             flood: false,
             lathe_diameter: false,
