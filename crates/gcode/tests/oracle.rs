@@ -221,9 +221,33 @@ enum Item {
         sub: usize,
         args: [f64; 2],
     },
+    /// A contour cut with cutter radius compensation: see [`CompContour`].
+    Comp(CompContour),
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
+}
+
+/// A closed-ish contour cut under G41/G42: vertices around a centre at increasing angles with
+/// jittered radii (so both convex and concave corners occur), joined by lines or by R-format
+/// arcs either way round; entry from outside, G40 and a straight exit.
+#[derive(Debug, Clone)]
+struct CompContour {
+    left: bool,
+    /// G18 (Z, X) instead of G17.
+    xz: bool,
+    /// `None`: D from the tool table (tool 1..3); `Some(d)`: G41.1/G42.1 with this diameter.
+    /// (No D, or D0, would take the diameter of LinuxCNC's spindle slot, which the standalone
+    /// `rs274` leaves uninitialised before an M6: its output then varies from run to run.)
+    dynamic: Option<f64>,
+    tool: u8,
+    center: [f64; 2],
+    radius: f64,
+    /// (angle step in degrees, radius factor, joint): 0 line, 1 arc CCW, 2 arc CW.
+    vertices: Vec<(f64, f64, u8)>,
+    /// Arc radius over half the chord.
+    bulge: f64,
+    f: f64,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -412,6 +436,78 @@ impl Writer {
             e[n] = if self.incremental { s[n] + v } else { v };
         }
         words
+    }
+
+    /// Write a [`CompContour`]; the program is absolute afterwards, in the contour's plane.
+    fn comp_contour(&mut self, c: &CompContour, deco: &Deco) {
+        self.incremental = false;
+        self.plane = if c.xz { 1 } else { 0 };
+        let (a, b, _) = plane_axes(self.plane);
+        let at = |angle_deg: f64, factor: f64| {
+            let (s, co) = angle_deg.to_radians().sin_cos();
+            let r = c.radius * factor;
+            [round4(c.center[0] + r * co), round4(c.center[1] + r * s)]
+        };
+        let point = |p: [f64; 2]| format!("{}{} {}{}", AXES[a], num(p[0]), AXES[b], num(p[1]));
+        let outside = at(0.0, 1.6);
+        let plane = if c.xz { "G18" } else { "G17" };
+        self.block(deco, &format!("G90 {plane} G0 {}", point(outside)));
+        let g = if c.left { 41 } else { 42 };
+        let on = match (c.dynamic, c.tool) {
+            (Some(d), _) => format!("G{g}.1 D{}", num(d)),
+            (None, t) => format!("G{g} D{t}"),
+        };
+        self.text.push_str(&format!(
+            "{on}
+"
+        ));
+        let mut angle = 0.0;
+        let mut here = at(angle, c.vertices[0].1);
+        let feed = self.feed_word(c.f, true);
+        self.text.push_str(&format!(
+            "G1 {}{feed}
+",
+            point(here)
+        ));
+        for &(step, factor, joint) in &c.vertices[1..] {
+            angle += step;
+            let next = at(angle, factor);
+            let feed = self.feed_word(c.f, false);
+            if joint == 0 || next == here {
+                self.text.push_str(&format!(
+                    "G1 {}{feed}
+",
+                    point(next)
+                ));
+            } else {
+                let half = (next[0] - here[0]).hypot(next[1] - here[1]) / 2.0;
+                let r = (half * c.bulge * 1e4).ceil() / 1e4;
+                let g = if joint == 1 { 3 } else { 2 };
+                self.text.push_str(&format!(
+                    "G{g} {} R{}{feed}
+",
+                    point(next),
+                    num(r)
+                ));
+            }
+            here = next;
+        }
+        self.text.push_str(
+            "G40
+",
+        );
+        let exit = at(angle, 1.8);
+        let feed = self.feed_word(c.f, false);
+        self.text.push_str(&format!(
+            "G1 {}{feed}
+",
+            point(exit)
+        ));
+        // The compensated tool ends beside the programmed point: only the plane's axes
+        // and the exit are known exactly.
+        self.forget();
+        self.pos[a] = Some(exit[0]);
+        self.pos[b] = Some(exit[1]);
     }
 
     fn extra(deco: &Deco) -> String {
@@ -757,6 +853,7 @@ impl Writer {
                 }
                 self.forget();
             }
+            Item::Comp(c) => self.comp_contour(c, deco),
             Item::Expression(e) => {
                 self.block(deco, &format!("#<v> = {e}"));
                 let prefix = if self.incremental { "G90 " } else { "" };
@@ -1048,12 +1145,47 @@ fn item() -> impl Strategy<Value = Item> {
         2 => (0..SUBROUTINES.len(), [value(20.0), value(20.0)])
             .prop_map(|(sub, args)| Item::Call { sub, args }),
         1 => (0..COMMENTS.len()).prop_map(Item::Comment),
+        3 => comp_contour().prop_map(Item::Comp),
     ];
     // About one program in twelve ends early on an error.
     prop_oneof![
         250 => valid,
         1 => (0..FAULTY.len()).prop_map(Item::Faulty),
     ]
+}
+
+fn comp_contour() -> impl Strategy<Value = CompContour> {
+    let vertex = (
+        20.0f64..=120.0,
+        prop_oneof![3 => Just(1.0), 2 => 0.7f64..=1.3],
+        prop_oneof![3 => Just(0u8), 1 => Just(1u8), 1 => Just(2u8)],
+    );
+    (
+        (any::<bool>(), any::<bool>()),
+        proptest::option::weighted(0.4, positive(0.1, 4.0)),
+        1u8..=3,
+        (value(20.0), value(20.0)),
+        positive(8.0, 30.0),
+        proptest::collection::vec(vertex, 2..=7),
+        prop_oneof![Just(1.0), 1.05f64..=3.0],
+        feed(),
+    )
+        .prop_map(
+            |((left, xz), dynamic, tool, (cx, cy), radius, vertices, bulge, f)| CompContour {
+                left,
+                xz,
+                dynamic,
+                tool,
+                center: [cx, cy],
+                radius,
+                vertices: vertices
+                    .into_iter()
+                    .map(|(s, k, j)| ((s * 10.0).round() / 10.0, (k * 100.0).round() / 100.0, j))
+                    .collect(),
+                bulge,
+                f,
+            },
+        )
 }
 
 fn program() -> impl Strategy<Value = Vec<(Item, Deco)>> {

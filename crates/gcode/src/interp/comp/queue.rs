@@ -72,6 +72,7 @@ pub(in crate::interp) fn is_held_kind(call: &Canon) -> bool {
             | Canon::StopSpindle
             | Canon::SetSpindleMode(_)
             | Canon::SetSpindleSpeed(_)
+            | Canon::OrientSpindle(_)
             | Canon::Comment(_)
     )
 }
@@ -168,6 +169,8 @@ impl Interpreter {
         let (a, b, _) = plane_axes(self.state.plane);
         let endpoint = self.comp.endpoint;
         let from = endpoint.unwrap_or([0.0; 2]);
+        // How much further than programmed a moved arc may sweep (rad), as LinuxCNC 2.9 has it.
+        let sweep_slack = if self.state.inches() { 0.001 } else { 0.0254 };
         for held in &mut self.comp.queue {
             match held {
                 Held::Call(..) => {}
@@ -180,7 +183,7 @@ impl Interpreter {
                     }
                     if arc.sweep != 0.0
                         && endpoint.is_some()
-                        && sweep.abs() > arc.sweep.abs() + 0.001
+                        && sweep.abs() > arc.sweep.abs() + sweep_slack
                     {
                         return Err(CompError::ArcGouge.into());
                     }
