@@ -1,10 +1,14 @@
-//! Subroutine files for `o<name> call`: `<name>.ngc` looked up in the program's folder and in
-//! the folders given with `--subroutine-path`, in that order (LinuxCNC's SUBROUTINE_PATH).
+//! What a program reads besides its own text: subroutine files for `o<name> call`
+//! (`<name>.ngc` looked up in the program's folder, then in the INI file's `SUBROUTINE_PATH`,
+//! then in the folders given with `--subroutine-path`, as LinuxCNC's SUBROUTINE_PATH) and the
+//! INI file's `#<_ini[section]name>` values.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use miette::{IntoDiagnostic, Result, WrapErr};
 use tezgah_gcode::interp::SubroutineLibrary;
+use tezgah_gcode::IniFile;
 
 #[derive(Debug)]
 pub struct Folders(Vec<PathBuf>);
@@ -18,15 +22,53 @@ impl SubroutineLibrary for Folders {
     }
 }
 
-/// The library for `program` (if read from a file) and the extra folders.
-pub fn folders(program: Option<&Path>, extra: &[PathBuf]) -> Option<Arc<dyn SubroutineLibrary>> {
-    let own = program.and_then(Path::parent).map(|p| {
-        if p.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            p.to_path_buf()
+/// The subroutine library and INI file of a program.
+pub struct ProgramInputs {
+    pub subroutines: Option<Arc<dyn SubroutineLibrary>>,
+    pub ini: Option<Arc<IniFile>>,
+}
+
+/// The inputs of `program` (if read from a file), with the INI file and extra folders given.
+pub fn program_inputs(
+    program: Option<&Path>,
+    ini: Option<&Path>,
+    extra: &[PathBuf],
+) -> Result<ProgramInputs> {
+    let ini = match ini {
+        None => None,
+        Some(path) => {
+            let text = std::fs::read_to_string(path)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("reading {}", path.display()))?;
+            let file = IniFile::parse(&text)
+                .into_diagnostic()
+                .wrap_err_with(|| format!("in {}", path.display()))?;
+            Some((folder_of(path), Arc::new(file)))
         }
+    };
+    let own = program.map(folder_of);
+    let from_ini = ini.iter().flat_map(|(dir, file)| {
+        file.subroutine_path()
+            .into_iter()
+            .map(|d| dir.join(d))
+            .collect::<Vec<_>>()
     });
-    let dirs: Vec<PathBuf> = own.into_iter().chain(extra.iter().cloned()).collect();
-    (!dirs.is_empty()).then(|| Arc::new(Folders(dirs)) as Arc<dyn SubroutineLibrary>)
+    let dirs: Vec<PathBuf> = own
+        .into_iter()
+        .chain(from_ini)
+        .chain(extra.iter().cloned())
+        .collect();
+    Ok(ProgramInputs {
+        subroutines: (!dirs.is_empty())
+            .then(|| Arc::new(Folders(dirs)) as Arc<dyn SubroutineLibrary>),
+        ini: ini.map(|(_, file)| file),
+    })
+}
+
+/// The folder a file is in (`.` for a bare file name).
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
 }

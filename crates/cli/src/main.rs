@@ -30,6 +30,15 @@ struct Inputs {
     /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
     #[arg(long = "subroutine-path")]
     subroutine_path: Vec<PathBuf>,
+    /// A LinuxCNC INI file: its `[RS274NGC] SUBROUTINE_PATH` and `#<_ini[section]name>` values.
+    #[arg(long)]
+    ini: Option<PathBuf>,
+}
+
+impl Inputs {
+    fn program_inputs(&self, program: Option<&Path>) -> Result<library::ProgramInputs> {
+        library::program_inputs(program, self.ini.as_deref(), &self.subroutine_path)
+    }
 }
 
 #[derive(Subcommand)]
@@ -101,6 +110,7 @@ fn main() -> ExitCode {
             tolerance,
             tool_table: inputs.tool_table,
             subroutine_path: inputs.subroutine_path,
+            ini: inputs.ini,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
@@ -134,8 +144,10 @@ fn load_tool_table(tool_table: Option<&Path>) -> Result<ToolTable> {
 fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
     // As `rs274`: tool table and stored offsets in inches.
+    let extra = inputs.program_inputs(Some(program))?;
     let config = Config {
-        subroutines: library::folders(Some(program), &inputs.subroutine_path),
+        subroutines: extra.subroutines,
+        ini: extra.ini,
         ..Config::linuxcnc(load_tool_table(inputs.tool_table.as_deref())?)
     };
     let mut interp = Interpreter::new(config);
@@ -172,9 +184,11 @@ fn check(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
     let mut counts = diagnostics::Counts::default();
     // As `run`: the machine's units (mm) for the tool table and the stored offsets.
+    let extra = inputs.program_inputs(Some(program))?;
     let config = Config {
         tool_table: load_tool_table(inputs.tool_table.as_deref())?,
-        subroutines: library::folders(Some(program), &inputs.subroutine_path),
+        subroutines: extra.subroutines,
+        ini: extra.ini,
         ..Config::default()
     };
     let errors = tezgah_gcode::check_into(&text, config, &mut counts);

@@ -40,6 +40,7 @@ pub struct RunArgs {
     pub tolerance: Option<f64>,
     pub tool_table: Option<PathBuf>,
     pub subroutine_path: Vec<PathBuf>,
+    pub ini: Option<PathBuf>,
 }
 
 /// A machine by built-in name or file path.
@@ -102,9 +103,15 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         None if args.program.is_none() => ToolTable::parse(DEMO_TOOLS).into_diagnostic()?,
         None => ToolTable::default(),
     };
+    let extra = crate::library::program_inputs(
+        args.program.as_deref(),
+        args.ini.as_deref(),
+        &args.subroutine_path,
+    )?;
     let config = Config {
         tool_table: table,
-        subroutines: crate::library::folders(args.program.as_deref(), &args.subroutine_path),
+        subroutines: extra.subroutines,
+        ini: extra.ini,
         ..Config::default()
     };
     let moves = match tezgah_gcode::program_moves(&text, config) {

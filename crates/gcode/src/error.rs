@@ -294,6 +294,11 @@ pub enum ErrorKind {
     G10POutOfRange(i64),
     #[error("R not allowed in G10 L20")]
     G10L20Rotation,
+    #[error("Cannot assign to read-only parameter #<{0}>")]
+    ReadOnlyParameter(String),
+    /// `(ABORT,…)`: the program stops with the comment's text, parameters filled in.
+    #[error("{0}")]
+    Abort(String),
     #[error(transparent)]
     CutterComp(#[from] crate::interp::CompError),
     #[error("Requested tool {0} not found in the tool table")]

@@ -11,6 +11,7 @@ pub mod codes;
 pub mod error;
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod ini;
 pub mod interp;
 pub mod lexer;
 pub mod moves;
@@ -21,6 +22,7 @@ pub mod tooltable;
 
 pub use canon::{Canon, CanonSink, Origin, Units};
 pub use error::{ErrorKind, GcodeError};
+pub use ini::{IniError, IniFile};
 pub use interp::{check, check_into, Config, Interpreter};
 pub use moves::{program_moves, MoveBuilder};
 pub use span::Span;

@@ -45,6 +45,8 @@ pub struct Params {
     locals: Vec<HashMap<String, f64>>,
     /// Read-only values the interpreter publishes (`#<_x>`, `#<_feed>`, …).
     pub system: SystemValues,
+    /// The INI file whose values are `#<_ini[section]name>` (read-only).
+    ini: Option<std::sync::Arc<crate::ini::IniFile>>,
 }
 
 impl Default for Params {
@@ -54,6 +56,7 @@ impl Default for Params {
             globals: HashMap::new(),
             locals: vec![HashMap::new()],
             system: SystemValues::default(),
+            ini: None,
         }
     }
 }
@@ -161,15 +164,31 @@ impl Params {
         self.numbered[base..base + 6].copy_from_slice(&v);
     }
 
-    /// The value of `#<name>`: a predefined value, a global, or a local of the current call.
+    /// The value of `#<name>`: a predefined value, an INI value, a global, or a local of the
+    /// current call.
     pub fn named(&self, name: &str) -> Option<f64> {
         if name.starts_with('_') {
             return self
                 .system
                 .get(name)
+                .or_else(|| self.ini_value(name))
                 .or_else(|| self.globals.get(name).copied());
         }
         self.locals.last()?.get(name).copied()
+    }
+
+    /// Make `ini`'s values the `#<_ini[section]name>` parameters.
+    pub fn set_ini(&mut self, ini: std::sync::Arc<crate::ini::IniFile>) {
+        self.ini = Some(ini);
+    }
+
+    fn ini_value(&self, name: &str) -> Option<f64> {
+        self.ini.as_ref()?.parameter(name)
+    }
+
+    /// Whether a program may not assign `#<name>` (a predefined or INI value).
+    pub fn is_read_only(&self, name: &str) -> bool {
+        name.starts_with('_') && (self.system.get(name).is_some() || self.ini_value(name).is_some())
     }
 
     pub fn set_named(&mut self, name: &str, v: f64) {

@@ -8,7 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
-use tezgah_gcode::{Canon, Config, Interpreter, Origin, ToolTable};
+use tezgah_gcode::{Canon, Config, IniFile, Interpreter, Origin, ToolTable};
 
 /// A folder test: its program, tool table, and whether `expected` keeps rs274's counter field
 /// (LinuxCNC's script for the folder does or does not strip it with awk).
@@ -25,6 +25,11 @@ struct Run {
     go_on: bool,
     /// The program must fail (LinuxCNC's script expects rs274 to exit with an error).
     fails: bool,
+    /// The INI file `rs274 -i` reads (its `#<_ini[…]…>` values).
+    ini: Option<&'static str>,
+    /// The script keeps rs274's standard error (`2>&1`): `executing` first, and on an error
+    /// its text and the offending line before the final resets.
+    stderr: bool,
     /// Compare the motion calls only: the expected file was made by an older rs274 whose
     /// other calls differ from LinuxCNC 2.9's (the reason is given where it is set).
     motion_only: bool,
@@ -41,6 +46,8 @@ const fn run(folder: &'static str, program: &'static str) -> Run {
         go_on: false,
         fails: false,
         motion_only: false,
+        ini: None,
+        stderr: false,
     }
 }
 
@@ -129,6 +136,34 @@ const RUNS: &[Run] = &[
     run("g84/g17/g98", "g17-g98-g84.ngc"),
     run("g84/g17/g99", "g17-g99-g84.ngc"),
     run("inverse-time-with-comp", "inverse.ngc"),
+    run("magic_comments/param_format_printing", "test.ngc"),
+    Run {
+        ini: Some("test.ini"),
+        counter: true,
+        fails: true,
+        stderr: true,
+        ..run("iniparam", "test.ngc")
+    },
+    Run {
+        ini: Some("test.ini"),
+        counter: true,
+        fails: true,
+        stderr: true,
+        ..run("iniparam-failassign", "test.ngc")
+    },
+    Run {
+        ini: Some("test.ini"),
+        counter: true,
+        fails: true,
+        stderr: true,
+        ..run("abort-hot-comment", "test.ngc")
+    },
+    // Its test.ini only sets SUBROUTINE_PATH=. (the folder).
+    Run {
+        subroutines: Some("."),
+        counter: true,
+        ..run("sequence-number", "test.ngc")
+    },
     run("inside-corners", "test.ngc"),
     run("crazy-paths", "test.ngc"),
     // Its expected file predates LinuxCNC 2.9's tool change calls (`CHANGE_TOOL()` without
@@ -143,7 +178,6 @@ const RUNS: &[Run] = &[
 /// Folders that need the full-dialect issue or are out of scope, with the reason.
 #[allow(dead_code)]
 const FOLDERS_NOT_YET: &[(&str, &str)] = &[
-    ("abort-hot-comment", "INI parameters (-i test.ini)"),
     ("g10/g10-l1-l10", "G10 L1/L10 tool table writes"),
     ("g10/g10-l11", "G10 L11 tool table writes"),
     ("g33.1", "spindle-synchronised motion, out of scope"),
@@ -155,14 +189,12 @@ const FOLDERS_NOT_YET: &[(&str, &str)] = &[
         "LinuxCNC 2.9 feeds G84 in G18 along the G19 axes and in G19 along the G18 axes (its \
          tap would go in sideways); tezgah taps along the plane's normal, as G81 does there",
     ),
-    ("iniparam, iniparam-failassign", "INI parameters"),
     ("m19", "spindle orientation"),
     (
         "m98m99/03, 06, 09, 11, 12, 13",
         "error-report formats, INI feature switches and main-program O-word rules of LinuxCNC \
          master not yet mirrored (12 is an expected failure in LinuxCNC too)",
     ),
-    ("magic_comments", "parameter formatting comments"),
     ("mdi-oword-m66", "MDI and M66, no expected file"),
     (
         "oword-mdi-sub-update, subroutine-return",
@@ -176,7 +208,6 @@ const FOLDERS_NOT_YET: &[(&str, &str)] = &[
         "value-returned",
         "Python plug-ins (PYTHON section of test.ini), out of scope",
     ),
-    ("sequence-number", "INI, O-words"),
 ];
 
 /// `bad/` programs that need the full-dialect issue (canned cycles, cutter compensation,
@@ -405,6 +436,10 @@ fn folder_tests_match_linuxcnc() {
         let expected = std::fs::read_to_string(base.join("expected")).unwrap();
         let table = r.table.map(|t| base.join(t));
         let mut cfg = config(table.as_deref());
+        if let Some(ini) = r.ini {
+            let text = std::fs::read_to_string(base.join(ini)).unwrap();
+            cfg.ini = Some(std::sync::Arc::new(IniFile::parse(&text).unwrap()));
+        }
         if let Some(dir) = r.subroutines {
             cfg.subroutines = Some(std::sync::Arc::new(Folder(base.join(dir))));
         }
@@ -417,6 +452,14 @@ fn folder_tests_match_linuxcnc() {
             our_calls_printing(&text, cfg, !r.counter)
         };
         assert_eq!(result.is_err(), r.fails, "{folder}: {result:?}");
+        if r.stderr {
+            ours.insert(0, "executing".into());
+            if let Err(e) = &result {
+                let at = ours.len() - 2; // before the two ON_RESET() of the end
+                let line = text.lines().nth(e.span.line as usize - 1).unwrap_or("");
+                ours.splice(at..at, [e.kind.to_string(), line.to_string()]);
+            }
+        }
         // How many ON_RESET() close the output depends on how rs274 was started.
         let mut theirs = expected_calls(&expected, r.counter);
         for list in [&mut ours, &mut theirs] {

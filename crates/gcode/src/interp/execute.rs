@@ -27,7 +27,8 @@ impl Interpreter {
     ) -> Result<Flow, GcodeError> {
         let plan = checks::check(block, &self.state)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
-        self.assign_parameters(block);
+        self.assign_parameters(block)
+            .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.execute_words(block, plan, sink)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))
     }
@@ -40,7 +41,9 @@ impl Interpreter {
     ) -> Exec<Flow> {
         let motion = plan.motion;
         if let Some(i) = block.comment {
-            self.comment(&self.norm.comments[i].text.clone(), sink)?;
+            let comment = &self.norm.comments[i];
+            let (text, at) = (comment.text.clone(), comment.at as u32);
+            self.comment(&text, at, sink)?;
         }
         if let Some(c) = block.g[ggroup::SPINDLE_MODE] {
             return Err(unsupported(c.code, c.at));
@@ -206,64 +209,6 @@ impl Interpreter {
             return Ok(self.stop(m.code, sink));
         }
         Ok(Flow::Continue)
-    }
-
-    /// `COMMENT`, or `MESSAGE` for `(MSG,…)` and `(DEBUG,…)`.
-    fn comment(&mut self, text: &str, sink: &mut impl CanonSink) -> Exec {
-        let lower = text.get(..6).unwrap_or(text).to_ascii_lowercase();
-        if lower.starts_with("msg,") {
-            self.emit(sink, Canon::Message(text[4..].to_string()));
-        } else if lower.starts_with("debug,") {
-            let expanded = self.substitute_parameters(&text[6..]);
-            self.emit(sink, Canon::Message(expanded));
-        } else if lower.starts_with("print,") {
-            let expanded = self.substitute_parameters(&text[6..]);
-            self.emit(sink, Canon::Print(expanded));
-        } else {
-            self.emit(sink, Canon::Comment(text.to_string()));
-        }
-        Ok(())
-    }
-
-    /// Replace `#n` and `#<name>` in a DEBUG text with their values (`%.6f`, as LinuxCNC).
-    fn substitute_parameters(&self, text: &str) -> String {
-        let mut out = String::with_capacity(text.len());
-        let b = text.as_bytes();
-        let mut i = 0;
-        while i < b.len() {
-            if b[i] == b'#' {
-                if b.get(i + 1) == Some(&b'<') {
-                    if let Some(end) = text[i + 2..].find('>') {
-                        let name: String = text[i + 2..i + 2 + end]
-                            .chars()
-                            .filter(|c| !c.is_whitespace())
-                            .collect::<String>()
-                            .to_ascii_lowercase();
-                        let v = self.params.named(&name).unwrap_or(0.0);
-                        out.push_str(&format!("{v:.6}"));
-                        i += 3 + end;
-                        continue;
-                    }
-                } else {
-                    let digits = b[i + 1..].iter().take_while(|c| c.is_ascii_digit()).count();
-                    if digits > 0 {
-                        let n: usize = text[i + 1..i + 1 + digits].parse().unwrap_or(0);
-                        let v = if crate::params::Params::in_range(n as i64) {
-                            self.params.get(n)
-                        } else {
-                            0.0
-                        };
-                        out.push_str(&format!("{v:.6}"));
-                        i += 1 + digits;
-                        continue;
-                    }
-                }
-            }
-            let ch = text[i..].chars().next().unwrap_or(' ');
-            out.push(ch);
-            i += ch.len_utf8();
-        }
-        out
     }
 
     /// `COMMENT("interpreter: …")`, the notes LinuxCNC makes on mode changes.

@@ -7,6 +7,7 @@
 
 mod arc;
 mod checks;
+mod comments;
 mod comp;
 mod control;
 mod cycles;
@@ -43,6 +44,8 @@ pub struct Config {
     pub limits: ControlLimits,
     /// Subroutines in files of their own (`o<name> call` of a name the program lacks).
     pub subroutines: Option<std::sync::Arc<dyn SubroutineLibrary>>,
+    /// A LinuxCNC INI file: its values are the read-only `#<_ini[section]name>` parameters.
+    pub ini: Option<std::sync::Arc<crate::ini::IniFile>>,
 }
 
 impl Config {
@@ -53,6 +56,7 @@ impl Config {
             machine_units: Units::Inches,
             limits: ControlLimits::default(),
             subroutines: None,
+            ini: None,
         }
     }
 }
@@ -139,6 +143,9 @@ impl Interpreter {
     pub fn new(cfg: Config) -> Self {
         let mut params = Params::default();
         params.set(crate::params::COORD_SYSTEM, 1.0);
+        if let Some(ini) = cfg.ini.as_ref().filter(|ini| ini.ini_vars()) {
+            params.set_ini(ini.clone());
+        }
         Interpreter {
             cfg,
             state: State::default(),
@@ -392,13 +399,17 @@ impl Interpreter {
     }
 
     /// Apply a block's parameter assignments (after the whole line was read, as LinuxCNC).
-    fn assign_parameters(&mut self, block: &Block) {
+    fn assign_parameters(&mut self, block: &Block) -> Result<(), (ErrorKind, u32)> {
         for a in &block.assignments {
             match &a.target {
                 crate::reader::ParamRef::Numbered(n) => self.params.set(*n, a.value),
+                crate::reader::ParamRef::Named(name) if self.params.is_read_only(name) => {
+                    return Err((ErrorKind::ReadOnlyParameter(name.clone()), a.at));
+                }
                 crate::reader::ParamRef::Named(name) => self.params.set_named(name, a.value),
             }
         }
+        Ok(())
     }
 
     /// Send a call, or hold it behind moves that cutter compensation holds back.

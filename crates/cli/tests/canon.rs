@@ -1,0 +1,66 @@
+//! `tezgah canon` end to end through the binary: a program that reads an INI file's values and
+//! calls a subroutine from the INI file's `SUBROUTINE_PATH`.
+
+use std::process::Command;
+
+#[test]
+fn canon_reads_ini_values_and_subroutine_path() {
+    let dir = std::env::temp_dir().join(format!("tezgah-canon-test-{}", std::process::id()));
+    let subs = dir.join("subs");
+    std::fs::create_dir_all(&subs).unwrap();
+    std::fs::write(
+        dir.join("machine.ini"),
+        "[RS274NGC]\nSUBROUTINE_PATH = subs\n[VARS]\nSAFE_Z = 12.5\n",
+    )
+    .unwrap();
+    std::fs::write(
+        subs.join("lift.ngc"),
+        "o<lift> sub\nG0 Z#<_ini[vars]safe_z>\no<lift> endsub\nM2\n",
+    )
+    .unwrap();
+    let program = dir.join("prog.ngc");
+    std::fs::write(
+        &program,
+        "G21\no<lift> call\nG0 X[#<_ini[vars]safe_z> * 2]\nM2\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+        .arg("canon")
+        .arg(&program)
+        .arg("--ini")
+        .arg(dir.join("machine.ini"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let traverses: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("STRAIGHT_TRAVERSE"))
+        .collect();
+    assert_eq!(
+        traverses,
+        [
+            "STRAIGHT_TRAVERSE(0.0000, 0.0000, 12.5000, 0.0000, 0.0000, 0.0000)",
+            "STRAIGHT_TRAVERSE(25.0000, 0.0000, 12.5000, 0.0000, 0.0000, 0.0000)",
+        ]
+    );
+
+    // Without the INI file the value is not defined: an error naming it, exit status 1.
+    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+        .arg("canon")
+        .arg(&program)
+        .arg("--subroutine-path")
+        .arg(&subs)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("Named parameter #<_ini[vars]safe_z> not defined"),
+        "{stderr}"
+    );
+}
