@@ -92,6 +92,17 @@ pub enum Canon {
     ChangeTool(usize),
     /// M61: tell the machine which pocket's tool is in the spindle without a change.
     ChangeToolNumber(usize),
+    /// G10 L1/L10/L11 wrote the tool table: `index` is the tool's pocket index (0 = the
+    /// spindle), the offsets are in the machine's units.
+    SetToolTableEntry {
+        index: usize,
+        tool: i64,
+        offset: Pose,
+        diameter: f64,
+        front_angle: f64,
+        back_angle: f64,
+        orientation: i32,
+    },
     /// X Y Z A B C offsets (U V W are always zero here).
     UseToolLengthOffset(Pose),
     FloodOn,
@@ -202,6 +213,21 @@ impl fmt::Display for Canon {
             StartChange => f.write_str("START_CHANGE()"),
             ChangeTool(p) => write!(f, "CHANGE_TOOL({p})"),
             ChangeToolNumber(p) => write!(f, "CHANGE_TOOL_NUMBER({p})"),
+            // rs274 prints the offsets (U V W zero) and the lathe fields, not the diameter.
+            SetToolTableEntry {
+                index,
+                tool,
+                offset: o,
+                front_angle,
+                back_angle,
+                orientation,
+                ..
+            } => write!(
+                f,
+                "SET_TOOL_TABLE_ENTRY({index}, {tool}, {:.4} {:.4} {:.4} {:.4} {:.4} {:.4} 0.0000 \
+                 0.0000 0.0000, {front_angle:.4}, {back_angle:.4}, {orientation})",
+                o.0[0], o.0[1], o.0[2], o.0[3], o.0[4], o.0[5]
+            ),
             UseToolLengthOffset(p) => {
                 let o = &p.0;
                 write!(

@@ -288,6 +288,16 @@ pub enum ErrorKind {
     // --- G10 and offsets ---
     #[error("Line with G10 does not have L0, L1, L10, L11, L2, or L20")]
     G10MissingL,
+    #[error("P value out of range with G10 L{0}")]
+    G10PToolOutOfRange(i64),
+    #[error("G10 L1 without offsets has no effect")]
+    G10L1NoOffsets,
+    #[error("G10 L0 not allowed with loaded tool <{0}>")]
+    G10L0ToolLoaded(i64),
+    #[error("Q number in G10 is not an integer")]
+    G10QNotInteger,
+    #[error("Invalid tool orientation")]
+    InvalidToolOrientation,
     #[error("P value not an integer with G10")]
     G10PNotInteger,
     #[error("P value out of range (0-9) with G10 L{0}")]

@@ -18,6 +18,10 @@ pub struct Tool {
     /// Offsets along X Y Z A B C (Z is the tool length).
     pub offset: Pose,
     pub diameter: f64,
+    /// Lathe tool angles (degrees) and orientation (0–9), kept to be written back.
+    pub front_angle: f64,
+    pub back_angle: f64,
+    pub orientation: i32,
     pub comment: String,
 }
 
@@ -38,6 +42,10 @@ pub struct ToolTable {
 impl ToolTable {
     pub fn get(&self, number: i64) -> Option<&Tool> {
         self.tools.get(&number)
+    }
+
+    pub fn get_mut(&mut self, number: i64) -> Option<&mut Tool> {
+        self.tools.get_mut(&number)
     }
 
     pub fn insert(&mut self, tool: Tool) {
@@ -95,8 +103,11 @@ impl ToolTable {
                     'B' => tool.offset.0[axis(Axis::B)] = value,
                     'C' => tool.offset.0[axis(Axis::C)] = value,
                     'D' => tool.diameter = value,
-                    // U V W offsets and the lathe fields I J Q are read and not used.
-                    'U' | 'V' | 'W' | 'I' | 'J' | 'Q' => {}
+                    'I' => tool.front_angle = value,
+                    'J' => tool.back_angle = value,
+                    'Q' => tool.orientation = value as i32,
+                    // U V W offsets are read and not used.
+                    'U' | 'V' | 'W' => {}
                     _ => return Err(err(format!("unknown field '{field}'"))),
                 }
             }

@@ -160,6 +160,13 @@ enum Item {
         /// XY rotation R (degrees).
         r: Option<f64>,
     },
+    /// G10 L1 / L10 / L11 (`l` = 1, 10, 11) of tool 1–3: X Y Z offsets and R (radius).
+    ToolWrite {
+        l: u8,
+        tool: u8,
+        xyz: [Option<f64>; 3],
+        r: Option<f64>,
+    },
     G92 {
         axes: Axes,
     },
@@ -697,6 +704,20 @@ impl Writer {
                 self.block(deco, &format!("G10 L{l} P{p}{}{r}", axis_words(axes)));
                 self.forget();
             }
+            Item::ToolWrite { l, tool, xyz, r } => {
+                let mut words = format!("G10 L{l} P{tool}");
+                for (k, v) in xyz.iter().enumerate() {
+                    if let Some(v) = v {
+                        words.push_str(&format!(" {}{}", AXES[k], num(*v)));
+                    }
+                }
+                match r {
+                    Some(r) => words.push_str(&format!(" R{}", num(*r))),
+                    None if xyz.iter().all(Option::is_none) => words.push_str(" Z0"),
+                    None => {}
+                }
+                self.block(deco, &words);
+            }
             Item::G92 { axes } => {
                 self.block(deco, &format!("G92{}", axis_words(axes)));
                 self.forget();
@@ -1117,6 +1138,17 @@ fn item() -> impl Strategy<Value = Item> {
             proptest::option::weighted(0.3, value(90.0))
         )
             .prop_map(|(l20, p, axes, r)| Item::G10 { l20, p, axes, r }),
+        1 => (
+            prop_oneof![Just(1u8), Just(10), Just(11)],
+            1u8..=3,
+            [
+                proptest::option::weighted(0.5, value(3.0)),
+                proptest::option::weighted(0.5, value(3.0)),
+                proptest::option::weighted(0.5, value(3.0))
+            ],
+            proptest::option::weighted(0.3, positive(0.0, 0.5))
+        )
+            .prop_map(|(l, tool, xyz, r)| Item::ToolWrite { l, tool, xyz, r }),
         1 => axes().prop_map(|axes| Item::G92 { axes }),
         1 => (1u8..=3).prop_map(Item::G92x),
         1 => axes().prop_map(|axes| Item::G52 { axes }),

@@ -112,21 +112,17 @@ fn check_g_codes(block: &Block, state: &State, motion: Option<u32>) -> Result<()
                 return Err((ErrorKind::G10MissingL, at));
             }
             let l = l.unwrap_or(0.0) as i64;
-            if l == 2 || l == 20 {
-                // LinuxCNC's test is one-sided: P2.6 passes (and means 2), P2.4 does not.
-                let p = block.get(b'p').unwrap_or(-1.0);
-                let rounded = p.round();
-                if (p + 0.0001) - rounded > 0.0002 {
-                    return Err((ErrorKind::G10PNotInteger, at));
-                }
-                if !(0.0..=9.0).contains(&rounded) {
-                    return Err((ErrorKind::G10POutOfRange(l), at));
-                }
-            } else {
-                return Err((
-                    ErrorKind::Unsupported(format!("G10 L{l} (tool table writes)")),
-                    at,
-                ));
+            // LinuxCNC's test is one-sided: P2.6 passes (and means 2), P2.4 does not.
+            let p = block.get(b'p').unwrap_or(-1.0);
+            let rounded = p.round();
+            if (p + 0.0001) - rounded > 0.0002 {
+                return Err((ErrorKind::G10PNotInteger, at));
+            }
+            if (l == 2 || l == 20) && !(0.0..=9.0).contains(&rounded) {
+                return Err((ErrorKind::G10POutOfRange(l), at));
+            }
+            if matches!(l, 1 | 10 | 11) && rounded < 1.0 {
+                return Err((ErrorKind::G10PToolOutOfRange(l), at));
             }
         }
         530 => {

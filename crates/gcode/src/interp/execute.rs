@@ -252,14 +252,17 @@ impl Interpreter {
             self.refuse_with_comp(CompError::ToolChange)
                 .map_err(|k| (k, at))?;
             let tool = self.state.selected_tool.unwrap_or(0);
-            self.state.spindle_tool = tool;
             self.emit(sink, Canon::StartChange);
             self.state.spindle = None;
             self.emit(sink, Canon::StopSpindle);
-            self.emit(sink, Canon::ChangeTool(self.pocket_of(tool)));
-            if let Some(offset) = self.table_offset(tool).filter(|_| tool != 0) {
-                self.state.spindle_tool_offset = offset;
+            let pocket = self.pocket_of(tool);
+            self.emit(sink, Canon::ChangeTool(pocket));
+            self.state.current_pocket = pocket;
+            // The spindle's entry becomes a copy of the tool's (tool 0 leaves it as it is).
+            if let Some(t) = self.cfg.tool_table.get(tool).filter(|_| tool != 0) {
+                self.state.spindle_slot = t.clone();
             }
+            self.publish_tool_parameters();
             return Ok(());
         }
         // M61 Q: declare the tool in the spindle.
@@ -271,15 +274,16 @@ impl Interpreter {
         if tool != 0 && self.cfg.tool_table.get(tool).is_none() {
             return Err((ErrorKind::ToolNotFound(tool), at));
         }
-        self.state.spindle_tool = tool;
-        self.emit(sink, Canon::ChangeToolNumber(self.pocket_of(tool)));
+        self.state.current_pocket = self.pocket_of(tool);
+        self.emit(sink, Canon::ChangeToolNumber(self.state.current_pocket));
+        self.publish_tool_parameters();
         Ok(())
     }
 
     fn tool_length(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
         let offset = match g {
             430 => match block.get(b'h').map(|h| h as i64) {
-                None | Some(0) => self.state.spindle_tool_offset,
+                None | Some(0) => self.to_program_units(self.state.spindle_slot.offset),
                 Some(h) => self
                     .table_offset(h)
                     .ok_or((ErrorKind::ToolNotFound(h), at))?,
@@ -310,7 +314,6 @@ impl Interpreter {
         s.origin = s.origin.scale_linear(k);
         s.axis_offset = s.axis_offset.scale_linear(k);
         s.tool_offset = s.tool_offset.scale_linear(k);
-        s.spindle_tool_offset = s.spindle_tool_offset.scale_linear(k);
         s.units = units;
         self.comp.scale(k);
     }
@@ -383,7 +386,18 @@ impl Interpreter {
         if let Some(e) = refusal {
             self.refuse_with_comp(e).map_err(|k| (k, at))?;
         }
+        let l = block.get(b'l').unwrap_or(0.0) as i64;
         match g {
+            100 if matches!(l, 1 | 10 | 11) => self.write_tool_table(block, l, at, sink)?,
+            100 if l == 0 => {
+                // LinuxCNC reloads its tool data; tezgah's table is the one it was given.
+                if self.state.spindle_slot.number > 0 {
+                    return Err((
+                        ErrorKind::G10L0ToolLoaded(self.state.spindle_slot.number),
+                        at,
+                    ));
+                }
+            }
             100 => self.set_coordinate_system(block, at, sink)?,
             280 | 300 => self.go_home(block, g, sink)?,
             281 | 301 => {

@@ -15,6 +15,7 @@ mod execute;
 mod motion;
 mod state;
 mod system;
+mod tools;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
 pub use comp::CompError;
@@ -46,6 +47,9 @@ pub struct Config {
     pub subroutines: Option<std::sync::Arc<dyn SubroutineLibrary>>,
     /// A LinuxCNC INI file: its values are the read-only `#<_ini[section]name>` parameters.
     pub ini: Option<std::sync::Arc<crate::ini::IniFile>>,
+    /// Pocket index of the tool in the spindle when the program starts (0: none). LinuxCNC's
+    /// standalone `rs274` starts with 1, so G10 writes to pocket 1 reach its spindle entry.
+    pub start_pocket: usize,
 }
 
 impl Config {
@@ -57,6 +61,7 @@ impl Config {
             limits: ControlLimits::default(),
             subroutines: None,
             ini: None,
+            start_pocket: 1,
         }
     }
 }
@@ -146,9 +151,13 @@ impl Interpreter {
         if let Some(ini) = cfg.ini.as_ref().filter(|ini| ini.ini_vars()) {
             params.set_ini(ini.clone());
         }
+        let state = State {
+            current_pocket: cfg.start_pocket,
+            ..State::default()
+        };
         Interpreter {
             cfg,
-            state: State::default(),
+            state,
             params,
             norm: NormLine::default(),
             block: Some(Box::default()),

@@ -35,10 +35,11 @@ pub struct State {
     pub tool_offset: Pose,
     /// Tool number chosen by the last T word (`None` before any).
     pub selected_tool: Option<i64>,
-    /// Offsets of the tool in the spindle (LinuxCNC's pocket 0), used by G43 without H.
-    pub spindle_tool_offset: Pose,
-    /// Number of the tool in the spindle (M6, M61), whose diameter G41/G42 use without D.
-    pub spindle_tool: i64,
+    /// Pocket index (table row) of the tool in the spindle: G10 writes to it reach the spindle.
+    pub current_pocket: usize,
+    /// LinuxCNC's table entry 0: the spindle's copy of its tool, made at M6 (machine units).
+    /// G43 without H takes its offsets, G41/G42 without D its diameter.
+    pub spindle_slot: crate::tooltable::Tool,
     pub mist: bool,
     pub flood: bool,
     pub lathe_diameter: bool,
@@ -72,8 +73,8 @@ impl Default for State {
             axis_offset: Pose::ZERO,
             tool_offset: Pose::ZERO,
             selected_tool: None,
-            spindle_tool_offset: Pose::ZERO,
-            spindle_tool: 0,
+            current_pocket: 0,
+            spindle_slot: Default::default(),
             mist: false,
             flood: false,
             lathe_diameter: false,

@@ -272,8 +272,8 @@ impl Interpreter {
             }
             d / 2.0
         } else {
-            let tool = match d {
-                None => self.state.spindle_tool,
+            let diameter = match d {
+                None => self.state.spindle_slot.diameter,
                 Some(d) => {
                     // LinuxCNC rounds by truncating d + 0.5, so a negative D is never near a
                     // whole number and fails here.
@@ -281,13 +281,14 @@ impl Interpreter {
                     if (tool as f64 - d).abs() >= 0.0001 {
                         return Err(CompError::DNotInteger(whole).into());
                     }
-                    if tool != 0 && self.cfg.tool_table.get(tool).is_none() {
-                        return Err(ErrorKind::ToolNotFound(tool));
+                    match self.cfg.tool_table.get(tool) {
+                        Some(t) => t.diameter,
+                        // D0 is the spindle's entry.
+                        None if tool == 0 => self.state.spindle_slot.diameter,
+                        None => return Err(ErrorKind::ToolNotFound(tool)),
                     }
-                    tool
                 }
             };
-            let diameter = self.cfg.tool_table.get(tool).map_or(0.0, |t| t.diameter);
             diameter * self.cfg.machine_units.mm() / self.state.units.mm() / 2.0
         };
         if radius < 0.0 {
