@@ -112,8 +112,8 @@ impl Interpreter {
             tool.offset.0[0] = self.length_to_machine_units(xy.0[0]);
             tool.offset.0[1] = self.length_to_machine_units(xy.0[1]);
         }
-        for i in 2..6 {
-            if let Some(v) = words[i] {
+        for (i, word) in words.iter().enumerate().skip(2) {
+            if let Some(v) = *word {
                 let d = t.0[i] - v;
                 tool.offset.0[i] = if i < 3 {
                     self.length_to_machine_units(d)
