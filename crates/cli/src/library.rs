@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use miette::{IntoDiagnostic, Result, WrapErr};
 use tezgah_gcode::interp::SubroutineLibrary;
+use tezgah_gcode::params::ParameterFile;
 use tezgah_gcode::IniFile;
 
 #[derive(Debug)]
@@ -22,16 +23,30 @@ impl SubroutineLibrary for Folders {
     }
 }
 
-/// The subroutine library and INI file of a program.
+/// The subroutine library, INI file and parameter file of a program.
 pub struct ProgramInputs {
     pub subroutines: Option<Arc<dyn SubroutineLibrary>>,
     pub ini: Option<Arc<IniFile>>,
+    pub parameters: Option<Arc<ParameterFile>>,
+}
+
+/// Read a LinuxCNC parameter file (`.var`).
+pub fn load_parameters(path: Option<&Path>) -> Result<Option<Arc<ParameterFile>>> {
+    let Some(path) = path else { return Ok(None) };
+    let text = std::fs::read_to_string(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("reading {}", path.display()))?;
+    let file = ParameterFile::parse(&text)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("in {}", path.display()))?;
+    Ok(Some(Arc::new(file)))
 }
 
 /// The inputs of `program` (if read from a file), with the INI file and extra folders given.
 pub fn program_inputs(
     program: Option<&Path>,
     ini: Option<&Path>,
+    parameters: Option<&Path>,
     extra: &[PathBuf],
 ) -> Result<ProgramInputs> {
     let ini = match ini {
@@ -62,6 +77,7 @@ pub fn program_inputs(
         subroutines: (!dirs.is_empty())
             .then(|| Arc::new(Folders(dirs)) as Arc<dyn SubroutineLibrary>),
         ini: ini.map(|(_, file)| file),
+        parameters: load_parameters(parameters)?,
     })
 }
 

@@ -33,11 +33,20 @@ struct Inputs {
     /// A LinuxCNC INI file: its `[RS274NGC] SUBROUTINE_PATH` and `#<_ini[section]name>` values.
     #[arg(long)]
     ini: Option<PathBuf>,
+    /// A LinuxCNC parameter file (`.var`): the work offsets, G92 offsets and other numbered
+    /// parameters the program starts with.
+    #[arg(long)]
+    params: Option<PathBuf>,
 }
 
 impl Inputs {
     fn program_inputs(&self, program: Option<&Path>) -> Result<library::ProgramInputs> {
-        library::program_inputs(program, self.ini.as_deref(), &self.subroutine_path)
+        library::program_inputs(
+            program,
+            self.ini.as_deref(),
+            self.params.as_deref(),
+            &self.subroutine_path,
+        )
     }
 }
 
@@ -111,6 +120,7 @@ fn main() -> ExitCode {
             tool_table: inputs.tool_table,
             subroutine_path: inputs.subroutine_path,
             ini: inputs.ini,
+            params: inputs.params,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
@@ -148,6 +158,7 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let config = Config {
         subroutines: extra.subroutines,
         ini: extra.ini,
+        parameters: extra.parameters,
         ..Config::linuxcnc(load_tool_table(inputs.tool_table.as_deref())?)
     };
     let mut interp = Interpreter::new(config);
@@ -189,6 +200,7 @@ fn check(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
         tool_table: load_tool_table(inputs.tool_table.as_deref())?,
         subroutines: extra.subroutines,
         ini: extra.ini,
+        parameters: extra.parameters,
         ..Config::default()
     };
     let errors = tezgah_gcode::check_into(&text, config, &mut counts);

@@ -41,6 +41,7 @@ pub struct RunArgs {
     pub tool_table: Option<PathBuf>,
     pub subroutine_path: Vec<PathBuf>,
     pub ini: Option<PathBuf>,
+    pub params: Option<PathBuf>,
 }
 
 /// A machine by built-in name or file path.
@@ -106,12 +107,14 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let extra = crate::library::program_inputs(
         args.program.as_deref(),
         args.ini.as_deref(),
+        args.params.as_deref(),
         &args.subroutine_path,
     )?;
     let config = Config {
         tool_table: table,
         subroutines: extra.subroutines,
         ini: extra.ini,
+        parameters: extra.parameters,
         ..Config::default()
     };
     let moves = match tezgah_gcode::program_moves(&text, config) {

@@ -64,3 +64,28 @@ fn canon_reads_ini_values_and_subroutine_path() {
         "{stderr}"
     );
 }
+
+#[test]
+fn canon_starts_from_a_parameter_file() {
+    let dir = std::env::temp_dir().join(format!("tezgah-canon-params-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // G55 active (#5220 = 2) with its X offset 1 inch (rs274's parameters are in inches).
+    std::fs::write(dir.join("offsets.var"), "5220\t2.000000\n5241\t1.000000\n").unwrap();
+    let program = dir.join("p.ngc");
+    std::fs::write(&program, "G21 G0 X0\nM2\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+        .arg("canon")
+        .arg(&program)
+        .arg("--params")
+        .arg(dir.join("offsets.var"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(
+        lines[1],
+        "SET_G5X_OFFSET(2, 25.4000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)"
+    );
+    assert!(lines.contains(&"STRAIGHT_TRAVERSE(0.0000, 0.0000, 0.0000, 0.0000, 0.0000, 0.0000)"));
+}

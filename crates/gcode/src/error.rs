@@ -280,6 +280,18 @@ pub enum ErrorKind {
     SmoothingQ,
     #[error("Found 'm98' code with no P-word")]
     M98WithoutP,
+    #[error("DISABLE_FANUC_STYLE_SUB set in INI file, but found m{0}")]
+    FanucSubsDisabled(u32),
+    #[error("DISABLE_FANUC_STYLE_SUB disabled in INI file, but found bare O-word")]
+    FanucProgramDisabled,
+    #[error("Fanuc 'O....' subroutine must be called with 'M98'")]
+    FanucSubNeedsM98,
+    #[error("'O.... sub' subroutine must be called with 'O.... call'")]
+    NgcSubNeedsCall,
+    #[error("Fanuc 'O....' subroutine definition must end with 'M99'")]
+    FanucSubNeedsM99,
+    #[error("'O.... endsub' or 'O.... return' must follow 'O.... sub' subroutine definition")]
+    NgcSubEndedByM99,
     #[error("M99 outside a subprogram (an endlessly repeated main program) is not supported")]
     M99InMain,
     #[error("{0} needs a [value]")]

@@ -56,10 +56,23 @@ impl IniFile {
             .map(String::as_str)
     }
 
+    /// A yes/no entry, read as LinuxCNC's `IniFile::Find(bool*)` reads it (`0`, `false`,
+    /// `no` and `off` are false; any other value is true).
+    pub fn flag(&self, section: &str, name: &str) -> Option<bool> {
+        let v = self.get(section, name)?.to_ascii_lowercase();
+        Some(!matches!(v.as_str(), "0" | "false" | "no" | "off"))
+    }
+
     /// Whether `#<_ini[…]…>` parameters are on (`[RS274NGC] INI_VARS`, default on).
     pub fn ini_vars(&self) -> bool {
-        self.get("RS274NGC", "INI_VARS")
-            .is_none_or(|v| !matches!(v.to_ascii_lowercase().as_str(), "0" | "false" | "no"))
+        self.flag("RS274NGC", "INI_VARS").unwrap_or(true)
+    }
+
+    /// Whether Fanuc-style subprograms (bare `O<n>`, M98, M99) are refused
+    /// (`[RS274NGC] DISABLE_FANUC_STYLE_SUB`, default off).
+    pub fn fanuc_subs_disabled(&self) -> bool {
+        self.flag("RS274NGC", "DISABLE_FANUC_STYLE_SUB")
+            .unwrap_or(false)
     }
 
     /// The folders of `[RS274NGC] SUBROUTINE_PATH` (colon-separated), as written.

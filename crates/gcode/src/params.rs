@@ -35,6 +35,52 @@ pub fn coord_system_base(n: usize) -> usize {
 /// Parameters a subroutine call gets from its arguments (`#1`…`#30`), restored on return.
 pub const CALL_PARAMETERS: usize = 30;
 
+/// A LinuxCNC parameter file (`.var`): `number value` lines in increasing order, the values
+/// the numbered parameters start with (work offsets, G92 offsets, home positions, …).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParameterFile {
+    values: Vec<(usize, f64)>,
+}
+
+/// A parameter file LinuxCNC would refuse, with the 1-based line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParameterFileError {
+    #[error("line {0}: Parameter number out of range")]
+    OutOfRange(usize),
+    #[error("line {0}: Parameter file out of order")]
+    OutOfOrder(usize),
+}
+
+impl ParameterFile {
+    /// Read a parameter file. Lines that do not start with a number and a value are
+    /// ignored, as LinuxCNC's `restore_parameters` ignores them.
+    pub fn parse(text: &str) -> Result<ParameterFile, ParameterFileError> {
+        let mut values: Vec<(usize, f64)> = Vec::new();
+        for (k, line) in text.lines().enumerate() {
+            let mut fields = line.split_whitespace();
+            let (Some(n), Some(v)) = (fields.next(), fields.next()) else {
+                continue;
+            };
+            let (Ok(n), Ok(v)) = (n.parse::<i64>(), v.parse::<f64>()) else {
+                continue;
+            };
+            if n <= 0 || n as usize >= MAX_PARAMETERS {
+                return Err(ParameterFileError::OutOfRange(k + 1));
+            }
+            if values.last().is_some_and(|&(last, _)| last >= n as usize) {
+                return Err(ParameterFileError::OutOfOrder(k + 1));
+            }
+            values.push((n as usize, v));
+        }
+        Ok(ParameterFile { values })
+    }
+
+    /// The `(number, value)` pairs, in increasing order.
+    pub fn values(&self) -> &[(usize, f64)] {
+        &self.values
+    }
+}
+
 /// Numbered and named parameters.
 #[derive(Debug, Clone)]
 pub struct Params {

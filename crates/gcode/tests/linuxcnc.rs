@@ -139,6 +139,12 @@ const RUNS: &[Run] = &[
     run("g84/g17/g98", "g17-g98-g84.ngc"),
     run("g84/g17/g99", "g17-g99-g84.ngc"),
     run("inverse-time-with-comp", "inverse.ngc"),
+    Run {
+        counter: true,
+        fails: true,
+        stderr: true,
+        ..run("m98m99/03-error-M98-no-P-word", "test.ngc")
+    },
     run("magic_comments/param_format_printing", "test.ngc"),
     Run {
         ini: Some("test.ini"),
@@ -192,7 +198,6 @@ const RUNS: &[Run] = &[
 #[allow(dead_code)]
 const FOLDERS_NOT_YET: &[(&str, &str)] = &[
     ("g33.1", "spindle-synchronised motion, out of scope"),
-    ("g52/g92-offset-persistence", "parameter files (-v), INI"),
     ("g64-r-planner", "G64 R of LinuxCNC master, not in 2.9"),
     ("g71-*, g72-*, g76", "lathe cycles, out of scope"),
     (
@@ -202,9 +207,8 @@ const FOLDERS_NOT_YET: &[(&str, &str)] = &[
     ),
     ("m19", "spindle orientation"),
     (
-        "m98m99/03, 06, 09, 11, 12, 13",
-        "error-report formats, INI feature switches and main-program O-word rules of LinuxCNC \
-         master not yet mirrored (12 is an expected failure in LinuxCNC too)",
+        "m98m99/12-M99-endless-main-program",
+        "M99 in the main program repeats it for ever (an expected failure in LinuxCNC's suite too)",
     ),
     ("mdi-oword-m66", "MDI and M66, no expected file"),
     (
@@ -433,6 +437,193 @@ fn bad_programs_fail_with_linuxcnc_text() {
     assert!(checked >= 21);
 }
 
+/// rs274's output with its standard error merged in (`2>&1`): `executing` first, and on an
+/// error its text and the offending line before the two `ON_RESET()` of the end.
+fn with_stderr(
+    calls: &mut Vec<String>,
+    result: &Result<(), tezgah_gcode::GcodeError>,
+    program: &str,
+) {
+    calls.insert(0, "executing".into());
+    if let Err(e) = result {
+        let at = calls.len() - 2;
+        let line = program.lines().nth(e.span.line as usize - 1).unwrap_or("");
+        calls.splice(at..at, [e.kind.to_string(), line.to_string()]);
+    }
+}
+
+/// `m98m99/06-error-mixed-sub-styles`: four programs that mix Fanuc and rs274ngc subroutine
+/// styles, each stopped with LinuxCNC's message; the expected file holds their outputs in turn.
+#[test]
+fn mixed_subroutine_styles_fail_as_linuxcnc() {
+    let Some(dir) = data_or_skip() else { return };
+    let base = dir.join("m98m99/06-error-mixed-sub-styles");
+    let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+    let mut theirs = expected_calls(&expected, true).into_iter().peekable();
+    for program in [
+        "O...-called-with-O..._call.ngc",
+        "O...-ended-with-O..._endsub.ngc",
+        "O...-sub-called-with-M98.ngc",
+        "O...-sub-ended-with-M99.ngc",
+    ] {
+        let text = std::fs::read_to_string(base.join(program)).unwrap();
+        let (mut ours, result) = our_calls_printing(&text, config(None), false);
+        assert!(result.is_err(), "{program} must fail");
+        with_stderr(&mut ours, &result, &text);
+        for call in ours {
+            assert_eq!(theirs.next().as_deref(), Some(call.as_str()), "{program}");
+        }
+    }
+    assert_eq!(theirs.next(), None, "every expected call was produced");
+}
+
+/// The calls of a program as the `awk '{$1=""; print}'` scripts leave them, without the final
+/// resets (how many close the output depends on how rs274 stopped).
+fn awk_calls(program: &str) -> (Vec<String>, Result<(), tezgah_gcode::GcodeError>) {
+    let (mut calls, result) = our_calls_printing(program, config(None), true);
+    while calls.last().is_some_and(|c| c == "ON_RESET()") {
+        calls.pop();
+    }
+    (calls, result)
+}
+
+/// `m98m99/11-main-program-oword`: a main program titled with a number (`O1`), ended by M2,
+/// M02, M30 or `%`, with an rs274ngc subroutine after it; the illegal variants stop where
+/// LinuxCNC's output stops. The expected file holds the outputs under `Legal test NAME:` and
+/// `Illegal test NAME:` headings.
+#[test]
+fn numbered_main_programs_run_as_linuxcnc() {
+    let Some(dir) = data_or_skip() else { return };
+    let base = dir.join("m98m99/11-main-program-oword");
+    let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+    let mut sections: Vec<(String, Vec<String>)> = Vec::new();
+    for line in expected.lines() {
+        if let Some(title) = line.strip_suffix(':').filter(|l| l.contains("test ")) {
+            sections.push((title.to_string(), Vec::new()));
+        } else if let Some((_, calls)) = sections.last_mut() {
+            calls.extend(expected_calls(line, false));
+        }
+    }
+    assert_eq!(sections.len(), 7);
+    for (title, mut theirs) in sections {
+        let (legal, name) = title.split_once(" test ").unwrap();
+        let file = format!("test-{}-{name}.ngc", legal.to_lowercase());
+        let text = std::fs::read_to_string(base.join(&file)).unwrap();
+        let (ours, result) = awk_calls(&text);
+        while theirs.last().is_some_and(|c| c == "ON_RESET()") {
+            theirs.pop();
+        }
+        assert_eq!(ours, theirs, "{file}: {result:?}");
+        if legal == "Legal" {
+            assert!(result.is_ok(), "{file}: {result:?}");
+        }
+    }
+}
+
+/// `m98m99/09-disable-fanuc-subs`: a Fanuc-style and an rs274ngc-style program, each run with
+/// an INI file that allows Fanuc subprograms, one that refuses them (`DISABLE_FANUC_STYLE_SUB`)
+/// and none. The expected file holds the six outputs under `program: …; INI: …` headings.
+#[test]
+fn fanuc_subprograms_can_be_disabled() {
+    let Some(dir) = data_or_skip() else { return };
+    let base = dir.join("m98m99/09-disable-fanuc-subs");
+    let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+    let mut sections: Vec<(String, Vec<String>)> = Vec::new();
+    for line in expected.lines() {
+        if let Some(title) = line.strip_prefix("program: ") {
+            sections.push((title.to_string(), Vec::new()));
+        } else if let Some((_, calls)) = sections.last_mut() {
+            calls.extend(expected_calls(line, false));
+        }
+    }
+    assert_eq!(sections.len(), 6);
+    for (title, mut theirs) in sections {
+        let (program, ini) = title.split_once("; INI: ").unwrap();
+        let text = std::fs::read_to_string(base.join(format!("test-{program}.ngc"))).unwrap();
+        let mut cfg = config(None);
+        let ini_file = match ini {
+            "fanuc" => Some("test-fanuc.ini"),
+            "NO fanuc" => Some("test-no-fanuc.ini"),
+            _ => None,
+        };
+        if let Some(f) = ini_file {
+            let ini = IniFile::parse(&std::fs::read_to_string(base.join(f)).unwrap()).unwrap();
+            cfg.ini = Some(std::sync::Arc::new(ini));
+        }
+        let (mut ours, result) = our_calls_printing(&text, cfg, false);
+        with_stderr(&mut ours, &result, &text);
+        for list in [&mut ours, &mut theirs] {
+            while list.last().is_some_and(|c| c == "ON_RESET()") {
+                list.pop();
+            }
+        }
+        assert_eq!(ours, theirs, "{title}");
+    }
+}
+
+/// `g52/g92-offset-persistence`: G92 offsets read from a parameter file (`rs274 -v`) apply
+/// from the start, unless the INI file sets `DISABLE_G92_PERSISTENCE`, which also clears them
+/// at the program's end. Three runs: persistence on by the INI file, by default, and off.
+#[test]
+fn g92_offsets_persist_as_the_ini_file_says() {
+    let Some(dir) = data_or_skip() else { return };
+    let base = dir.join("g52/g92-offset-persistence");
+    let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+    // Each run's output starts again at call number 1.
+    let mut runs: Vec<Vec<String>> = Vec::new();
+    for line in expected.lines() {
+        if line.trim_start().starts_with("1 N") {
+            runs.push(Vec::new());
+        }
+        if let Some(run) = runs.last_mut() {
+            run.extend(expected_calls(line, true));
+        }
+    }
+    let text = std::fs::read_to_string(base.join("g92_offsets.ngc")).unwrap();
+    let vars = std::fs::read_to_string(base.join("g92_offsets.var.template")).unwrap();
+    let vars = std::sync::Arc::new(tezgah_gcode::params::ParameterFile::parse(&vars).unwrap());
+    let inis = [
+        Some("persistent_g92_offset_true.ini"),
+        None,
+        Some("persistent_g92_offset_false.ini"),
+    ];
+    assert_eq!(runs.len(), inis.len());
+    for (mut theirs, ini) in runs.into_iter().zip(inis) {
+        let mut cfg = config(None);
+        cfg.parameters = Some(vars.clone());
+        if let Some(f) = ini {
+            let ini = IniFile::parse(&std::fs::read_to_string(base.join(f)).unwrap()).unwrap();
+            cfg.ini = Some(std::sync::Arc::new(ini));
+        }
+        let (mut ours, result) = our_calls_printing(&text, cfg, false);
+        assert!(result.is_ok(), "{ini:?}: {result:?}");
+        for list in [&mut ours, &mut theirs] {
+            while list.last().is_some_and(|c| c == "ON_RESET()") {
+                list.pop();
+            }
+        }
+        assert_eq!(ours, theirs, "{ini:?}");
+    }
+}
+
+/// `m98m99/13-named-program`: `O<name>` and `O42` titles before the program body.
+#[test]
+fn named_programs_run_as_linuxcnc() {
+    let Some(dir) = data_or_skip() else { return };
+    let base = dir.join("m98m99/13-named-program");
+    let expected = std::fs::read_to_string(base.join("expected")).unwrap();
+    let mut theirs = expected_calls(&expected, true).into_iter();
+    for file in ["test-named.ngc", "test-numbered.ngc"] {
+        let text = std::fs::read_to_string(base.join(file)).unwrap();
+        let (ours, result) = our_calls_printing(&text, config(None), false);
+        assert!(result.is_ok(), "{file}: {result:?}");
+        for call in ours {
+            assert_eq!(theirs.next().as_deref(), Some(call.as_str()), "{file}");
+        }
+    }
+    assert_eq!(theirs.next(), None, "every expected call was produced");
+}
+
 #[test]
 fn folder_tests_match_linuxcnc() {
     let Some(dir) = data_or_skip() else { return };
@@ -464,12 +655,7 @@ fn folder_tests_match_linuxcnc() {
         };
         assert_eq!(result.is_err(), r.fails, "{folder}: {result:?}");
         if r.stderr {
-            ours.insert(0, "executing".into());
-            if let Err(e) = &result {
-                let at = ours.len() - 2; // before the two ON_RESET() of the end
-                let line = text.lines().nth(e.span.line as usize - 1).unwrap_or("");
-                ours.splice(at..at, [e.kind.to_string(), line.to_string()]);
-            }
+            with_stderr(&mut ours, &result, &text);
         }
         // How many ON_RESET() close the output depends on how rs274 was started.
         let mut theirs = expected_calls(&expected, r.counter);

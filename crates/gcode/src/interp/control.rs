@@ -119,8 +119,6 @@ enum Skip {
         args: Vec<f64>,
         return_to: LinePos,
     },
-    /// The M99 that ends a Fanuc-style subprogram met in passing.
-    FanucDefinition,
     /// An M98 call to a subprogram not met yet: its `O<n>` line.
     FanucCall {
         label: OLabel,
@@ -139,24 +137,17 @@ pub struct Control {
     skip: Option<Skip>,
     /// Fanuc-style subprograms met so far (the line after their `O<n>`).
     programs: HashMap<OLabel, LinePos>,
-    /// Whether a line has executed: a bare `O<n>` before that is the program's number.
-    started: bool,
     /// The line after the one executing (where an M98 returns to).
     pub(super) next_line: Option<LinePos>,
 }
 
 impl Control {
-    pub(super) fn mark_started(&mut self) {
-        self.started = true;
-    }
-
     /// The error to report when the program ends in the middle of a skip.
     pub fn unfinished(&self) -> Option<ErrorKind> {
         Some(match self.skip.as_ref()? {
             Skip::Call { label, .. } | Skip::FanucCall { label, .. } => {
                 ErrorKind::SubroutineNotFound(label.to_string())
             }
-            Skip::FanucDefinition => ErrorKind::OWordTargetMissing("…".into(), "M99"),
             Skip::Definition(l) => ErrorKind::OWordTargetMissing(l.to_string(), "endsub"),
             Skip::Branch(l) | Skip::PastIf(l) => {
                 ErrorKind::OWordTargetMissing(l.to_string(), "endif")
@@ -180,10 +171,6 @@ impl Interpreter {
         sink: &mut impl CanonSink,
     ) -> Result<Flow, GcodeError> {
         let text = &self.norm.text;
-        if matches!(self.control.skip, Some(Skip::FanucDefinition)) && ends_subprogram(text) {
-            self.control.skip = None;
-            return Ok(Flow::Continue);
-        }
         // An N word may stand before the O-word.
         let mut i = 0;
         if text.first() == Some(&b'n') {
@@ -239,6 +226,13 @@ impl Interpreter {
                 self.control.skip = None;
                 let o = self.read_control_line(line)?;
                 return self.o_word(&o, line, sink).map_err(|(k, _)| span(k));
+            }
+            // The two styles do not mix: the definition must be of the call's kind.
+            (Some(Skip::Call { label, .. }), OKeyword::Program) if matches(&label) => {
+                return Err(span(ErrorKind::FanucSubNeedsM98));
+            }
+            (Some(Skip::FanucCall { label, .. }), OKeyword::Sub) if matches(&label) => {
+                return Err(span(ErrorKind::NgcSubNeedsCall));
             }
             (
                 Some(Skip::FanucCall {
@@ -308,11 +302,14 @@ impl Interpreter {
         let label = &o.label;
         let unmatched = |what| (ErrorKind::UnmatchedOWord(what, label.to_string()), o.at);
         match o.keyword {
-            // The program's number on its first line, or a Fanuc-style subprogram to pass over.
-            OKeyword::Program if !self.control.started => {}
+            // A program number (`O1000`, `O<name>`): LinuxCNC goes on executing through it at
+            // the top level, so a Fanuc-style subprogram belongs after M2/M30. It is noted so
+            // that a later M98 finds it.
+            OKeyword::Program if self.fanuc_subs_disabled() => {
+                return Err((ErrorKind::FanucProgramDisabled, o.at));
+            }
             OKeyword::Program => {
                 self.control.programs.insert(label.clone(), line.next());
-                self.control.skip = Some(Skip::FanucDefinition);
             }
             // Subroutines are defined at the program's level, never inside another's body.
             OKeyword::Sub if !self.control.frames.is_empty() => {
@@ -329,7 +326,7 @@ impl Interpreter {
                     .last()
                     .is_some_and(|f| f.fanuc.is_some())
                 {
-                    return Err(unmatched("M98 subprogram ended by"));
+                    return Err((ErrorKind::FanucSubNeedsM99, o.at));
                 }
                 let frame = self.control.frames.pop().ok_or_else(|| {
                     unmatched(if o.keyword == OKeyword::Return {
@@ -552,7 +549,7 @@ impl Interpreter {
             return Err((ErrorKind::M99InMain, at));
         };
         let Some(fanuc) = frame.fanuc.as_mut() else {
-            return Err((ErrorKind::UnmatchedOWord("M99", "sub".into()), at));
+            return Err((ErrorKind::NgcSubEndedByM99, at));
         };
         fanuc.passes_left -= 1;
         if fanuc.passes_left > 0 {
@@ -636,16 +633,6 @@ impl Interpreter {
         });
         Ok(())
     }
-}
-
-/// Whether a (normalised) line holds M99, the end of a Fanuc-style subprogram.
-fn ends_subprogram(text: &[u8]) -> bool {
-    text.windows(3).enumerate().any(|(i, w)| {
-        w == b"m99"
-            && !text
-                .get(i + 3)
-                .is_some_and(|c| c.is_ascii_digit() || *c == b'.')
-    })
 }
 
 /// Where subroutines that live in their own files come from (LinuxCNC's `SUBROUTINE_PATH`):

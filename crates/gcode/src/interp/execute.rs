@@ -25,6 +25,10 @@ impl Interpreter {
         line: LineRef,
         sink: &mut impl CanonSink,
     ) -> Result<Flow, GcodeError> {
+        if let Some(m) = block.m[mgroup::SUBPROGRAM].filter(|_| self.fanuc_subs_disabled()) {
+            let kind = ErrorKind::FanucSubsDisabled(m.code);
+            return Err(GcodeError::new(kind, line.span(m.at as usize)));
+        }
         let plan = checks::check(block, &self.state)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.assign_parameters(block)
@@ -332,7 +336,7 @@ impl Interpreter {
     }
 
     /// Offsets (program units) and XY rotation (degrees) stored for system `index`.
-    fn coordinate_system(&self, index: usize) -> (Pose, f64) {
+    pub(super) fn coordinate_system(&self, index: usize) -> (Pose, f64) {
         let base = coord_system_base(index);
         (self.offset_params(base), self.params.get(base + 9))
     }
@@ -411,15 +415,7 @@ impl Interpreter {
                 self.set_offset_params(base, machine);
             }
             520 | 920 => self.set_axis_offsets(block, g == 520, sink),
-            921 | 922 => {
-                self.state.pos = self.state.pos + self.state.axis_offset;
-                self.state.axis_offset = Pose::ZERO;
-                if g == 921 {
-                    self.params.set6(params::G92_OFFSET, [0.0; 6]);
-                }
-                self.params.set(params::G92_ENABLED, 0.0);
-                self.emit(sink, Canon::SetG92Offset(Pose::ZERO));
-            }
+            921 | 922 => self.cancel_axis_offsets(g == 921, sink),
             923 => {
                 let offset = self.offset_params(params::G92_OFFSET);
                 self.state.pos = self.state.pos + self.state.axis_offset - offset;
@@ -431,6 +427,18 @@ impl Interpreter {
             _ => return Err(unsupported(g, at)),
         }
         Ok(())
+    }
+
+    /// G92.1 (`forget`: the stored offsets too) and G92.2: the G92/G52 offsets stop applying;
+    /// the tool stays where it is.
+    fn cancel_axis_offsets(&mut self, forget: bool, sink: &mut impl CanonSink) {
+        self.state.pos = self.state.pos + self.state.axis_offset;
+        self.state.axis_offset = Pose::ZERO;
+        if forget {
+            self.params.set6(params::G92_OFFSET, [0.0; 6]);
+        }
+        self.params.set(params::G92_ENABLED, 0.0);
+        self.emit(sink, Canon::SetG92Offset(Pose::ZERO));
     }
 
     /// G10 L2 / L20: set a coordinate system's offsets directly, or so that the current point
@@ -536,6 +544,10 @@ impl Interpreter {
         if self.state.flood {
             self.state.flood = false;
             self.emit(sink, Canon::FloodOff);
+        }
+        if self.g92_not_persistent() {
+            // G92/G52 offsets last one run (LinuxCNC's DISABLE_G92_PERSISTENCE).
+            self.cancel_axis_offsets(true, sink);
         }
         if pallet {
             self.emit(sink, Canon::PalletShuttle);

@@ -47,6 +47,8 @@ pub struct Config {
     pub subroutines: Option<std::sync::Arc<dyn SubroutineLibrary>>,
     /// A LinuxCNC INI file: its values are the read-only `#<_ini[section]name>` parameters.
     pub ini: Option<std::sync::Arc<crate::ini::IniFile>>,
+    /// The parameter file the numbered parameters start from (LinuxCNC's `-v` file).
+    pub parameters: Option<std::sync::Arc<crate::params::ParameterFile>>,
     /// Pocket index of the tool in the spindle when the program starts (0: none). LinuxCNC's
     /// standalone `rs274` starts with 1, so G10 writes to pocket 1 reach its spindle entry.
     pub start_pocket: usize,
@@ -61,6 +63,7 @@ impl Config {
             limits: ControlLimits::default(),
             subroutines: None,
             ini: None,
+            parameters: None,
             start_pocket: 1,
         }
     }
@@ -155,7 +158,7 @@ impl Interpreter {
             current_pocket: cfg.start_pocket,
             ..State::default()
         };
-        Interpreter {
+        let mut interp = Interpreter {
             cfg,
             state,
             params,
@@ -168,6 +171,48 @@ impl Interpreter {
             comp: comp::CutterComp::default(),
             closing_percent_sought: false,
             files: Vec::new(),
+        };
+        interp.restore_parameters();
+        interp
+    }
+
+    /// Start from the parameter file, if any: its active coordinate system (`#5220`) and
+    /// offsets, and its G92 offsets unless the INI file's `DISABLE_G92_PERSISTENCE` clears them
+    /// (LinuxCNC's `init`).
+    fn restore_parameters(&mut self) {
+        let Some(file) = self.cfg.parameters.clone() else {
+            return;
+        };
+        for &(n, v) in file.values() {
+            self.params.set(n, v);
+        }
+        let index = (self.params.get(crate::params::COORD_SYSTEM) + 0.0001) as usize;
+        let index = if (1..=9).contains(&index) { index } else { 1 };
+        self.params.set(crate::params::COORD_SYSTEM, index as f64);
+        let (origin, rotation) = self.coordinate_system(index);
+        self.state.origin_index = index;
+        self.state.origin = origin;
+        self.state.rotation = rotation;
+        if self.g92_not_persistent() {
+            self.clear_g92_parameters();
+        }
+        if self.params.get(crate::params::G92_ENABLED) != 0.0 {
+            self.state.axis_offset = self.offset_params(crate::params::G92_OFFSET);
+        }
+    }
+
+    /// Whether the INI file makes G92/G52 offsets last only one program run.
+    fn g92_not_persistent(&self) -> bool {
+        self.cfg.ini.as_ref().is_some_and(|ini| {
+            ini.flag("RS274NGC", "DISABLE_G92_PERSISTENCE")
+                .unwrap_or(false)
+        })
+    }
+
+    /// `#5210…#5219` to zero.
+    fn clear_g92_parameters(&mut self) {
+        for n in crate::params::G92_ENABLED..crate::params::G92_ENABLED + 10 {
+            self.params.set(n, 0.0);
         }
     }
 
@@ -192,7 +237,7 @@ impl Interpreter {
         sink.call(
             o,
             Canon::SetG5xOffset {
-                index: 1,
+                index: self.state.origin_index as u8,
                 offset: self.state.origin,
             },
         );
@@ -375,10 +420,8 @@ impl Interpreter {
             let flow = self
                 .o_word(&o, line, sink)
                 .map_err(|(kind, _)| GcodeError::new(kind, line.span(at)));
-            self.control.mark_started();
             return flow;
         }
-        self.control.mark_started();
         self.execute_block(block, line, sink)
     }
 
@@ -419,6 +462,14 @@ impl Interpreter {
             }
         }
         Ok(())
+    }
+
+    /// Whether the INI file refuses Fanuc-style subprograms.
+    fn fanuc_subs_disabled(&self) -> bool {
+        self.cfg
+            .ini
+            .as_ref()
+            .is_some_and(|ini| ini.fanuc_subs_disabled())
     }
 
     /// Send a call, or hold it behind moves that cutter compensation holds back.
