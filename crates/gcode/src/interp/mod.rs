@@ -389,6 +389,10 @@ impl Interpreter {
             .map_err(|(kind, byte)| GcodeError::new(kind, line.span(byte)))?;
         if let Some(flow) = self.percent_line(line)? {
             if flow == Flow::End {
+                // Moves cutter compensation still holds are not lost at the closing `%`
+                // (LinuxCNC drops them; only M0/M1/M2/M30 release them there).
+                self.flush_comp(sink)
+                    .map_err(|kind| GcodeError::new(kind, line.span(0)))?;
                 sink.call(Origin::default(), Canon::Finish);
             }
             return Ok(flow);
