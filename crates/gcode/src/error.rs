@@ -298,6 +298,8 @@ pub enum ErrorKind {
     G10L20Rotation,
     #[error("Requested tool {0} not found in the tool table")]
     ToolNotFound(i64),
+    #[error("H word missing with G43.4")]
+    CentrePointMissingH,
 
     // --- motion ---
     #[error("Cannot do g1 with zero feed rate")]

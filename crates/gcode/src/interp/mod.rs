@@ -13,6 +13,7 @@ mod execute;
 mod motion;
 mod state;
 mod system;
+mod tcp;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
 use control::SubroutineFile;
@@ -41,6 +42,9 @@ pub struct Config {
     pub limits: ControlLimits,
     /// Subroutines in files of their own (`o<name> call` of a name the program lacks).
     pub subroutines: Option<std::sync::Arc<dyn SubroutineLibrary>>,
+    /// Tool-centre-point control whatever the program says (the machine file's
+    /// `tcp = "always"`); read by [`crate::moves::program_moves`], not by the interpreter.
+    pub tool_centre_point_always: bool,
 }
 
 impl Config {
@@ -51,6 +55,7 @@ impl Config {
             machine_units: Units::Inches,
             limits: ControlLimits::default(),
             subroutines: None,
+            tool_centre_point_always: false,
         }
     }
 }
