@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
-use tezgah_kinematics::{builtin_names, Machine};
+use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
 use tezgah_motion::interpolate::{run as run_items, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
@@ -105,6 +105,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let config = Config {
         tool_table: table,
         subroutines: crate::library::folders(args.program.as_deref(), &args.subroutine_path),
+        tool_centre_point_always: machine.tcp == TcpSwitch::Always,
         ..Config::default()
     };
     let moves = match tezgah_gcode::program_moves(&text, config) {
@@ -124,6 +125,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
     let start = Pose::ZERO;
+    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
@@ -132,6 +134,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
             tolerance,
             start,
             blend_max_angle: RUN_BLEND_MAX_ANGLE_DEG.to_radians(),
+            control: pm.initial,
             ..SmoothOptions::default()
         },
     )
@@ -140,7 +143,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
         .count();
-    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     let options = PlanOptions {
         period,
         // The chord error gets what compression and blending leave of the tolerance.
@@ -202,7 +204,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let start_tip = Vec3::from(start.xyz());
     let duration = run_items(
         items,
-        &machine.kinematics,
         pm,
         options,
         (start_tip, [start.0[3], start.0[4], start.0[5]]),

@@ -9,6 +9,7 @@ pub mod interpolate;
 pub mod path;
 pub mod plan;
 pub mod profile;
+pub mod takeup;
 pub mod verify;
 
 pub use path::{Junction, PathItem, Segment, SegmentFeed};
