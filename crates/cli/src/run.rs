@@ -245,6 +245,14 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     })
 }
 
+/// The machine file's `kinematics.tcp`, as written there.
+fn tcp_name(machine: &Machine) -> &'static str {
+    match machine.tcp {
+        TcpSwitch::Program => "program",
+        TcpSwitch::Always => "always",
+    }
+}
+
 fn report_json(
     machine: &Machine,
     r: &Report,
@@ -277,6 +285,7 @@ fn report_json(
     serde_json::json!({
         "program": program,
         "machine": machine.name,
+        "tcp": tcp_name(machine),
         "period_s": period,
         "tolerance_mm": tolerance,
         "cycle_time_s": r.cycle_time,
@@ -299,9 +308,10 @@ fn summary(
     tolerance: f64,
 ) {
     println!(
-        "{program} on {} ({}), period {} ms, tolerance {} mm",
+        "{program} on {} ({}, TCP {}), period {} ms, tolerance {} mm",
         machine.name,
         machine.kinematics.type_name(),
+        tcp_name(machine),
         period * 1e3,
         tolerance
     );
