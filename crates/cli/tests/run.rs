@@ -102,7 +102,14 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
     let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/five-axis.ngc");
     let tools = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
     let out = tezgah()
-        .args(["run", program, "--machine", "table-ac", "--tool-table", tools])
+        .args([
+            "run",
+            program,
+            "--machine",
+            "table-ac",
+            "--tool-table",
+            tools,
+        ])
         .arg("--report")
         .arg(&json)
         .output()
@@ -130,7 +137,11 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
             ("peak_jerk", "max_jerk"),
         ] {
             let (p, l) = (j[peak].as_f64().unwrap(), j[limit].as_f64().unwrap());
-            assert!(p > 0.0 && p <= 1.005 * l, "{}: {peak} {p} > {limit} {l}", j["name"]);
+            assert!(
+                p > 0.0 && p <= 1.005 * l,
+                "{}: {peak} {p} > {limit} {l}",
+                j["name"]
+            );
         }
     }
     // G43.4 H1 needs tool 1 in a tool table: without one the run stops at line 5.

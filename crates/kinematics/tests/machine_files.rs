@@ -45,7 +45,11 @@ fn builtins_parse() {
 fn tcp_is_switched_by_the_program_unless_the_file_says_always() {
     use tezgah_kinematics::TcpSwitch;
     for name in builtin_names() {
-        assert_eq!(Machine::builtin(name).unwrap().tcp, TcpSwitch::Program, "{name}");
+        assert_eq!(
+            Machine::builtin(name).unwrap().tcp,
+            TcpSwitch::Program,
+            "{name}"
+        );
     }
     let ac = Machine::builtin_text("table-ac").unwrap();
     let always = edit(ac, "[kinematics]", "tcp", "tcp = \"always\"");

@@ -79,7 +79,9 @@ impl TakeUp {
                 .zip(new.as_slice())
                 .any(|(p, q)| (p - q).abs() > SAME_JOINTS);
             if moved {
-                out = Some(PathItem::Segment(joint_line(m, &old, &new, seg).map_err(err)?));
+                out = Some(PathItem::Segment(
+                    joint_line(m, &old, &new, seg).map_err(err)?,
+                ));
             }
             self.control = seg.control;
             self.joints = new;

@@ -102,24 +102,40 @@ fn tcp_puts_the_tip_on_the_program_point_with_the_length_along_the_tool_axis() {
         assert_within_limits(&out.report);
         // The final row holds the end of line 6 exactly: the closed form.
         let (last, _, _) = out.samples.last().unwrap();
-        assert_joints(&last.joints, closed_form([20.0, 5.0, -3.0], 30.0, 40.0, length));
+        assert_joints(
+            &last.joints,
+            closed_form([20.0, 5.0, -3.0], 30.0, 40.0, length),
+        );
         // Every TCP sample: the forward kinematics with this tool puts the tip on the
         // sampled program point and the tool axis at the programmed A and C (DESIGN.md:
         // seen from the part, (sin A sin C, sin A cos C, cos A)).
         let machine = Machine::builtin("table-ac").unwrap();
         let mut checked = 0;
         for (s, control, _) in &out.samples {
-            if *control != Some(ToolControl::CentrePoint { tool_length: length }) {
+            if *control
+                != Some(ToolControl::CentrePoint {
+                    tool_length: length,
+                })
+            {
                 continue;
             }
             let pose = machine
                 .kinematics
                 .forward(&s.joints, &Tool::with_length(length))
                 .unwrap();
-            assert!((pose.tip - s.tip).norm() < 1e-9, "line {}: {:?}", s.line, pose);
+            assert!(
+                (pose.tip - s.tip).norm() < 1e-9,
+                "line {}: {:?}",
+                s.line,
+                pose
+            );
             let (a, c) = (s.rotary[0].to_radians(), s.rotary[2].to_radians());
             let axis = Vec3::new(a.sin() * c.sin(), a.sin() * c.cos(), a.cos());
-            assert!((pose.axis.into_inner() - axis).norm() < 1e-12, "line {}", s.line);
+            assert!(
+                (pose.axis.into_inner() - axis).norm() < 1e-12,
+                "line {}",
+                s.line
+            );
             checked += 1;
         }
         assert!(checked > 1000, "{checked} TCP samples");
@@ -128,15 +144,17 @@ fn tcp_puts_the_tip_on_the_program_point_with_the_length_along_the_tool_axis() {
 
 #[test]
 fn g49_returns_to_joint_mode_where_moves_are_straight_in_joint_space() {
-    let program = TCP_PROGRAM.replace("{H}", "1").replace(
-        "M2\n",
-        "G49\nG0 X50 Y-20 Z10 A10 C-30\nM2\n",
-    );
+    let program = TCP_PROGRAM
+        .replace("{H}", "1")
+        .replace("M2\n", "G49\nG0 X50 Y-20 Z10 A10 C-30\nM2\n");
     let out = run_program(&program);
     assert_within_limits(&out.report);
     // TCP off: the program axes are the joints.
     let (last, _, _) = out.samples.last().unwrap();
-    assert_joints(&last.joints, [50.0, -20.0, 10.0, 10f64.to_radians(), -30f64.to_radians()]);
+    assert_joints(
+        &last.joints,
+        [50.0, -20.0, 10.0, 10f64.to_radians(), -30f64.to_radians()],
+    );
     // The G0 (the joint-mode segment that ends at the programmed point; the take-up before
     // it ends where it starts): every sample on the straight joint line between its ends.
     let end = Vec3::new(50.0, -20.0, 10.0);
@@ -152,7 +170,9 @@ fn g49_returns_to_joint_mode_where_moves_are_straight_in_joint_space() {
     for s in &on_g0 {
         // q = goal + λ (first − goal) with one λ for every joint.
         let d0: Vec<f64> = (0..5).map(|j| first[j] - goal[j]).collect();
-        let k = (0..5).max_by(|&i, &j| d0[i].abs().total_cmp(&d0[j].abs())).unwrap();
+        let k = (0..5)
+            .max_by(|&i, &j| d0[i].abs().total_cmp(&d0[j].abs()))
+            .unwrap();
         let lambda = (s.joints[k] - goal[k]) / d0[k];
         for j in 0..5 {
             let want = goal[j] + lambda * d0[j];

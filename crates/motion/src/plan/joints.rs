@@ -12,9 +12,7 @@
 
 use tezgah_geom::{Axis, Pose, ToolControl, Vec3};
 use tezgah_kinematics::tcp::ProgramPose;
-use tezgah_kinematics::{
-    Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool,
-};
+use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
 
 use super::PlanError;
 
@@ -138,11 +136,14 @@ impl PlanMachine {
         let tool = match control {
             ToolControl::CentrePoint { tool_length } => Tool::with_length(tool_length),
             ToolControl::Joints if self.orients() => {
-                let map = self.map.as_deref().ok_or_else(|| KinematicsError::BadInput {
-                    reason: "with TCP off the program axes drive the joints of their names, \
+                let map = self
+                    .map
+                    .as_deref()
+                    .ok_or_else(|| KinematicsError::BadInput {
+                        reason: "with TCP off the program axes drive the joints of their names, \
                              and this machine's joints are not named x y z a b c"
-                        .into(),
-                })?;
+                            .into(),
+                    })?;
                 let mut q = Joints::zeros(map.len());
                 for (v, m) in q.as_mut_slice().iter_mut().zip(map) {
                     *v = match *m {

@@ -21,7 +21,9 @@ mod piece;
 
 use std::collections::VecDeque;
 
-use tezgah_geom::{Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, ToolControl, Vec3};
+use tezgah_geom::{
+    Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, ToolControl, Vec3,
+};
 
 pub use blend::{Blend, End};
 pub use error::PathError;
@@ -141,8 +143,13 @@ pub fn build(
 #[allow(clippy::large_enum_variant)]
 pub(crate) enum Tok {
     Piece(Piece),
-    Dwell { seconds: f64, line: u32 },
-    Stop { line: u32 },
+    Dwell {
+        seconds: f64,
+        line: u32,
+    },
+    Stop {
+        line: u32,
+    },
     /// TCP switched (or its tool length changed): the machine stops before it, and nothing
     /// is compressed or blended across it.
     Control(ToolControl),
