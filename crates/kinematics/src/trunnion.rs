@@ -198,6 +198,20 @@ impl Kinematics for Trunnion {
         let [t1, c1] = atan2_pair([h, cy], [k.z, cx]);
         let (sc, cc) = (cy * inv_h, cx * inv_h);
         let b1 = self.turns(t1, c1, previous);
+        // The usual case along a path, decided without branch 2: the previous tilt is ≥ 0,
+        // branch 1 needs no turn of the tilt and at most a quarter turn of C. Branch 2 then
+        // costs at least |t1 + pt| + π − d ≥ |t1 − pt| + d (its C is half a turn away, so
+        // at least π − d from the previous C), so branch 1 is the nearest.
+        if let Some((t, c)) = b1 {
+            let d = (c - previous[C]).abs();
+            if previous[TILT] >= 0.0 && t == t1 && d <= std::f64::consts::FRAC_PI_2 {
+                let m = self.linear_sc(&pose.tip, h, k.z, sc, cc, tool);
+                let q = Joints::new([m.x, m.y, m.z, t, c]);
+                if check_limits(&q, &self.limits).is_ok() {
+                    return Ok(q);
+                }
+            }
+        }
         let b2 = self.turns(-t1, c1 + std::f64::consts::PI, previous);
         let cost = |b: &Option<(f64, f64)>| {
             b.map_or(f64::INFINITY, |(t, c)| {
