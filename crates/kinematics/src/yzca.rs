@@ -202,6 +202,18 @@ impl Kinematics for Yzca {
         // Branch 2 turns the table half a turn and tilts the other way: (−y, z, C + π, −A).
         let (lc, la) = (&self.limits[C], &self.limits[A]);
         let b1 = turns(c1, a1, previous, lc, la);
+        // The usual case along a path, decided without branch 2 (as in the trunnions): A
+        // keeps its sign and needs no turn, C moves at most a quarter turn. Branch 2 costs at
+        // least |a1 + pa| + π − d ≥ |a1 − pa| + d, so branch 1 is the nearest.
+        if let Some((c, a)) = b1 {
+            let d = (c - previous[C]).abs();
+            if a1 * previous[A] >= 0.0 && a == a1 && d <= std::f64::consts::FRAC_PI_2 {
+                let q = Joints::new([y1, z1, c, a]);
+                if check_limits(&q, &self.limits).is_ok() {
+                    return Ok(q);
+                }
+            }
+        }
         let b2 = turns(c1 + std::f64::consts::PI, -a1, previous, lc, la);
         let cost = |b: &Option<(f64, f64)>| {
             b.map_or(f64::INFINITY, |(c, a)| {

@@ -334,3 +334,35 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, .. ProptestConfig::default() })]
+
+    /// The same for Y-Z-C-A: (C, A) nearest the previous ones among (C, A) and (C + π, −A).
+    #[test]
+    fn yzca_inverse_takes_the_nearest_branch(
+        prev_a in -110.0f64..110.0, prev_c in -720.0f64..720.0,
+        y in 5.0f64..150.0, z in -100.0f64..100.0, c in -720.0f64..720.0, a in -110.0f64..110.0,
+    ) {
+        let m = machine("yzca");
+        let tool = Tool::with_length(25.0);
+        let pose = m.kinematics.forward(&file_q(&m, &[y, z, c, a]), &tool).unwrap();
+        let previous = file_q(&m, &[0.0, 0.0, prev_c, prev_a]);
+        let Ok(q) = m.kinematics.inverse(&pose, &tool, &previous) else {
+            return Ok(());
+        };
+        assert_pose_eq(&m.kinematics.forward(&q, &tool).unwrap(), &pose, 1e-9)?;
+        let cost = |c: f64, a: f64| (c - previous[2]).abs() + (a - previous[3]).abs();
+        let (c2, a2) = (q[2] + std::f64::consts::PI, -q[3]);
+        let c2 = previous[2] + (c2 - previous[2] + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let alt = Joints::from_slice(&[-q[0], q[1], c2, a2]).unwrap();
+        if m.kinematics.check_joints(&alt).is_ok() {
+            prop_assert!(
+                cost(q[2], q[3]) <= cost(c2, a2) + 1e-12,
+                "chose ({}, {}) cost {} > ({c2}, {a2}) cost {}",
+                q[2], q[3], cost(q[2], q[3]), cost(c2, a2)
+            );
+        }
+    }
+}
