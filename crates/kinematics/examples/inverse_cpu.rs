@@ -27,7 +27,10 @@ fn main() {
         let m = Machine::builtin(name).expect("built-in machine");
         let tool = Tool::with_length(25.0);
         let ps = poses(&m, &tool);
-        let q0 = m.kinematics.inverse(&ps[0], &tool, &m.home()).expect("reachable");
+        let q0 = m
+            .kinematics
+            .inverse(&ps[0], &tool, &m.home())
+            .expect("reachable");
         let mut best = f64::INFINITY;
         // Best of five: what is left of the noise only ever adds time.
         for _ in 0..5 {
@@ -35,13 +38,20 @@ fn main() {
             for _ in 0..ROUNDS / 5 {
                 let mut q = q0;
                 for p in &ps {
-                    q = m.kinematics.inverse(black_box(p), &tool, &q).expect("reachable");
+                    q = m
+                        .kinematics
+                        .inverse(black_box(p), &tool, &q)
+                        .expect("reachable");
                 }
                 black_box(q);
             }
             let dt = (cpu_ns().unwrap_or(0) - t0) as f64 * 1e-9;
             best = best.min(dt / (ROUNDS / 5 * ps.len()) as f64);
         }
-        println!("{name:<13} {:6.1} M poses/s of CPU time ({:.1} ns/pose)", 1e-6 / best, best * 1e9);
+        println!(
+            "{name:<13} {:6.1} M poses/s of CPU time ({:.1} ns/pose)",
+            1e-6 / best,
+            best * 1e9
+        );
     }
 }

@@ -302,7 +302,10 @@ mod tests {
         ] {
             let got = atan2_pair([y, 0.5], [x, -0.5]);
             let want = f64::atan2(y, x);
-            assert!(got[0] == want || (got[0].is_nan() && want.is_nan()), "{y} {x}");
+            assert!(
+                got[0] == want || (got[0].is_nan() && want.is_nan()),
+                "{y} {x}"
+            );
             assert_eq!(got[1], f64::atan2(0.5, -0.5));
         }
     }
