@@ -232,3 +232,24 @@ fn a_switch_at_a_point_whose_joints_agree_needs_no_take_up() {
     let q = last.unwrap();
     assert_eq!(q.as_slice(), &[1.0, 0.0, 30.0]);
 }
+
+#[test]
+fn with_tcp_off_an_axis_without_a_joint_is_refused_not_ignored() {
+    let machine = Machine::builtin("table-ac").unwrap();
+    let moves = program_moves("G21\nG1 X5 B10 F100\nM2\n", Config::default()).unwrap();
+    let items = smooth::build(moves, &SmoothOptions::default()).unwrap();
+    let pm = PlanMachine::from_machine(&machine).unwrap();
+    let err = run(
+        items,
+        pm,
+        PlanOptions::default(),
+        (Vec3::zeros(), [0.0; 3]),
+        |_, _| {},
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.starts_with("line 2: B has no joint on this machine"),
+        "{err}"
+    );
+}

@@ -15,6 +15,11 @@ use tezgah_kinematics::tcp::ProgramPose;
 use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
 
 use super::PlanError;
+use crate::path::Segment;
+
+/// A program axis "moves" along a segment when its ends or middle differ by more than this
+/// (mm or degrees): round-off of the path builders, far below any resolution.
+const STILL: f64 = 1e-9;
 
 /// What drives a joint when it follows the path directly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -122,6 +127,42 @@ impl PlanMachine {
         } else {
             None
         }
+    }
+
+    /// With TCP off on a machine whose rotaries orient the tool, a program axis without a
+    /// joint of its name (X on Y-Z-C-A, B on table-ac) cannot move: refused, not ignored.
+    pub fn check_axes(&self, seg: &Segment) -> Result<(), PlanError> {
+        let Some(map) = self.map.as_deref() else {
+            return Ok(());
+        };
+        if seg.control != ToolControl::Joints || !self.orients() {
+            return Ok(());
+        }
+        let (a, b) = seg.curve.domain();
+        let ends = [
+            seg.curve.point(a),
+            seg.curve.point(0.5 * (a + b)),
+            seg.curve.point(b),
+        ];
+        for axis in Axis::ALL {
+            let i = axis.index();
+            let driven = map.iter().any(|m| match *m {
+                JointMap::Tip(j) => j == i,
+                JointMap::Rotary(k) => k + 3 == i,
+            });
+            let moves = if axis.is_linear() {
+                ends.iter().any(|p| (p[i] - ends[0][i]).abs() > STILL)
+            } else {
+                (seg.rotary[1][i - 3] - seg.rotary[0][i - 3]).abs() > STILL
+            };
+            if moves && !driven {
+                return Err(PlanError::NoJoint {
+                    line: seg.line,
+                    axis: axis.letter(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Joints for the tip (mm) and A B C (degrees) under `control`, nearest `previous`;

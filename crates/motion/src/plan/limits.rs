@@ -141,6 +141,7 @@ fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
 /// Samples the tip path (tangent, curvature vector and its derivative by differences of the
 /// curvature vector between samples) and maps it onto the joints.
 pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
+    machine.check_axes(seg)?;
     let n = machine.joint_count().min(MAX_JOINTS);
     let rotary_only = seg.rotary_only();
     let length = if rotary_only {
