@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
-use tezgah_kinematics::{builtin_names, Machine};
+use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
 use tezgah_motion::interpolate::{run as run_items, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
@@ -115,6 +115,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         subroutines: extra.subroutines,
         ini: extra.ini,
         parameters: extra.parameters,
+        tool_centre_point_always: machine.tcp == TcpSwitch::Always,
         ..Config::default()
     };
     let moves = match tezgah_gcode::program_moves(&text, config) {
@@ -134,6 +135,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
     let start = Pose::ZERO;
+    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
@@ -142,6 +144,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
             tolerance,
             start,
             blend_max_angle: RUN_BLEND_MAX_ANGLE_DEG.to_radians(),
+            control: pm.initial,
             ..SmoothOptions::default()
         },
     )
@@ -150,7 +153,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
         .count();
-    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     let options = PlanOptions {
         period,
         // The chord error gets what compression and blending leave of the tolerance.
@@ -212,7 +214,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let start_tip = Vec3::from(start.xyz());
     let duration = run_items(
         items,
-        &machine.kinematics,
         pm,
         options,
         (start_tip, [start.0[3], start.0[4], start.0[5]]),
@@ -254,6 +255,14 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     })
 }
 
+/// The machine file's `kinematics.tcp`, as written there.
+fn tcp_name(machine: &Machine) -> &'static str {
+    match machine.tcp {
+        TcpSwitch::Program => "program",
+        TcpSwitch::Always => "always",
+    }
+}
+
 fn report_json(
     machine: &Machine,
     r: &Report,
@@ -286,6 +295,7 @@ fn report_json(
     serde_json::json!({
         "program": program,
         "machine": machine.name,
+        "tcp": tcp_name(machine),
         "period_s": period,
         "tolerance_mm": tolerance,
         "cycle_time_s": r.cycle_time,
@@ -308,9 +318,10 @@ fn summary(
     tolerance: f64,
 ) {
     println!(
-        "{program} on {} ({}), period {} ms, tolerance {} mm",
+        "{program} on {} ({}, TCP {}), period {} ms, tolerance {} mm",
         machine.name,
         machine.kinematics.type_name(),
+        tcp_name(machine),
         period * 1e3,
         tolerance
     );

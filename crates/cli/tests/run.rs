@@ -97,11 +97,20 @@ fn errors_are_reported_not_panics() {
 }
 
 #[test]
-fn five_axis_example_on_table_ac_holds_limits() {
+fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
     let json = tmp("r5.json");
     let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/five-axis.ngc");
+    let tools = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
     let out = tezgah()
-        .args(["run", program, "--machine", "table-ac", "--report"])
+        .args([
+            "run",
+            program,
+            "--machine",
+            "table-ac",
+            "--tool-table",
+            tools,
+        ])
+        .arg("--report")
         .arg(&json)
         .output()
         .unwrap();
@@ -119,5 +128,31 @@ fn five_axis_example_on_table_ac_holds_limits() {
     assert!(
         joints[4]["peak_velocity"].as_f64().unwrap() > 1.0,
         "C turns"
+    );
+    assert_eq!(report["tcp"], "program");
+    for j in joints {
+        for (peak, limit) in [
+            ("peak_velocity", "max_velocity"),
+            ("peak_acceleration", "max_acceleration"),
+            ("peak_jerk", "max_jerk"),
+        ] {
+            let (p, l) = (j[peak].as_f64().unwrap(), j[limit].as_f64().unwrap());
+            assert!(
+                p > 0.0 && p <= 1.005 * l,
+                "{}: {peak} {p} > {limit} {l}",
+                j["name"]
+            );
+        }
+    }
+    // G43.4 H1 needs tool 1 in a tool table: without one the run stops at line 5.
+    let out = tezgah()
+        .args(["run", program, "--machine", "table-ac"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("Requested tool 1") && err.contains("five-axis.ngc:5:7"),
+        "{err}"
     );
 }

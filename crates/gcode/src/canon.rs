@@ -61,6 +61,9 @@ pub enum Canon {
     /// Fanuc's `G05.1 Q1`/`Q0` (tezgah's own call; LinuxCNC has none): compression of short
     /// moves into splines on or off.
     SetSmoothing(bool),
+    /// Fanuc's `G43.4 H<n>` / `G49` (tezgah's own call; LinuxCNC 2.9 has no G43.4):
+    /// tool-centre-point control on with the tool length (program units), or off (`None`).
+    SetToolCentrePoint(Option<f64>),
     /// G93 = 1, G94 = 0, G95 = 2 (LinuxCNC's `SET_FEED_MODE(spindle, mode)`).
     SetFeedMode(i32),
     SetFeedRate(f64),
@@ -154,6 +157,8 @@ impl fmt::Display for Canon {
             SetFeedReference => f.write_str("SET_FEED_REFERENCE(CANON_XYZ)"),
             OnReset => f.write_str("ON_RESET()"),
             SetSmoothing(on) => write!(f, "SET_SMOOTHING({})", if *on { "ON" } else { "OFF" }),
+            SetToolCentrePoint(Some(length)) => write!(f, "SET_TOOL_CENTRE_POINT(ON, {length:.4})"),
+            SetToolCentrePoint(None) => f.write_str("SET_TOOL_CENTRE_POINT(OFF)"),
             SelectPlane(p) => write!(
                 f,
                 "SELECT_PLANE({})",

@@ -75,7 +75,7 @@ pub fn g_group(g10: u32) -> Option<usize> {
         930 | 940 | 950 => FEED_MODE,
         200 | 210 => UNITS,
         400 | 410 | 411 | 420 | 421 => CUTTER_COMP,
-        430 | 431 | 432 | 490 => TOOL_LENGTH,
+        430 | 431 | 432 | 434 | 490 => TOOL_LENGTH,
         980 | 990 => RETRACT,
         540 | 550 | 560 | 570 | 580 | 590 | 591 | 592 | 593 => COORD_SYSTEM,
         610 | 611 | 640 => PATH_CONTROL,
@@ -118,6 +118,8 @@ mod tests {
     #[test]
     fn groups() {
         assert_eq!(g_group(431), Some(ggroup::TOOL_LENGTH));
+        assert_eq!(g_group(434), Some(ggroup::TOOL_LENGTH));
+        assert_eq!(g_name(434), "G43.4");
         assert_eq!(g_group(592), Some(ggroup::COORD_SYSTEM));
         assert_eq!(g_group(12), None);
         assert_eq!(g_group(815), None);

@@ -325,6 +325,8 @@ pub enum ErrorKind {
     CutterComp(#[from] crate::interp::CompError),
     #[error("Requested tool {0} not found in the tool table")]
     ToolNotFound(i64),
+    #[error("H word missing with G43.4")]
+    CentrePointMissingH,
 
     // --- motion ---
     #[error("Cannot do g1 with zero feed rate")]

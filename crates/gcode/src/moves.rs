@@ -4,8 +4,14 @@
 //! moves are absolute, in mm and degrees, with work offsets, G92/G52, XY rotation and tool
 //! length applied (`machine = g5x + R(p + g92) + tool`). Inverse-time feeds already arrive as
 //! a rate per move, so the planner sees one feed unit: mm/min (or mm/rev under G95).
+//!
+//! Under tool-centre-point control (G43.4, or always on a machine that says so) the tool
+//! length is not added along Z: moves carry the tool tip, and the length travels in a
+//! [`MoveKind::ToolControl`] move, for the kinematics to apply along the tool axis.
 
-use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, StopKind};
+use tezgah_geom::{
+    ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, StopKind, ToolControl,
+};
 
 use crate::canon::{Canon, CanonSink, ControlMode, Origin, Units};
 use crate::interp::state_rotate_xy as rotate_xy;
@@ -20,6 +26,15 @@ pub struct MoveBuilder<F: FnMut(Move)> {
     g92: Pose,
     rotation: f64,
     tool: Pose,
+    /// Tool length under TCP (mm), `None` with TCP off.
+    centre_point: Option<f64>,
+    /// TCP whatever the program says (machine file `tcp = "always"`); G43/G49 then only set
+    /// the length. Announced before the first move.
+    centre_point_always: bool,
+    announced: bool,
+    /// The current point without the tool offset (`g5x + R(p + g92)`, mm): where the next
+    /// move starts, in the coordinates of TCP; the tool is added to it with TCP off.
+    tipless: Pose,
 }
 
 impl<F: FnMut(Move)> MoveBuilder<F> {
@@ -32,13 +47,47 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
             g92: Pose::ZERO,
             rotation: 0.0,
             tool: Pose::ZERO,
+            centre_point: None,
+            centre_point_always: false,
+            announced: false,
+            tipless: Pose::ZERO,
         }
     }
 
-    /// Machine position in mm of program point `p` (program units).
-    fn machine(&self, p: Pose) -> Pose {
-        (self.g5x + rotate_xy(p + self.g92, self.rotation) + self.tool)
-            .scale_linear(self.units.mm())
+    /// Tool-centre-point control from the start and whatever the program says (the machine
+    /// file's `tcp = "always"`): G43 H then sets the TCP tool length, G49 zeroes it.
+    pub fn centre_point_always(mut self) -> Self {
+        self.centre_point_always = true;
+        self.centre_point = Some(0.0);
+        self
+    }
+
+    /// Machine position in mm of program point `p` (program units); remembers it as the
+    /// current point.
+    fn machine(&mut self, p: Pose) -> Pose {
+        let tipless =
+            (self.g5x + rotate_xy(p + self.g92, self.rotation)).scale_linear(self.units.mm());
+        self.tipless = tipless;
+        self.with_tool(tipless)
+    }
+
+    /// A tip-less point as the moves carry it: with the tool offset added when TCP is off.
+    fn with_tool(&self, tipless: Pose) -> Pose {
+        match self.centre_point {
+            Some(_) => tipless,
+            None => tipless + self.tool.scale_linear(self.units.mm()),
+        }
+    }
+
+    /// Tells the path stage how the coordinates read from here on.
+    fn announce(&mut self, line: u32) {
+        self.announced = true;
+        let control = match self.centre_point {
+            Some(tool_length) => ToolControl::CentrePoint { tool_length },
+            None => ToolControl::Joints,
+        };
+        let at = self.with_tool(self.tipless);
+        self.push(line, MoveKind::ToolControl { control, at });
     }
 
     fn push(&mut self, line: u32, kind: MoveKind) {
@@ -49,12 +98,29 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
 impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
     fn call(&mut self, origin: Origin, call: Canon) {
         let line = origin.line;
+        if self.centre_point_always && !self.announced {
+            // Set-up calls come before line 1; the switch is the program's from its start.
+            self.announce(line.max(1));
+        }
         match call {
             Canon::UseLengthUnits(u) => self.units = u,
             Canon::SetG5xOffset { offset, .. } => self.g5x = offset,
             Canon::SetG92Offset(p) => self.g92 = p,
             Canon::SetXyRotation(r) => self.rotation = r,
-            Canon::UseToolLengthOffset(p) => self.tool = p,
+            Canon::UseToolLengthOffset(p) => {
+                // The tip stays put: the interpreter shifts the program point by the change
+                // of offset, so the tip-less point shifts by it too.
+                self.tipless = self.tipless - (p - self.tool).scale_linear(self.units.mm());
+                self.tool = p;
+                if self.centre_point_always {
+                    self.centre_point = Some(p.z() * self.units.mm());
+                    self.announce(line);
+                }
+            }
+            Canon::SetToolCentrePoint(length) if !self.centre_point_always => {
+                self.centre_point = length.map(|l| l * self.units.mm());
+                self.announce(line);
+            }
             Canon::SelectPlane(p) => self.plane = p.unwrap_or(self.plane),
             Canon::StraightTraverse(p) => {
                 let end = self.machine(p);
@@ -81,7 +147,9 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 let mut center = end;
                 center.0[i] = first_axis;
                 center.0[j] = second_axis;
-                let (end, center) = (self.machine(end), self.machine(center));
+                // The end last: it is the current point afterwards.
+                let center = self.machine(center);
+                let end = self.machine(end);
                 self.push(
                     line,
                     MoveKind::Arc(ArcMove {
@@ -128,7 +196,11 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
 /// Interpret a whole program into moves (stops at the first error).
 pub fn program_moves(program: &str, cfg: crate::Config) -> Result<Vec<Move>, crate::GcodeError> {
     let mut moves = Vec::new();
+    let always = cfg.tool_centre_point_always;
     let mut builder = MoveBuilder::new(|m| moves.push(m));
+    if always {
+        builder = builder.centre_point_always();
+    }
     crate::Interpreter::new(cfg).run(program, &mut builder)?;
     Ok(moves)
 }

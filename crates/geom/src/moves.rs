@@ -61,8 +61,27 @@ pub enum MoveKind {
     PathMode(PathMode),
     /// Fanuc's `G05.1 Q1` (true) / `Q0`: runs of short moves may be compressed into splines.
     Smoothing(bool),
+    /// Tool-centre-point control switched (G43.4 on, G49 off) or, under it, a new tool length.
+    /// `at` is the current point in the coordinates of the new control (nothing moves here: the
+    /// next move starts from `at`; a machine whose joints differ between the two readings of
+    /// the point takes them up before that move).
+    ToolControl { control: ToolControl, at: Pose },
     /// M0/M1/M60 pauses and M2/M30 program end.
     Stop(StopKind),
+}
+
+/// How the program axes reach the joints.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum ToolControl {
+    /// TCP off (G49, or no G43.4): program axes are joints. On machines whose rotary joints
+    /// orient the tool, X Y Z A B C drive the joints of those names and moves are straight in
+    /// joint space; Cartesian and delta machines keep X Y Z as the gauge point (tool length,
+    /// if any, already added along Z by G43).
+    #[default]
+    Joints,
+    /// TCP on (G43.4): X Y Z are the tool tip in the workpiece frame and A B C orient the tool;
+    /// the joints follow, with the tip `tool_length` mm from the gauge point along the tool axis.
+    CentrePoint { tool_length: f64 },
 }
 
 /// Feed-rate interpretation.

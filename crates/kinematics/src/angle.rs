@@ -120,6 +120,91 @@ pub fn atan2(y: f64, x: f64) -> f64 {
     }
 }
 
+/// Two atan2 at once, `[atan2(y[0], x[0]), atan2(y[1], x[1])]`: the tilt and the C angle that
+/// every 5-axis inverse needs. The same Cephes rational as [`atan2`], written without
+/// branches (each lane picks its reduction by selects) so that the two lanes run side by side
+/// in one vector register: one division for the reduction and one for the rational serve both
+/// angles. Arguments must be finite and not both zero in a lane (the models' unit tool axes
+/// off the pole); a lane outside that falls back to the library.
+#[inline(always)]
+pub fn atan2_pair(y: [f64; 2], x: [f64; 2]) -> [f64; 2] {
+    const P: [f64; 5] = [
+        -8.750_608_600_031_904e-1,
+        -1.615_753_718_733_365e1,
+        -7.500_855_792_314_705e1,
+        -1.228_866_684_490_136_2e2,
+        -6.485_021_904_942_025e1,
+    ];
+    const Q: [f64; 5] = [
+        2.485_846_490_142_306_3e1,
+        1.650_270_098_316_988_6e2,
+        4.328_810_604_912_903e2,
+        4.853_903_996_359_137e2,
+        1.945_506_571_482_614e2,
+    ];
+    const T3P8: f64 = 2.414_213_562_373_095;
+    const MOREBITS: f64 = 6.123_233_995_736_766e-17;
+    let ordinary = |i: usize| y[i].is_finite() && x[i].is_finite() && (y[i] != 0.0 || x[i] != 0.0);
+    if !(ordinary(0) && ordinary(1)) {
+        return [y[0].atan2(x[0]), y[1].atan2(x[1])];
+    }
+    let ay = [y[0].abs(), y[1].abs()];
+    let ax = [x[0].abs(), x[1].abs()];
+    let mut num = [0.0; 2];
+    let mut den = [0.0; 2];
+    let mut base = [0.0; 2];
+    let mut extra = [0.0; 2];
+    for i in 0..2 {
+        let steep = ay[i] > T3P8 * ax[i];
+        let flat = ay[i] <= 0.66 * ax[i];
+        num[i] = if steep {
+            -ax[i]
+        } else if flat {
+            ay[i]
+        } else {
+            ay[i] - ax[i]
+        };
+        den[i] = if steep {
+            ay[i]
+        } else if flat {
+            ax[i]
+        } else {
+            ay[i] + ax[i]
+        };
+        base[i] = if steep {
+            std::f64::consts::FRAC_PI_2
+        } else if flat {
+            0.0
+        } else {
+            std::f64::consts::FRAC_PI_4
+        };
+        extra[i] = if steep {
+            MOREBITS
+        } else if flat {
+            0.0
+        } else {
+            0.5 * MOREBITS
+        };
+    }
+    let t = [num[0] / den[0], num[1] / den[1]];
+    let z = [t[0] * t[0], t[1] * t[1]];
+    let mut out = [0.0; 2];
+    let mut pz = [0.0; 2];
+    let mut qz = [0.0; 2];
+    for i in 0..2 {
+        pz[i] = (((P[0] * z[i] + P[1]) * z[i] + P[2]) * z[i] + P[3]) * z[i] + P[4];
+        qz[i] = ((((z[i] + Q[0]) * z[i] + Q[1]) * z[i] + Q[2]) * z[i] + Q[3]) * z[i] + Q[4];
+    }
+    let ratio = [pz[0] / qz[0], pz[1] / qz[1]];
+    for i in 0..2 {
+        let r = base[i] + (t[i] * (z[i] * ratio[i]) + t[i] + extra[i]);
+        // x = −0 lands in the steep branch, where atan2 is ±π/2 either way.
+        let r = if x[i] < 0.0 { PI - r } else { r };
+        out[i] = if y[i].is_sign_negative() { -r } else { r };
+    }
+    out
+}
+
 /// Degrees to radians.
 #[inline]
 pub fn deg(a: f64) -> f64 {
@@ -182,6 +267,47 @@ mod tests {
             assert!(a == b || (a.is_nan() && b.is_nan()), "{y} {x}: {a} vs {b}");
         }
         assert_eq!(atan2(1.0, -1.0), 0.75 * PI);
+    }
+
+    /// The pair against the library, lane by lane, including axis-aligned arguments.
+    #[test]
+    fn atan2_pair_matches_libm() {
+        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut worst: f64 = 0.0;
+        for i in 0..200_000 {
+            let scale = 10f64.powi((i % 21) - 10);
+            let y = [next() * scale, next()];
+            let x = [next(), next() * scale];
+            let got = atan2_pair(y, x);
+            for k in 0..2 {
+                worst = worst.max((got[k] - y[k].atan2(x[k])).abs());
+            }
+        }
+        assert!(worst < 1e-15, "worst {worst:e}");
+        for (y, x) in [
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (1.0, -0.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (0.0, 1.0),
+            (0.0, 0.0),
+            (f64::NAN, 1.0),
+        ] {
+            let got = atan2_pair([y, 0.5], [x, -0.5]);
+            let want = f64::atan2(y, x);
+            assert!(
+                got[0] == want || (got[0].is_nan() && want.is_nan()),
+                "{y} {x}"
+            );
+            assert_eq!(got[1], f64::atan2(0.5, -0.5));
+        }
     }
 
     #[test]

@@ -35,5 +35,5 @@ pub mod yzca;
 
 pub use error::{AtLine, KinematicsError};
 pub use kinematics::{Jacobian, Kinematics, Tolerances};
-pub use machine::{builtin_names, Machine, MachineError, Model};
+pub use machine::{builtin_names, Machine, MachineError, Model, TcpSwitch};
 pub use pose::{JointKind, JointLimit, Joints, Tool, ToolPose};

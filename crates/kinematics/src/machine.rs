@@ -64,15 +64,17 @@ fn invalid(field: impl Into<String>, reason: impl Into<String>) -> MachineError 
     }
 }
 
-/// The built-in machine files, embedded at compile time; the first is the default.
+/// The built-in machine files, embedded at compile time; the first is the default. They live
+/// in the crate (`crates/kinematics/machines/`, which the workspace's `machines/` links to) so
+/// that the packaged crate holds them too: one copy, built from a clean checkout or crates.io.
 const BUILTIN: &[(&str, &str)] = &[
-    ("mill3", include_str!("../../../machines/mill3.toml")),
-    ("yzca", include_str!("../../../machines/yzca.toml")),
-    ("table-ac", include_str!("../../../machines/table-ac.toml")),
-    ("table-bc", include_str!("../../../machines/table-bc.toml")),
+    ("mill3", include_str!("../machines/mill3.toml")),
+    ("yzca", include_str!("../machines/yzca.toml")),
+    ("table-ac", include_str!("../machines/table-ac.toml")),
+    ("table-bc", include_str!("../machines/table-bc.toml")),
     (
         "linear-delta",
-        include_str!("../../../machines/linear-delta.toml"),
+        include_str!("../machines/linear-delta.toml"),
     ),
 ];
 
@@ -100,6 +102,7 @@ struct RawMachine {
 struct RawKinematics {
     #[serde(rename = "type")]
     kind: String,
+    tcp: Option<String>,
     axis_tolerance_deg: Option<f64>,
     pole_cone_deg: Option<f64>,
     centre_tolerance_mm: Option<f64>,
@@ -187,6 +190,18 @@ impl Joint {
     }
 }
 
+/// When tool-centre-point control is on (`[kinematics] tcp`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TcpSwitch {
+    /// `"program"` (the default): as the program says, on from `G43.4 H<n>` until `G49` (or
+    /// another tool-length code); off, program axes are joints.
+    #[default]
+    Program,
+    /// `"always"`: program coordinates are always the tool tip and orientation; G43 H gives
+    /// the tool length along the tool axis, G49 zeroes it.
+    Always,
+}
+
 /// A validated machine: name, kinematic model, motion settings, joints.
 #[derive(Clone, Debug)]
 pub struct Machine {
@@ -198,6 +213,8 @@ pub struct Machine {
     pub motion: Motion,
     /// `[[joint]]`, in file order (the order of joint values everywhere).
     pub joints: Vec<Joint>,
+    /// `[kinematics] tcp`: when tool-centre-point control is on.
+    pub tcp: TcpSwitch,
 }
 
 impl Machine {
@@ -354,11 +371,22 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
         }
     }
     let kinematics = build_model(&raw.kinematics, &joints)?;
+    let tcp = match raw.kinematics.tcp.as_deref() {
+        None | Some("program") => TcpSwitch::Program,
+        Some("always") => TcpSwitch::Always,
+        Some(other) => {
+            return Err(invalid(
+                "kinematics.tcp",
+                format!("`{other}` is not `program` or `always`"),
+            ))
+        }
+    };
     Ok(Machine {
         name: raw.name,
         kinematics,
         motion,
         joints,
+        tcp,
     })
 }
 

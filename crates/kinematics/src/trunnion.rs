@@ -4,7 +4,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use crate::angle::{atan2, unwrap_within};
+use crate::angle::{atan2_pair, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
@@ -188,14 +188,30 @@ impl Kinematics for Trunnion {
             return self.inverse_at_pole(pose, tool, previous);
         }
         // Branch 1 (tilt ≥ 0) from the axis (table_ac/table_bc `solutions`), with its sines
-        // and cosines read off the unit axis; branch 2 is (−tilt, C + π).
-        let t1 = atan2(h, k.z);
+        // and cosines read off the unit axis; branch 2 is (−tilt, C + π). The two angles are
+        // independent: one two-lane atan2 gives both.
         let inv_h = 1.0 / h;
-        let (c1, sc, cc) = match self.tilt {
-            TiltAxis::X => (atan2(k.x, k.y), k.x * inv_h, k.y * inv_h),
-            TiltAxis::Y => (atan2(k.y, -k.x), k.y * inv_h, -k.x * inv_h),
+        let (cy, cx) = match self.tilt {
+            TiltAxis::X => (k.x, k.y),
+            TiltAxis::Y => (k.y, -k.x),
         };
+        let [t1, c1] = atan2_pair([h, cy], [k.z, cx]);
+        let (sc, cc) = (cy * inv_h, cx * inv_h);
         let b1 = self.turns(t1, c1, previous);
+        // The usual case along a path, decided without branch 2: the previous tilt is ≥ 0,
+        // branch 1 needs no turn of the tilt and at most a quarter turn of C. Branch 2 then
+        // costs at least |t1 + pt| + π − d ≥ |t1 − pt| + d (its C is half a turn away, so
+        // at least π − d from the previous C), so branch 1 is the nearest.
+        if let Some((t, c)) = b1 {
+            let d = (c - previous[C]).abs();
+            if previous[TILT] >= 0.0 && t == t1 && d <= std::f64::consts::FRAC_PI_2 {
+                let m = self.linear_sc(&pose.tip, h, k.z, sc, cc, tool);
+                let q = Joints::new([m.x, m.y, m.z, t, c]);
+                if check_limits(&q, &self.limits).is_ok() {
+                    return Ok(q);
+                }
+            }
+        }
         let b2 = self.turns(-t1, c1 + std::f64::consts::PI, previous);
         let cost = |b: &Option<(f64, f64)>| {
             b.map_or(f64::INFINITY, |(t, c)| {

@@ -14,7 +14,7 @@
 
 use nalgebra::Vector3;
 
-use crate::angle::{atan2, unwrap_near, unwrap_within};
+use crate::angle::{atan2, atan2_pair, unwrap_near, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{
     check_input, check_pose, check_tip, choose_nearest, Jacobian, Kinematics, Tolerances,
@@ -177,27 +177,43 @@ impl Kinematics for Yzca {
         let l = self.lever(tool);
         // The radial plane (cos C, −sin C): from the tip, else from the axis, else keep C.
         let rho = (p.x * p.x + p.y * p.y).sqrt();
-        let (c1, sc, cc) = if rho > self.tolerances.centre_mm {
-            let inv = 1.0 / rho;
-            (atan2(-p.y, p.x), -p.y * inv, p.x * inv)
-        } else {
-            self.radial_on_axis(&k, previous[C])
-        };
         // Axis components along the radial and tangential (sin C, cos C) directions: a
-        // 4-axis machine tilts only in the radial plane.
-        let u = k.x * cc - k.y * sc;
-        let t = k.x * sc + k.y * cc;
+        // 4-axis machine tilts only in the radial plane. Off the C axis, C and A are
+        // independent angles: one two-lane atan2 gives both.
+        let radial = |sc: f64, cc: f64| (k.x * cc - k.y * sc, k.x * sc + k.y * cc);
+        let (c1, a1, sc, cc, u, t) = if rho > self.tolerances.centre_mm {
+            let inv = 1.0 / rho;
+            let (sc, cc) = (-p.y * inv, p.x * inv);
+            let (u, t) = radial(sc, cc);
+            let [c1, a1] = atan2_pair([-p.y, -u], [p.x, k.z]);
+            (c1, a1, sc, cc, u, t)
+        } else {
+            let (c1, sc, cc) = self.radial_on_axis(&k, previous[C]);
+            let (u, t) = radial(sc, cc);
+            (c1, atan2(-u, k.z), sc, cc, u, t)
+        };
         if t.abs() > self.axis_sin {
             return Err(out_of_plane(t));
         }
         let r = p.x * cc - p.y * sc;
-        let a1 = atan2(-u, k.z);
         let inv_n = 1.0 / (u * u + k.z * k.z).sqrt();
         let y1 = r + l * u * inv_n; // r − l·sin A with sin A = −u/n
         let z1 = p.z + l * k.z * inv_n;
         // Branch 2 turns the table half a turn and tilts the other way: (−y, z, C + π, −A).
         let (lc, la) = (&self.limits[C], &self.limits[A]);
         let b1 = turns(c1, a1, previous, lc, la);
+        // The usual case along a path, decided without branch 2 (as in the trunnions): A
+        // keeps its sign and needs no turn, C moves at most a quarter turn. Branch 2 costs at
+        // least |a1 + pa| + π − d ≥ |a1 − pa| + d, so branch 1 is the nearest.
+        if let Some((c, a)) = b1 {
+            let d = (c - previous[C]).abs();
+            if a1 * previous[A] >= 0.0 && a == a1 && d <= std::f64::consts::FRAC_PI_2 {
+                let q = Joints::new([y1, z1, c, a]);
+                if check_limits(&q, &self.limits).is_ok() {
+                    return Ok(q);
+                }
+            }
+        }
         let b2 = turns(c1 + std::f64::consts::PI, -a1, previous, lc, la);
         let cost = |b: &Option<(f64, f64)>| {
             b.map_or(f64::INFINITY, |(c, a)| {

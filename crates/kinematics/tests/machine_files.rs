@@ -42,6 +42,24 @@ fn builtins_parse() {
 }
 
 #[test]
+fn tcp_is_switched_by_the_program_unless_the_file_says_always() {
+    use tezgah_kinematics::TcpSwitch;
+    for name in builtin_names() {
+        assert_eq!(
+            Machine::builtin(name).unwrap().tcp,
+            TcpSwitch::Program,
+            "{name}"
+        );
+    }
+    let ac = Machine::builtin_text("table-ac").unwrap();
+    let always = edit(ac, "[kinematics]", "tcp", "tcp = \"always\"");
+    assert_eq!(
+        Machine::from_toml_str(&always).unwrap().tcp,
+        TcpSwitch::Always
+    );
+}
+
+#[test]
 fn machine_files_on_disk_match_builtins() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines");
     for name in builtin_names() {
@@ -258,6 +276,11 @@ fn bad_fields_are_named() {
             edit(ac, "[kinematics]", "pivot", "# no pivot"),
             "kinematics.pivot",
             "missing",
+        ),
+        (
+            edit(ac, "[kinematics]", "tcp", "tcp = \"sometimes\""),
+            "kinematics.tcp",
+            "`sometimes` is not `program` or `always`",
         ),
         (
             edit(ac, "[kinematics]", "pivot", "pivot_to_gauge = 1.0"),

@@ -286,3 +286,83 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, .. ProptestConfig::default() })]
+
+    /// The trunnion inverse returns the solution nearest the previous joints (|Δtilt| + |ΔC|)
+    /// among the two branches (tilt, C) and (−tilt, C + π), whichever path it takes inside
+    /// (the quick one when branch 1 is plainly nearer, the full comparison otherwise).
+    #[test]
+    fn trunnion_inverse_takes_the_nearest_branch(
+        bc in any::<bool>(),
+        prev_tilt in -30.0f64..120.0, prev_c in -720.0f64..720.0,
+        tilt in -29.0f64..119.0, c in -720.0f64..720.0,
+        x in -50.0f64..50.0, y in -50.0f64..50.0, z in -20.0f64..20.0,
+    ) {
+        let name = if bc { "table-bc" } else { "table-ac" };
+        let m = machine(name);
+        let tool = Tool::with_length(25.0);
+        let target = file_q(&m, &[x, y, z, tilt, c]);
+        let pose = m.kinematics.forward(&target, &tool).unwrap();
+        prop_assume!(pose.axis.z < 1.0 - 1e-9); // off the pole
+        let previous = file_q(&m, &[0.0, 0.0, 0.0, prev_tilt, prev_c]);
+        let Ok(q) = m.kinematics.inverse(&pose, &tool, &previous) else {
+            return Ok(());
+        };
+        assert_pose_eq(&m.kinematics.forward(&q, &tool).unwrap(), &pose, 1e-9)?;
+        let cost = |t: f64, c: f64| (t - previous[3]).abs() + (c - previous[4]).abs();
+        // The other branch, at C's nearest turn (C is endless), if its tilt is in limits.
+        let (t2, c2) = (-q[3], q[4] + std::f64::consts::PI);
+        let c2 = previous[4] + (c2 - previous[4] + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let lt = &m.kinematics.joint_limits()[3];
+        if t2 >= lt.min && t2 <= lt.max {
+            let other = file_q(&m, &[0.0, 0.0, 0.0, t2.to_degrees(), c2.to_degrees()]);
+            let alt = Joints::from_slice(&[0.0, 0.0, 0.0, other[3], other[4]]).unwrap();
+            // Only a candidate if its linear joints are in limits too.
+            let in_limits = m.kinematics.inverse(&pose, &tool, &alt).is_ok_and(|a| {
+                (a[3] - t2).abs() < 1e-12 && (a[4] - c2).abs() < 1e-9
+            });
+            if in_limits {
+                prop_assert!(
+                    cost(q[3], q[4]) <= cost(t2, c2) + 1e-12,
+                    "{name}: chose ({}, {}), cost {} > ({t2}, {c2}) cost {}",
+                    q[3], q[4], cost(q[3], q[4]), cost(t2, c2)
+                );
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2000, .. ProptestConfig::default() })]
+
+    /// The same for Y-Z-C-A: (C, A) nearest the previous ones among (C, A) and (C + π, −A).
+    #[test]
+    fn yzca_inverse_takes_the_nearest_branch(
+        prev_a in -110.0f64..110.0, prev_c in -720.0f64..720.0,
+        y in 5.0f64..150.0, z in -100.0f64..100.0, c in -720.0f64..720.0, a in -110.0f64..110.0,
+    ) {
+        let m = machine("yzca");
+        let tool = Tool::with_length(25.0);
+        let pose = m.kinematics.forward(&file_q(&m, &[y, z, c, a]), &tool).unwrap();
+        let previous = file_q(&m, &[0.0, 0.0, prev_c, prev_a]);
+        let Ok(q) = m.kinematics.inverse(&pose, &tool, &previous) else {
+            return Ok(());
+        };
+        assert_pose_eq(&m.kinematics.forward(&q, &tool).unwrap(), &pose, 1e-9)?;
+        let cost = |c: f64, a: f64| (c - previous[2]).abs() + (a - previous[3]).abs();
+        let (c2, a2) = (q[2] + std::f64::consts::PI, -q[3]);
+        let c2 = previous[2] + (c2 - previous[2] + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        let alt = Joints::from_slice(&[-q[0], q[1], c2, a2]).unwrap();
+        if m.kinematics.check_joints(&alt).is_ok() {
+            prop_assert!(
+                cost(q[2], q[3]) <= cost(c2, a2) + 1e-12,
+                "chose ({}, {}) cost {} > ({c2}, {a2}) cost {}",
+                q[2], q[3], cost(q[2], q[3]), cost(c2, a2)
+            );
+        }
+    }
+}

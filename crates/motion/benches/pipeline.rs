@@ -68,7 +68,6 @@ fn pipeline(text: &str, machine: &Machine) -> (f64, u64) {
     let mut acc = 0.0;
     let d = run(
         items,
-        &machine.kinematics,
         pm,
         PlanOptions::default(),
         (Vec3::zeros(), [0.0; 3]),

@@ -9,10 +9,11 @@
 use std::sync::Arc;
 
 use tezgah_geom::{ArcLengthMap, Curve, Vec3};
-use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Model, Tool, ToolPose};
+use tezgah_kinematics::{Joints, KinematicsError};
 
 use crate::path::Segment;
-use crate::plan::{JointMap, PlanMachine, Planned};
+use crate::plan::{PlanMachine, Planned};
+use crate::takeup::TakeUp;
 
 /// Why interpolation failed.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -94,12 +95,9 @@ impl Param {
 }
 
 /// The interpolator: feed it planned items, it calls the sink for every sample.
-pub struct Interpolator<'m> {
-    model: &'m Model,
-    map: Vec<JointMap>,
-    /// Program axes of the TCP angles, for non-Cartesian models.
-    tcp: Option<Vec<tezgah_geom::Axis>>,
-    tool: Tool,
+pub struct Interpolator {
+    /// The machine: joints from the program point under each segment's tool control.
+    machine: PlanMachine,
     period: f64,
     /// Next sample index.
     k: u64,
@@ -109,14 +107,11 @@ pub struct Interpolator<'m> {
     joints: Joints,
 }
 
-impl<'m> Interpolator<'m> {
-    /// `start` are the joints before the program (internal units).
-    pub fn new(model: &'m Model, machine: &PlanMachine, period: f64, start: Joints) -> Self {
+impl Interpolator {
+    /// `start` are the joints before the program (internal units), a guess for continuity.
+    pub fn new(machine: &PlanMachine, period: f64, start: Joints) -> Self {
         Interpolator {
-            model,
-            map: machine.map.clone(),
-            tcp: machine.numeric.as_ref().map(|_| machine.axes.clone()),
-            tool: Tool::default(),
+            machine: machine.clone(),
             period,
             k: 0,
             t0: 0.0,
@@ -160,21 +155,10 @@ impl<'m> Interpolator<'m> {
             line: seg.line,
             source,
         };
-        if let Some(axes) = &self.tcp {
-            let q = crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
-                .map_err(err)?;
-            self.joints = q;
-            return Ok((tip, rotary, q));
-        }
-        let mut q = self
-            .model
-            .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints)
+        let q = self
+            .machine
+            .joints(seg.control, &tip, &rotary, &self.joints)
             .map_err(err)?;
-        for (j, m) in self.map.iter().enumerate() {
-            if let (JointMap::Rotary(r), true) = (m, j < q.len()) {
-                q[j] = rotary[*r].to_radians();
-            }
-        }
         self.joints = q;
         Ok((tip, rotary, q))
     }
@@ -263,22 +247,18 @@ impl<'m> Interpolator<'m> {
         Ok(())
     }
 
-    /// Emits the start row (before any motion), given the start pose.
+    /// Emits the start row (before any motion), given the start pose under the machine's
+    /// initial tool control.
     pub fn start(
         &mut self,
         tip: Vec3,
         rotary: [f64; 3],
         line: u32,
     ) -> Result<(), InterpolateError> {
-        let q = match &self.tcp {
-            Some(axes) => {
-                crate::plan::joints::tcp_joints(self.model, axes, &tip, &rotary, &self.joints)
-            }
-            None => self
-                .model
-                .inverse(&ToolPose::vertical(tip), &self.tool, &self.joints),
-        }
-        .map_err(|source| InterpolateError::Kinematics { line, source })?;
+        let q = self
+            .machine
+            .joints(self.machine.initial, &tip, &rotary, &self.joints)
+            .map_err(|source| InterpolateError::Kinematics { line, source })?;
         self.joints = q;
         self.last = Some(Sample {
             index: 0,
@@ -310,27 +290,36 @@ pub enum RunError {
     Interpolate(#[from] InterpolateError),
 }
 
-/// Plans and samples a stream of path items from the start pose (tip, A B C), calling `sink`
-/// for every sample; returns the unrounded duration. Memory stays bounded by the planner's
-/// window: items are planned and sampled as they come.
+impl From<crate::takeup::TakeUpError> for RunError {
+    fn from(e: crate::takeup::TakeUpError) -> Self {
+        RunError::Interpolate(InterpolateError::Kinematics {
+            line: e.line,
+            source: e.source,
+        })
+    }
+}
+
+/// Plans and samples a stream of path items from the start pose (tip, A B C, under the
+/// machine's initial tool control), calling `sink` for every sample; returns the unrounded
+/// duration. Where the tool control switches and the joints of the current point differ
+/// between the two readings, a take-up move ([`crate::takeup`]) is run first. Memory stays
+/// bounded by the planner's window: items are planned and sampled as they come.
 pub fn run(
     items: impl IntoIterator<Item = crate::path::PathItem>,
-    model: &Model,
     machine: PlanMachine,
     options: crate::plan::PlanOptions,
     start: (Vec3, [f64; 3]),
     mut sink: impl FnMut(&Sample, Option<&Arc<Segment>>),
 ) -> Result<f64, RunError> {
     let period = options.period;
-    let mut interp = Interpolator::new(
-        model,
-        &machine,
-        period,
-        Joints::zeros(machine.joint_count()),
-    );
-    let mut planner = crate::plan::Planner::new(machine, options)?;
+    let mut interp = Interpolator::new(&machine, period, Joints::zeros(machine.joint_count()));
     interp.start(start.0, start.1, 1)?;
+    let mut takeup = TakeUp::new(&machine, start, interp.joints);
+    let mut planner = crate::plan::Planner::new(machine, options)?;
     for item in items {
+        if let Some(t) = takeup.before(&item)? {
+            planner.push(t)?;
+        }
         planner.push(item)?;
         while let Some(p) = planner.pop() {
             interp.push(&p, &mut sink)?;

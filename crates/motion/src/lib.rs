@@ -1,14 +1,16 @@
 //! tezgah-motion: path building, jerk-limited feed planning and interpolation.
 //!
 //! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. Stages:
-//! [`path`] (moves → segments), [`plan`] (speed limits, look-ahead, one [`profile`] per group of
-//! segments), [`interpolate`] (samples at the period, joints by inverse kinematics) and
+//! [`path`] (moves → segments), [`takeup`] (the joint move at a tool-centre-point switch),
+//! [`plan`] (speed limits, look-ahead, one [`profile`] per group of segments), [`interpolate`]
+//! (samples at the period, joints by the kinematics under each segment's tool control) and
 //! [`verify`] (the post-run replay).
 
 pub mod interpolate;
 pub mod path;
 pub mod plan;
 pub mod profile;
+pub mod takeup;
 pub mod verify;
 
 pub use path::{Junction, PathItem, Segment, SegmentFeed};

@@ -153,8 +153,13 @@ impl Verifier {
         if let Some(seg) = seg {
             let d = distance_to(seg, &s.tip);
             self.deviation(d, s.line);
-            // The chord to the previous sample: its midpoint against the two segments.
-            if let Some((p, pseg)) = &self.last {
+            // The chord to the previous sample: its midpoint against the two segments. Across
+            // a tool-control switch (at rest) the tip is read two ways: no chord there.
+            let same_reading = match &self.last {
+                Some((_, Some(ps))) => ps.control == seg.control,
+                _ => true,
+            };
+            if let (Some((p, pseg)), true) = (&self.last, same_reading) {
                 let mid = 0.5 * (p.tip + s.tip);
                 let mut dm = distance_to(seg, &mid);
                 if let Some(ps) = pseg {

@@ -4,7 +4,7 @@
 //! sum of the per-block optimal profile durations.
 
 use proptest::prelude::*;
-use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, Vec3};
+use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, ToolControl, Vec3};
 use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::{run, Sample};
 use tezgah_motion::path::direct::{build, DirectOptions};
@@ -25,12 +25,25 @@ fn run_moves(moves: &[Move]) -> Out {
 }
 
 fn run_on(machine: &Machine, moves: &[Move]) -> Out {
-    let pm = PlanMachine::from_machine(machine).unwrap();
+    run_under(machine, moves, ToolControl::Joints)
+}
+
+/// Tool-centre-point control from the start (the machine file's `tcp = "always"`), no tool.
+fn run_tcp(machine: &Machine, moves: &[Move]) -> Out {
+    run_under(machine, moves, TCP)
+}
+
+const TCP: ToolControl = ToolControl::CentrePoint { tool_length: 0.0 };
+
+fn run_under(machine: &Machine, moves: &[Move], control: ToolControl) -> Out {
+    let mut pm = PlanMachine::from_machine(machine).unwrap();
+    pm.initial = control;
     let items = build(
         moves,
         Pose::ZERO,
         DirectOptions {
             tolerance: TOL,
+            control,
             ..DirectOptions::default()
         },
     )
@@ -39,7 +52,6 @@ fn run_on(machine: &Machine, moves: &[Move]) -> Out {
     let mut samples = vec![];
     let duration = run(
         items,
-        &machine.kinematics,
         pm,
         PlanOptions::default(),
         (Vec3::zeros(), [0.0; 3]),
@@ -420,7 +432,7 @@ fn five_axis_table_ac_and_yzca() {
         feed6(5, [0.0, 20.0, 0.0, 45.0, 0.0, 200.0]),
         feed6(6, [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
     ];
-    let out = run_on(&ac, &m);
+    let out = run_tcp(&ac, &m);
     assert_within_limits(&out);
     assert_eq!(out.samples.last().unwrap().tip, Vec3::zeros());
     // The rotary joints really moved, and one of them works near its limits.
@@ -435,24 +447,28 @@ fn five_axis_table_ac_and_yzca() {
         feed(4, 0.0, 80.0, -2.0),
         arc(5, [80.0, 0.0, -2.0], [0.0, 0.0], -1),
     ];
-    let out = run_on(&yzca, &m);
+    let out = run_tcp(&yzca, &m);
     assert_within_limits(&out);
 }
 
 #[test]
 fn a_path_through_a_singular_pose_is_refused() {
     let yzca = Machine::builtin("yzca").unwrap();
-    let pm = PlanMachine::from_machine(&yzca).unwrap();
+    let mut pm = PlanMachine::from_machine(&yzca).unwrap();
+    pm.initial = TCP;
     let m = vec![
         f(1, 3000.0),
         feed(2, 0.0, 0.0, -1.0),
         // Leaving the C axis sideways: C, undefined on the axis, must turn 45° at once.
         feed(3, 30.0, 30.0, -1.0),
     ];
-    let items = build(&m, Pose::ZERO, DirectOptions::default()).unwrap();
+    let options = DirectOptions {
+        control: TCP,
+        ..DirectOptions::default()
+    };
+    let items = build(&m, Pose::ZERO, options).unwrap();
     let r = run(
         items,
-        &yzca.kinematics,
         pm,
         PlanOptions::default(),
         (Vec3::zeros(), [0.0; 3]),

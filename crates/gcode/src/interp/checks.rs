@@ -191,7 +191,7 @@ fn check_other_words(
     rule(b'e', false, ErrorKind::EWordUnused)?;
     rule(
         b'h',
-        matches!(block.g(ggroup::TOOL_LENGTH), Some(430 | 432)),
+        matches!(block.g(ggroup::TOOL_LENGTH), Some(430 | 432 | 434)),
         ErrorKind::HWordUnused,
     )?;
     let ij_user = arc || g10 || matches!(motion, Some(50 | 51 | 870));

@@ -294,6 +294,7 @@ impl Interpreter {
             },
             // Axes it does not name keep their offsets.
             431 => block.axes_over(self.state.tool_offset),
+            434 => self.centre_point_offset(block, at)?,
             490 => Pose::ZERO,
             _ => return Err(unsupported(g, at)),
         };
@@ -303,6 +304,7 @@ impl Interpreter {
         self.state.pos = self.state.pos + shift;
         self.state.tool_offset = offset;
         self.emit(sink, Canon::UseToolLengthOffset(offset));
+        self.switch_centre_point(g == 434, sink);
         Ok(())
     }
 

@@ -15,6 +15,7 @@ mod execute;
 mod motion;
 mod state;
 mod system;
+mod tcp;
 mod tools;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
@@ -52,6 +53,9 @@ pub struct Config {
     /// Pocket index of the tool in the spindle when the program starts (0: none). LinuxCNC's
     /// standalone `rs274` starts with 1, so G10 writes to pocket 1 reach its spindle entry.
     pub start_pocket: usize,
+    /// Tool-centre-point control whatever the program says (the machine file's
+    /// `tcp = "always"`); read by [`crate::moves::program_moves`], not by the interpreter.
+    pub tool_centre_point_always: bool,
 }
 
 impl Config {
@@ -65,6 +69,7 @@ impl Config {
             ini: None,
             parameters: None,
             start_pocket: 1,
+            tool_centre_point_always: false,
         }
     }
 }

@@ -33,6 +33,8 @@ pub struct State {
     /// G92/G52 offsets in force.
     pub axis_offset: Pose,
     pub tool_offset: Pose,
+    /// G43.4 in force: tool-centre-point control with `tool_offset`'s Z as the tool length.
+    pub tool_centre_point: bool,
     /// Tool number chosen by the last T word (`None` before any).
     pub selected_tool: Option<i64>,
     /// Pocket index (table row) of the tool in the spindle: G10 writes to it reach the spindle.
@@ -72,6 +74,7 @@ impl Default for State {
             rotation: 0.0,
             axis_offset: Pose::ZERO,
             tool_offset: Pose::ZERO,
+            tool_centre_point: false,
             selected_tool: None,
             current_pocket: 0,
             spindle_slot: Default::default(),

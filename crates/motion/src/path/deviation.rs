@@ -81,6 +81,12 @@ fn programmed(start: Pose, moves: &[Move]) -> (Vec<Boxed<Prog>>, Vec<Vec3>) {
                 Ok(arc) => (Prog::Arc(arc), a.end),
                 Err(_) => continue,
             },
+            // A TCP switch moves nothing; the next move starts from the point read anew.
+            MoveKind::ToolControl { at, .. } => {
+                pos = at;
+                vertices.push(Vec3::from(pos.xyz()));
+                continue;
+            }
             _ => continue,
         };
         let (lo, hi) = match &item {

@@ -4,7 +4,9 @@
 //! angle between the end and start tangents. The smoothing builder (`path::smooth`) replaces
 //! this for G64; tests and `tezgah run` use it as the exact-path reference.
 
-use tezgah_geom::{Arc, Curve, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, Vec3};
+use tezgah_geom::{
+    Arc, Curve, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, ToolControl, Vec3,
+};
 
 use super::segment::{Junction, PathItem, Segment, SegmentFeed};
 
@@ -33,6 +35,8 @@ pub struct DirectOptions {
     /// G64: the same threshold; larger, since the planner still bounds the velocity step at a
     /// kink by the jerk budget (plan::junction), so a small kink costs speed, not accuracy.
     pub continuous_tangent_angle: f64,
+    /// Tool control before the program switches it (the machine file's `tcp`).
+    pub control: ToolControl,
 }
 
 impl Default for DirectOptions {
@@ -41,6 +45,7 @@ impl Default for DirectOptions {
             tolerance: 0.01,
             exact_tangent_angle: 1e-6,
             continuous_tangent_angle: 0.05,
+            control: ToolControl::Joints,
         }
     }
 }
@@ -55,6 +60,7 @@ pub struct Direct {
     feed_mode: FeedMode,
     path_mode: PathMode,
     pending: Option<Segment>,
+    control: ToolControl,
 }
 
 fn end_tangent(seg: &Segment) -> Option<Vec3> {
@@ -87,6 +93,7 @@ impl Direct {
             feed_mode: FeedMode::UnitsPerMinute,
             path_mode: PathMode::default(),
             pending: None,
+            control: options.control,
         }
     }
 
@@ -151,6 +158,16 @@ impl Direct {
             }
             // The direct builder never compresses: G05.1 changes nothing here.
             MoveKind::Smoothing(_) => return Ok(()),
+            // TCP switched: stop; the next move starts from the same point read the new way.
+            MoveKind::ToolControl { control, at } => {
+                if !at.0.iter().all(|v| v.is_finite()) {
+                    return Err(DirectError::NotFinite { line });
+                }
+                self.flush(Junction::Stop, out);
+                self.control = control;
+                self.position = at;
+                return Ok(());
+            }
             MoveKind::Dwell { seconds } => {
                 if !(seconds.is_finite() && seconds >= 0.0) {
                     return Err(DirectError::BadDwell { line, seconds });
@@ -198,6 +215,7 @@ impl Direct {
             feed: self.feed(line, rapid)?,
             end: Junction::Stop,
             tolerance: self.tolerance(),
+            control: self.control,
         };
         if seg.rotary_only() && seg.rotary_travel() <= 0.0 {
             // Nothing moves: a repeated point.

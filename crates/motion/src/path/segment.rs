@@ -5,7 +5,7 @@
 //! planning (look-ahead, interpolation): the builder emits [`PathItem`]s in program order, the
 //! planner consumes them as a stream.
 
-use tezgah_geom::{Curve, Vec3};
+use tezgah_geom::{Curve, ToolControl, Vec3};
 
 /// How fast a segment is to be run, before the machine's limits lower it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +50,8 @@ pub struct Segment {
     pub end: Junction,
     /// The path tolerance in force (mm): chord error and smoothing stay within it.
     pub tolerance: f64,
+    /// How the program axes reach the joints along this segment (TCP on or off).
+    pub control: ToolControl,
 }
 
 impl Segment {
@@ -80,6 +82,7 @@ impl std::fmt::Debug for Segment {
             .field("feed", &self.feed)
             .field("end", &self.end)
             .field("tolerance", &self.tolerance)
+            .field("control", &self.control)
             .finish_non_exhaustive()
     }
 }

@@ -1,20 +1,27 @@
 //! The machine as the planner sees it: for every joint, which path quantity drives it and its
-//! velocity, acceleration and jerk limits in internal units (mm, rad, s).
+//! velocity, acceleration and jerk limits in internal units (mm, rad, s), under the tool
+//! control in force on each segment (TCP on or off, [`ToolControl`]).
 //!
-//! Cartesian machines: linear joints x y z follow the tool tip one to one (so a joint's
-//! derivatives along the path are the components of the tip's), extra rotary joints follow the
-//! programmed A B C linearly. Every other model (delta, trunnions, Y-Z-C-A): the joints are
-//! the tool-centre-point inverse of the program pose (tip + the model's program angles, see
-//! `tezgah_kinematics::tcp`), and their derivatives along the path are taken by differences
-//! of that map along each segment (`numeric`).
+//! Joints follow the path directly where they are program axes: on a Cartesian machine always
+//! (x y z the tip's coordinates, with the tool length a constant along Z; extra rotaries the
+//! programmed A B C), and on a machine whose rotaries orient the tool when TCP is off (joints
+//! driven by the program axes of their names). Otherwise — TCP on, or a delta — the joints
+//! are the tool-centre-point inverse of the program pose (tip + the model's program angles,
+//! `tezgah_kinematics::tcp`, with the tool length along the tool axis), and their derivatives
+//! along the path are taken by differences of that map along each segment (`limits`).
 
-use tezgah_geom::{Axis, Pose, Vec3};
+use tezgah_geom::{Axis, Pose, ToolControl, Vec3};
 use tezgah_kinematics::tcp::ProgramPose;
-use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, Tool};
+use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
 
 use super::PlanError;
+use crate::path::Segment;
 
-/// What drives a joint.
+/// A program axis "moves" along a segment when its ends or middle differ by more than this
+/// (mm or degrees): round-off of the path builders, far below any resolution.
+const STILL: f64 = 1e-9;
+
+/// What drives a joint when it follows the path directly.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum JointMap {
     /// Tip coordinate 0, 1 or 2 (mm).
@@ -26,75 +33,191 @@ pub enum JointMap {
 /// Joint maps and limits (internal units).
 #[derive(Debug, Clone)]
 pub struct PlanMachine {
-    pub map: Vec<JointMap>,
+    /// The model (forward and inverse kinematics).
+    pub model: Model,
+    /// Program axes → joints where the joints follow them directly: a Cartesian machine's
+    /// joints, or with TCP off the joints of a machine whose rotaries orient the tool (by
+    /// joint name; `None` if a name is not an axis letter).
+    pub map: Option<Vec<JointMap>>,
     pub max_velocity: Vec<f64>,
     pub max_acceleration: Vec<f64>,
     pub max_jerk: Vec<f64>,
-    /// The model, when joints come from its tool-centre-point inverse (not Cartesian).
-    pub numeric: Option<Model>,
     /// The program axes carrying the model's TCP angles (`Machine::tcp_axes`).
     pub axes: Vec<Axis>,
+    /// The tool control before the program says otherwise (machine file `tcp`).
+    pub initial: ToolControl,
 }
 
 impl PlanMachine {
-    /// From a validated machine; refuses models whose joints are not the tip's coordinates.
+    /// From a validated machine; refuses models whose joints cannot follow program axes.
     pub fn from_machine(machine: &Machine) -> Result<Self, PlanError> {
-        let numeric = match machine.kinematics {
-            Model::Cartesian(_) => None,
-            _ => Some(machine.kinematics.clone()),
+        let axes = machine
+            .tcp_axes()
+            .map_err(|_| PlanError::UnsupportedKinematics {
+                kind: machine.kinematics.type_name(),
+                supported: "machines whose rotary joints carry program axes",
+            })?;
+        let by_name: Option<Vec<JointMap>> = machine
+            .joints
+            .iter()
+            .map(|j| match j.name.to_ascii_lowercase().as_str() {
+                "x" => Some(JointMap::Tip(0)),
+                "y" => Some(JointMap::Tip(1)),
+                "z" => Some(JointMap::Tip(2)),
+                "a" => Some(JointMap::Rotary(0)),
+                "b" => Some(JointMap::Rotary(1)),
+                "c" => Some(JointMap::Rotary(2)),
+                _ => None,
+            })
+            .collect();
+        let map = match machine.kinematics {
+            // The first three joints are x y z whatever their names; extras by name (a, b or
+            // c, which `tcp_axes` has checked).
+            Model::Cartesian(_) => Some(
+                (0..machine.joints.len())
+                    .map(|i| match i {
+                        0..=2 => JointMap::Tip(i),
+                        _ => JointMap::Rotary(axes[i - 3].index() - 3),
+                    })
+                    .collect(),
+            ),
+            Model::LinearDelta(_) => None,
+            _ => by_name,
         };
-        let axes = match numeric {
-            Some(_) => machine
-                .tcp_axes()
-                .map_err(|_| PlanError::UnsupportedKinematics {
-                    kind: machine.kinematics.type_name(),
-                    supported: "machines whose rotary joints carry program axes",
-                })?,
-            None => vec![],
-        };
-        let mut map = Vec::with_capacity(machine.joints.len());
         let (mut v, mut a, mut j) = (vec![], vec![], vec![]);
-        for (i, joint) in machine.joints.iter().enumerate() {
-            map.push(if i < 3 || numeric.is_some() {
-                JointMap::Tip(i)
-            } else {
-                // Cartesian extra joints are named a, b or c (kinematics README).
-                let k = match joint.name.as_str() {
-                    "b" => 1,
-                    "c" => 2,
-                    _ => 0,
-                };
-                JointMap::Rotary(k)
-            });
+        for joint in &machine.joints {
             let s = joint.to_internal();
             v.push(joint.max_velocity * s);
             a.push(joint.max_acceleration * s);
             j.push(joint.max_jerk * s);
         }
         Ok(PlanMachine {
+            model: machine.kinematics.clone(),
             map,
             max_velocity: v,
             max_acceleration: a,
             max_jerk: j,
-            numeric,
             axes,
+            initial: match machine.tcp {
+                TcpSwitch::Program => ToolControl::Joints,
+                TcpSwitch::Always => ToolControl::CentrePoint { tool_length: 0.0 },
+            },
         })
     }
 
     pub fn joint_count(&self) -> usize {
-        self.map.len()
+        self.max_velocity.len()
     }
-}
 
-/// Joints of a non-Cartesian machine for the tip (mm) and A B C (degrees), nearest `previous`.
-pub fn tcp_joints(
-    model: &Model,
-    axes: &[Axis],
-    tip: &Vec3,
-    rotary: &[f64; 3],
-    previous: &Joints,
-) -> Result<Joints, KinematicsError> {
-    let pose = Pose::new(tip.x, tip.y, tip.z, rotary[0], rotary[1], rotary[2]);
-    let p = ProgramPose::from_program(&pose, axes)?;
-    model.tcp_inverse(&p.tip, &p.angles, &Tool::default(), previous)
+    /// Whether the rotary joints orient the tool (trunnions, Y-Z-C-A): only there does
+    /// switching TCP change what the program axes mean.
+    fn orients(&self) -> bool {
+        !matches!(self.model, Model::Cartesian(_) | Model::LinearDelta(_))
+    }
+
+    /// The direct map under `control`, or `None` where the joints come from the TCP inverse.
+    pub fn map_for(&self, control: ToolControl) -> Option<&[JointMap]> {
+        let direct = match self.model {
+            Model::Cartesian(_) => true,
+            Model::LinearDelta(_) => false,
+            _ => control == ToolControl::Joints,
+        };
+        if direct {
+            self.map.as_deref()
+        } else {
+            None
+        }
+    }
+
+    /// With TCP off on a machine whose rotaries orient the tool, a program axis without a
+    /// joint of its name (X on Y-Z-C-A, B on table-ac) cannot move: refused, not ignored.
+    pub fn check_axes(&self, seg: &Segment) -> Result<(), PlanError> {
+        let Some(map) = self.map.as_deref() else {
+            return Ok(());
+        };
+        if seg.control != ToolControl::Joints || !self.orients() {
+            return Ok(());
+        }
+        let (a, b) = seg.curve.domain();
+        let ends = [
+            seg.curve.point(a),
+            seg.curve.point(0.5 * (a + b)),
+            seg.curve.point(b),
+        ];
+        for axis in Axis::ALL {
+            let i = axis.index();
+            let driven = map.iter().any(|m| match *m {
+                JointMap::Tip(j) => j == i,
+                JointMap::Rotary(k) => k + 3 == i,
+            });
+            let moves = if axis.is_linear() {
+                ends.iter().any(|p| (p[i] - ends[0][i]).abs() > STILL)
+            } else {
+                (seg.rotary[1][i - 3] - seg.rotary[0][i - 3]).abs() > STILL
+            };
+            if moves && !driven {
+                return Err(PlanError::NoJoint {
+                    line: seg.line,
+                    axis: axis.letter(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Joints for the tip (mm) and A B C (degrees) under `control`, nearest `previous`;
+    /// every limit checked.
+    pub fn joints(
+        &self,
+        control: ToolControl,
+        tip: &Vec3,
+        rotary: &[f64; 3],
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
+        let tool = match control {
+            ToolControl::CentrePoint { tool_length } => Tool::with_length(tool_length),
+            ToolControl::Joints if self.orients() => {
+                let map = self
+                    .map
+                    .as_deref()
+                    .ok_or_else(|| KinematicsError::BadInput {
+                        reason: "with TCP off the program axes drive the joints of their names, \
+                             and this machine's joints are not named x y z a b c"
+                            .into(),
+                    })?;
+                let mut q = Joints::zeros(map.len());
+                for (v, m) in q.as_mut_slice().iter_mut().zip(map) {
+                    *v = match *m {
+                        JointMap::Tip(i) => tip[i],
+                        JointMap::Rotary(k) => rotary[k].to_radians(),
+                    };
+                }
+                self.model.check_joints(&q)?;
+                return Ok(q);
+            }
+            // Cartesian and delta: X Y Z are the gauge point (the G43 length already in Z).
+            ToolControl::Joints => Tool::default(),
+        };
+        let pose = Pose::new(tip.x, tip.y, tip.z, rotary[0], rotary[1], rotary[2]);
+        let p = ProgramPose::from_program(&pose, &self.axes)?;
+        self.model.tcp_inverse(&p.tip, &p.angles, &tool, previous)
+    }
+
+    /// The program point (tip mm, A B C degrees) of joints `q` with TCP off: where a take-up
+    /// move in joint mode starts and ends. Program axes without a joint read 0.
+    pub fn joint_mode_point(&self, q: &Joints) -> Result<(Vec3, [f64; 3]), KinematicsError> {
+        let mut tip = Vec3::zeros();
+        let mut rotary = [0.0; 3];
+        if !self.orients() {
+            tip = self.model.forward(q, &Tool::default())?.tip;
+        }
+        for (v, m) in q.as_slice().iter().zip(self.map.iter().flatten()) {
+            match *m {
+                JointMap::Tip(i) if self.orients() => tip[i] = *v,
+                JointMap::Tip(_) => {}
+                JointMap::Rotary(k) => rotary[k] = v.to_degrees(),
+            }
+        }
+        Ok((tip, rotary))
+    }
 }

@@ -9,11 +9,10 @@
 //! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
 //! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
 
-use tezgah_geom::Axis;
 use tezgah_geom::{Curve, Vec3};
-use tezgah_kinematics::{Joints, Model};
+use tezgah_kinematics::Joints;
 
-use super::joints::{tcp_joints, JointMap, PlanMachine};
+use super::joints::{JointMap, PlanMachine};
 use super::PlanError;
 use crate::path::{Segment, SegmentFeed};
 use crate::profile::Limits;
@@ -142,6 +141,7 @@ fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
 /// Samples the tip path (tangent, curvature vector and its derivative by differences of the
 /// curvature vector between samples) and maps it onto the joints.
 pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
+    machine.check_axes(seg)?;
     let n = machine.joint_count().min(MAX_JOINTS);
     let rotary_only = seg.rotary_only();
     let length = if rotary_only {
@@ -210,11 +210,11 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             }
         }
     }
-    if let Some(model) = &machine.numeric {
-        numeric_joints(seg, model, &machine.axes, n, &mut g)?;
+    let Some(map) = machine.map_for(seg.control) else {
+        numeric_joints(seg, machine, n, &mut g)?;
         return Ok(g);
-    }
-    for (j, m) in machine.map.iter().take(n).enumerate() {
+    };
+    for (j, m) in map.iter().take(n).enumerate() {
         match *m {
             JointMap::Tip(i) => {
                 g.g1[j] = g1[i];
@@ -244,8 +244,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
 #[allow(clippy::needless_range_loop)]
 fn numeric_joints(
     seg: &Segment,
-    model: &Model,
-    axes: &[Axis],
+    machine: &PlanMachine,
     n: usize,
     g: &mut Geometry,
 ) -> Result<(), PlanError> {
@@ -268,7 +267,7 @@ fn numeric_joints(
         let f = k as f64 / steps as f64;
         let (tip, rot) = at(f);
         // Unreachable points are the interpolator's error to report, with the line.
-        let Ok(qk) = tcp_joints(model, axes, &tip, &rot, &prev) else {
+        let Ok(qk) = machine.joints(seg.control, &tip, &rot, &prev) else {
             return Ok(());
         };
         prev = qk;
@@ -290,7 +289,7 @@ fn numeric_joints(
             let mut before = Joints::zeros(n);
             before.as_mut_slice().copy_from_slice(&q[k][..n]);
             let (tip, rot) = at((k as f64 + 0.5) / steps as f64);
-            if let Ok(mid) = tcp_joints(model, axes, &tip, &rot, &before) {
+            if let Ok(mid) = machine.joints(seg.control, &tip, &rot, &before) {
                 let half = (mid[i] - x(k)).abs().max((x(k + 1) - mid[i]).abs());
                 if half > 0.9 * big {
                     return Err(PlanError::JointJump {

@@ -34,6 +34,11 @@ pub enum PlanError {
          passes through a singular pose of the machine"
     )]
     JointJump { line: u32, joint: usize, jump: f64 },
+    #[error(
+        "line {line}: {axis} has no joint on this machine: with tool-centre-point control off \
+         (G49, or before G43.4) the program axes drive the joints of their names"
+    )]
+    NoJoint { line: u32, axis: char },
     #[error("line {line}: dwell of {seconds} s is not a finite, non-negative time")]
     BadDwell { line: u32, seconds: f64 },
     #[error("bad planner option {name}: {value}")]

@@ -21,7 +21,9 @@ mod piece;
 
 use std::collections::VecDeque;
 
-use tezgah_geom::{Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, Vec3};
+use tezgah_geom::{
+    Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, ToolControl, Vec3,
+};
 
 pub use blend::{Blend, End};
 pub use error::PathError;
@@ -64,6 +66,9 @@ pub struct SmoothOptions {
     pub start: Pose,
     /// Moves read and processed at a time (bounded memory). Default 512.
     pub window: usize,
+    /// Tool control before the program switches it (the machine file's `tcp`). Default TCP
+    /// off.
+    pub control: ToolControl,
 }
 
 impl Default for SmoothOptions {
@@ -79,6 +84,7 @@ impl Default for SmoothOptions {
             angular_tolerance: 0.1,
             start: Pose::ZERO,
             window: 512,
+            control: ToolControl::Joints,
         }
     }
 }
@@ -137,8 +143,16 @@ pub fn build(
 #[allow(clippy::large_enum_variant)]
 pub(crate) enum Tok {
     Piece(Piece),
-    Dwell { seconds: f64, line: u32 },
-    Stop { line: u32 },
+    Dwell {
+        seconds: f64,
+        line: u32,
+    },
+    Stop {
+        line: u32,
+    },
+    /// TCP switched (or its tool length changed): the machine stops before it, and nothing
+    /// is compressed or blended across it.
+    Control(ToolControl),
 }
 
 /// The modal state the moves run under.
@@ -149,6 +163,7 @@ struct Modal {
     feed_mode: FeedMode,
     mode: Mode,
     tolerance: f64,
+    control: ToolControl,
 }
 
 /// The streaming smoothing builder: an iterator of `Result<PathItem, PathError>`; after an
@@ -162,6 +177,8 @@ pub struct Smoother<I> {
     done: bool,
     /// Programmed moves folded into splines, and splines made (for reports).
     stats: Stats,
+    /// The tool control of the segments being emitted (the tokens run ahead of it).
+    control: ToolControl,
 }
 
 /// Counts for reports and the compression ratio.
@@ -194,7 +211,9 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 feed_mode: FeedMode::UnitsPerMinute,
                 mode: Mode::Continuous,
                 tolerance: opts.tolerance,
+                control: opts.control,
             },
+            control: opts.control,
             opts,
             pending: None,
             out: VecDeque::new(),
@@ -240,6 +259,21 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
             MoveKind::Smoothing(on) => {
                 self.opts.compress = on;
                 return Ok(None);
+            }
+            MoveKind::ToolControl { control, at } => {
+                if control == m.control && at == m.pos {
+                    return Ok(None);
+                }
+                if !at.0.iter().all(|c| c.is_finite()) {
+                    return Err(PathError::Curve {
+                        line,
+                        source: tezgah_geom::CurveError::NotFinite,
+                    });
+                }
+                // Nothing moves: the next move starts from the same point read the new way.
+                m.control = control;
+                m.pos = at;
+                return Ok(Some(Tok::Control(control)));
             }
             MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
             MoveKind::Stop(StopKind::Pause)
@@ -353,6 +387,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     self.flush(Junction::Stop);
                     self.out.push_back(PathItem::Stop { line });
                 }
+                Tok::Control(control) => {
+                    self.flush(Junction::Stop);
+                    self.control = control;
+                }
             }
         }
         if !more {
@@ -363,16 +401,21 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
 
     fn flush(&mut self, end: Junction) {
         if let Some(a) = self.pending.take() {
-            self.out.push_back(PathItem::Segment(a.into_segment(end)));
+            self.emit(a.into_segment(end));
         }
+    }
+
+    /// Queues a segment under the tool control in force.
+    fn emit(&mut self, mut seg: Segment) {
+        seg.control = self.control;
+        self.out.push_back(PathItem::Segment(seg));
     }
 
     /// Decide the junction between `a` and `b`, blending where allowed; emits `a` (and the
     /// blend) and trims `b`'s start.
     fn join(&mut self, mut a: Piece, b: &mut Piece) {
         if a.mode == Mode::ExactStop {
-            self.out
-                .push_back(PathItem::Segment(a.into_segment(Junction::Stop)));
+            self.emit(a.into_segment(Junction::Stop));
             return;
         }
         let blendable = a.mode == Mode::Continuous
@@ -420,14 +463,14 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     feed,
                     end: Junction::Smooth,
                     tolerance: a.tolerance.min(b.tolerance),
+                    control: self.control,
                 };
                 a.u1 = p.ua;
                 b.u0 = p.ub;
                 self.stats.blends += 1;
                 self.stats.max_blend_deviation = self.stats.max_blend_deviation.max(p.deviation);
-                self.out
-                    .push_back(PathItem::Segment(a.into_segment(Junction::Smooth)));
-                self.out.push_back(PathItem::Segment(seg));
+                self.emit(a.into_segment(Junction::Smooth));
+                self.emit(seg);
             }
             Err(NoBlend::Tangent { same_curvature }) => {
                 let end = if same_curvature {
@@ -435,12 +478,11 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 } else {
                     Junction::Tangent
                 };
-                self.out.push_back(PathItem::Segment(a.into_segment(end)));
+                self.emit(a.into_segment(end));
             }
             Err(NoBlend::Corner) => {
                 self.stats.corners += 1;
-                self.out
-                    .push_back(PathItem::Segment(a.into_segment(Junction::Corner)));
+                self.emit(a.into_segment(Junction::Corner));
             }
         }
     }

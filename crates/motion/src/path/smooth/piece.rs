@@ -244,6 +244,8 @@ impl Piece {
             feed,
             end,
             tolerance: self.tolerance,
+            // The builder stamps the control in force when it emits the segment.
+            control: tezgah_geom::ToolControl::Joints,
         }
     }
 }

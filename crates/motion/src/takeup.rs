@@ -1,0 +1,117 @@
+//! Switching tool-centre-point control (G43.4 / G49) between the path stage and the planner:
+//! where the control changes, the machine is at rest (the path builders end the segment before
+//! with a stop) and the same program point may need other joints under the new reading — the
+//! tool length now along the tool axis, or program axes now joints. This module inserts the
+//! move that takes that difference up, straight in joint space, before the next segment.
+//!
+//! Straight in joint space keeps every joint between two values inside its limits, so the
+//! take-up never leaves the machine's range; it runs at the rapid speed and ends at rest.
+
+use std::sync::Arc;
+
+use tezgah_geom::{Curve, Line, ToolControl, Vec3};
+use tezgah_kinematics::{Joints, KinematicsError};
+
+use crate::path::{Junction, PathItem, Segment, SegmentFeed};
+use crate::plan::PlanMachine;
+
+/// Joint differences at or below this (mm or rad) need no take-up: round-off of the two
+/// inverse kinematics, far below any machine's resolution.
+const SAME_JOINTS: f64 = 1e-9;
+
+/// A switch whose take-up cannot be computed: the point is unreachable under one of the
+/// two controls.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("line {line}: tool-centre-point switch: {source}")]
+pub struct TakeUpError {
+    pub line: u32,
+    pub source: KinematicsError,
+}
+
+/// Watches the path items for control switches; [`TakeUp::before`] gives the take-up move to
+/// run before an item, if one is needed.
+#[derive(Debug)]
+pub struct TakeUp {
+    machine: Arc<PlanMachine>,
+    control: ToolControl,
+    /// The program point where the last segment ended (tip mm, A B C degrees) and the joints
+    /// there, under `control`.
+    end: (Vec3, [f64; 3]),
+    joints: Joints,
+}
+
+impl TakeUp {
+    /// Starting at `start` (tip, A B C) with joints `joints`, under the machine's initial
+    /// control.
+    pub fn new(machine: &PlanMachine, start: (Vec3, [f64; 3]), joints: Joints) -> Self {
+        TakeUp {
+            machine: Arc::new(machine.clone()),
+            control: machine.initial,
+            end: start,
+            joints,
+        }
+    }
+
+    /// The take-up segment to run before `item` (a segment under another control than the
+    /// one before), or `None`.
+    pub fn before(&mut self, item: &PathItem) -> Result<Option<PathItem>, TakeUpError> {
+        let PathItem::Segment(seg) = item else {
+            return Ok(None);
+        };
+        let err = |source| TakeUpError {
+            line: seg.line,
+            source,
+        };
+        let (a, b) = seg.curve.domain();
+        let start = (seg.curve.point(a), seg.rotary[0]);
+        let mut out = None;
+        if seg.control != self.control {
+            let m = &self.machine;
+            let old = m
+                .joints(self.control, &self.end.0, &self.end.1, &self.joints)
+                .map_err(err)?;
+            let new = m
+                .joints(seg.control, &start.0, &start.1, &old)
+                .map_err(err)?;
+            let moved = old
+                .as_slice()
+                .iter()
+                .zip(new.as_slice())
+                .any(|(p, q)| (p - q).abs() > SAME_JOINTS);
+            if moved {
+                out = Some(PathItem::Segment(
+                    joint_line(m, &old, &new, seg).map_err(err)?,
+                ));
+            }
+            self.control = seg.control;
+            self.joints = new;
+        }
+        self.end = (seg.curve.point(b), seg.rotary[1]);
+        Ok(out)
+    }
+}
+
+/// A rapid straight in joint space from `from` to `to` (TCP off: the program axes are the
+/// joints, or on a Cartesian machine or a delta the gauge point), at rest at both ends.
+fn joint_line(
+    m: &PlanMachine,
+    from: &Joints,
+    to: &Joints,
+    next: &Segment,
+) -> Result<Segment, KinematicsError> {
+    let (p0, r0) = m.joint_mode_point(from)?;
+    let (p1, r1) = m.joint_mode_point(to)?;
+    let line = Line::new(p0, p1).map_err(|e| KinematicsError::BadInput {
+        reason: e.to_string(),
+    })?;
+    Ok(Segment {
+        length: line.length(),
+        curve: Box::new(line),
+        rotary: [r0, r1],
+        line: next.line,
+        feed: SegmentFeed::Rapid,
+        end: Junction::Stop,
+        tolerance: next.tolerance,
+        control: ToolControl::Joints,
+    })
+}
