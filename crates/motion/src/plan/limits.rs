@@ -10,7 +10,7 @@
 //! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
 
 use tezgah_geom::Axis;
-use tezgah_geom::{Curve, Vec3};
+use tezgah_geom::{ArcLengthMap, Curve, Vec3};
 use tezgah_kinematics::{Joints, Model};
 
 use super::joints::{tcp_joints, JointMap, PlanMachine};
@@ -29,9 +29,12 @@ pub struct PlanOptions {
     /// Share of a segment's tolerance given to the chord error at the period (the rest is for
     /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance.
     pub chord_share: f64,
-    /// Share of each joint's acceleration and jerk given to curvature on curved segments
-    /// (the rest drives the path's own acceleration and jerk).
+    /// Share of each joint's acceleration and jerk that the pure curvature terms |q''|v² and
+    /// |q'''|v³ may take on curved segments; it sets their speed cap (see [`segment_limits`]).
     pub curvature_share: f64,
+    /// Share of the jerk left after |q'''|v³ that the cross term 3|q''|·v·a may take; it caps
+    /// the path acceleration on curved segments, and the rest drives the path jerk.
+    pub cross_share: f64,
     /// Share of each joint's acceleration and jerk kept back on segments next to a junction
     /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
     /// finite differences at the period (Δv/Ts² + Δa/Ts for the jerk).
@@ -56,6 +59,7 @@ impl Default for PlanOptions {
             period: 0.001,
             chord_share: 0.5,
             curvature_share: 0.5,
+            cross_share: 0.5,
             junction_reserve: 0.25,
             min_junction_share: 0.05,
             window: 64,
@@ -89,6 +93,7 @@ impl PlanOptions {
         }
         unit("chord_share", self.chord_share, true)?;
         unit("curvature_share", self.curvature_share, true)?;
+        unit("cross_share", self.cross_share, true)?;
         unit("junction_reserve", self.junction_reserve, false)?;
         unit("group_ratio", self.group_ratio, true)?;
         unit("min_junction_share", self.min_junction_share, false)?;
@@ -236,10 +241,22 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     Ok(g)
 }
 
-/// Joint derivatives by differences of the inverse kinematics at equal steps h along the
-/// segment (lines and arcs have constant parametric speed, so equal steps in u are equal in
-/// s): q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas at the ends.
-/// Margins cover the peaks between samples (the step turns the joint map by little).
+/// Whether the curve's parametric speed is constant (u ∝ s), checked at five parameters.
+fn constant_speed(curve: &dyn Curve) -> bool {
+    let (a, b) = curve.domain();
+    let s0 = curve.speed(a);
+    [0.25, 0.5, 0.75, 1.0]
+        .iter()
+        .all(|&f| (curve.speed(a + (b - a) * f) - s0).abs() <= 1e-12 * s0)
+}
+
+/// Joint derivatives by differences of the inverse kinematics at equal arc-length steps h
+/// along the segment: q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas
+/// at the ends. Margins cover the peaks between samples (the step turns the joint map by
+/// little). The samples are where the interpolator puts them: tip at u(s), rotary axes linear
+/// in s. Lines, arcs and helices have constant parametric speed (u ∝ s); a blend or spline
+/// does not, and equal steps in u there would misjudge h (and so q''' by the cube of the
+/// speed ratio), which is why an arc-length map is built for them.
 // Joint i indexes several parallel arrays (rows of q, g1…g3, ends): a range loop is clearest.
 #[allow(clippy::needless_range_loop)]
 fn numeric_joints(
@@ -254,9 +271,16 @@ fn numeric_joints(
     let steps = (16 + (length / 0.5).ceil() as usize).min(512);
     let h = length / steps as f64;
     let [r0, r1] = seg.rotary;
+    let map = if g.rotary_only || constant_speed(&*seg.curve) {
+        None
+    } else {
+        ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)).ok()
+    };
     let at = |f: f64| {
         let tip = if g.rotary_only {
             seg.curve.point(ua)
+        } else if let Some(m) = &map {
+            seg.curve.point(m.u_at(&*seg.curve, f * m.length()))
         } else {
             seg.curve.point(ua + (ub - ua) * f)
         };
@@ -343,30 +367,23 @@ pub enum LimitedBy {
     Idle,
 }
 
-/// Largest v ≥ 0 with c3·v³ + c1·v ≤ budget (both terms increase with v).
-fn cubic_cap(c3: f64, c1: f64, budget: f64) -> f64 {
-    if c3 <= 0.0 && c1 <= 0.0 {
-        return f64::INFINITY;
-    }
-    let f = |v: f64| c3 * v * v * v + c1 * v;
-    let mut hi = 1.0;
-    while f(hi) < budget && hi < 1e12 {
-        hi *= 2.0;
-    }
-    let mut lo = 0.0;
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) <= budget {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
-}
-
 /// Speed, acceleration and jerk of the path profile on `seg` (see the module doc). `reserve`
 /// keeps [`PlanOptions::junction_reserve`] of the joint budgets back for junction jumps.
+///
+/// On a curved segment V, A and J are chosen jointly so that for every joint i (budget b)
+///   g1ᵢ·V ≤ Vᵢ,   g2ᵢV² + g1ᵢA ≤ b·Aᵢ,   g3ᵢV³ + 3g2ᵢ·V·A + g1ᵢJ ≤ b·Jᵢ:
+/// 1. the speed cap takes only the pure curvature terms, each within its share c
+///    ([`PlanOptions::curvature_share`]): V ≤ √(c·b·Aᵢ/g2ᵢ), V ≤ ∛(c·b·Jᵢ/g3ᵢ) (ref 000
+///    §2.5–2.8, v ≤ √(A/κ) and v ≤ (J/κ²)^⅓ per joint);
+/// 2. at the speed finally chosen (feed, chord error and joint speed may lower it) the jerk
+///    left, Rᵢ = b·Jᵢ − g3ᵢV³ ≥ (1 − c)·b·Jᵢ, is shared between the cross term and the path
+///    jerk: A ≤ x·Rᵢ/(3g2ᵢV) with x = [`PlanOptions::cross_share`], and A ≤ (b·Aᵢ − g2ᵢV²)/g1ᵢ;
+/// 3. J takes what is left: J = minᵢ (Rᵢ − 3g2ᵢ·V·A)/g1ᵢ ≥ (1 − x)·Rᵢ/g1ᵢ.
+///
+/// The cross term is thus paid by a lower path acceleration where the curvature is high, not
+/// by a lower speed: charging it at a fixed A (as a speed cap) made tight corner blends
+/// (g2 ≈ 1/r large) crawl at ~0.07 mm/s, while their speed need only obey √(A/κ) and ∛(J/κ²).
+/// A tight blend is then driven at nearly constant speed, which is what the jerk allows there.
 pub fn segment_limits(
     seg: &Segment,
     geom: &Geometry,
@@ -381,33 +398,28 @@ pub fn segment_limits(
         1.0
     };
     let curved = geom.curved();
-    let share = if curved {
-        1.0 - options.curvature_share
-    } else {
-        1.0
-    };
     let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut by = LimitedBy::JointVelocity;
     for i in 0..n {
         if geom.g1[i] > 0.0 {
             v = v.min(machine.max_velocity[i] / geom.g1[i]);
-            a = a.min(share * budget * machine.max_acceleration[i] / geom.g1[i]);
-            j = j.min(share * budget * machine.max_jerk[i] / geom.g1[i]);
+            if !curved {
+                a = a.min(budget * machine.max_acceleration[i] / geom.g1[i]);
+                j = j.min(budget * machine.max_jerk[i] / geom.g1[i]);
+            }
         }
     }
     if curved {
+        let c = options.curvature_share * budget;
         let mut vc = f64::INFINITY;
         for i in 0..n {
             let (g2, g3) = (geom.g2[i], geom.g3[i]);
-            let a_left = (1.0 - share) * budget * machine.max_acceleration[i];
-            let j_left = (1.0 - share) * budget * machine.max_jerk[i];
             if g2 > 0.0 {
-                // |q''|v² ≤ A_i share: v ≤ √(A/κ) per joint (ref 000 eq. 2.5x).
-                vc = vc.min((a_left / g2).sqrt());
+                vc = vc.min((c * machine.max_acceleration[i] / g2).sqrt());
             }
-            // |q'''|v³ + 3|q''|·v·A ≤ J_i share: v ≤ (J/κ²)^⅓ with the cross term.
-            let aa = if a.is_finite() { a } else { 0.0 };
-            vc = vc.min(cubic_cap(g3, 3.0 * g2 * aa, j_left));
+            if g3 > 0.0 {
+                vc = vc.min((c * machine.max_jerk[i] / g3).cbrt());
+            }
         }
         if vc < v {
             v = vc;
@@ -440,36 +452,26 @@ pub fn segment_limits(
         v = options.idle_rotary[0].min(feed);
         by = LimitedBy::Idle;
     }
-    if curved && v.is_finite() && a.is_finite() && j.is_finite() {
-        // The split above is a floor: at the speed finally chosen the curvature terms may
-        // need less than their share, and the path gets the rest:
-        // A = minᵢ (budget·Aᵢ − g2ᵢV²)/g1ᵢ, J = minᵢ (budget·Jᵢ − g3ᵢV³ − 3g2ᵢ·V·A)/g1ᵢ.
-        let rest = |aa: f64| {
-            let (mut a2, mut j2) = (f64::INFINITY, f64::INFINITY);
-            for i in 0..n {
-                let g1 = geom.g1[i];
-                if g1 > 0.0 {
-                    a2 = a2.min((budget * machine.max_acceleration[i] - geom.g2[i] * v * v) / g1);
-                    j2 = j2.min(
-                        (budget * machine.max_jerk[i]
-                            - geom.g3[i] * v * v * v
-                            - 3.0 * geom.g2[i] * v * aa)
-                            / g1,
-                    );
-                }
+    if curved && v.is_finite() {
+        // Steps 2 and 3 of the doc above, at the speed finally chosen.
+        let x = options.cross_share;
+        for i in 0..n {
+            let (g1, g2) = (geom.g1[i], geom.g2[i]);
+            let rest = budget * machine.max_jerk[i] - geom.g3[i] * v * v * v;
+            if g1 > 0.0 {
+                a = a.min((budget * machine.max_acceleration[i] - g2 * v * v) / g1);
             }
-            (a2, j2)
-        };
-        let (a_more, _) = rest(a);
-        let a_more = a_more.max(a);
-        let (_, j_with_more) = rest(a_more);
-        if j_with_more >= j {
-            a = a_more;
-            j = j_with_more;
-        } else {
-            // Keep the floor for A; J still gains what the curvature leaves.
-            let (_, j_floor) = rest(a);
-            j = j.max(j_floor);
+            if g2 > 0.0 && v > 0.0 {
+                a = a.min(x * rest / (3.0 * g2 * v));
+            }
+        }
+        for i in 0..n {
+            let g1 = geom.g1[i];
+            if g1 > 0.0 {
+                let rest =
+                    budget * machine.max_jerk[i] - geom.g3[i] * v * v * v - 3.0 * geom.g2[i] * v * a;
+                j = j.min(rest / g1);
+            }
         }
     }
     if !a.is_finite() {
