@@ -116,12 +116,11 @@ fn limits_hold_every_cartesian_joint_on_random_curved_segments() {
                 let [q1, q2, q3] = arc_length_derivs(&*seg.curve, u);
                 for i in 0..3 {
                     let vel = q1[i].abs() * v / pm.max_velocity[i];
-                    let acc = (q2[i].abs() * v * v + q1[i].abs() * a)
-                        / (budget * pm.max_acceleration[i]);
-                    let jerk = (q3[i].abs() * v * v * v
-                        + 3.0 * q2[i].abs() * v * a
-                        + q1[i].abs() * j)
-                        / (budget * pm.max_jerk[i]);
+                    let acc =
+                        (q2[i].abs() * v * v + q1[i].abs() * a) / (budget * pm.max_acceleration[i]);
+                    let jerk =
+                        (q3[i].abs() * v * v * v + 3.0 * q2[i].abs() * v * a + q1[i].abs() * j)
+                            / (budget * pm.max_jerk[i]);
                     worst = worst.max(vel).max(acc).max(jerk);
                     assert!(
                         vel <= 1.0 + 1e-9 && acc <= 1.0 + 1e-9 && jerk <= 1.0 + 1e-9,
@@ -141,7 +140,13 @@ fn tight_corner_blends_get_the_pure_curvature_speed() {
     let machine = Machine::default_machine();
     let pm = PlanMachine::from_machine(&machine).unwrap();
     let options = PlanOptions::default();
-    for (h, deg) in [(0.01, 90.0), (0.02, 120.0), (0.005, 150.0), (0.05, 45.0), (0.2, 90.0)] {
+    for (h, deg) in [
+        (0.01, 90.0),
+        (0.02, 120.0),
+        (0.005, 150.0),
+        (0.05, 45.0),
+        (0.2, 90.0),
+    ] {
         let seg = segment(corner_blend(h, f64::to_radians(deg)), 1000.0);
         let geom = analyse(&seg, &pm).unwrap();
         let sl = segment_limits(&seg, &geom, &pm, &options, false).unwrap();

@@ -132,20 +132,27 @@ impl Geometry {
     }
 }
 
-/// Unit tangent and curvature vector dT/ds at `u`.
-fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
-    let [_, d1, d2, _] = curve.derivs(u);
-    let sp = d1.norm();
-    if sp <= 0.0 {
-        return (Vec3::zeros(), Vec3::zeros());
+/// The tip's derivatives by arc length at `u`: unit tangent q_s, curvature vector q_ss and its
+/// rate q_sss, by the chain rule with s_u = |C'|, s_uu = C'·C''/s_u,
+/// s_uuu = (|C''|² + C'·C''' − s_uu²)/s_u:
+///   q_s = C'/s_u,  q_ss = (C'' − q_s·s_uu)/s_u²,  q_sss = (C''' − 3q_ss·s_u·s_uu − q_s·s_uuu)/s_u³.
+/// Exact at the point, whatever the parametrisation (blends and splines are not u ∝ s).
+fn frame(curve: &dyn Curve, u: f64) -> [Vec3; 3] {
+    let [_, c1, c2, c3] = curve.derivs(u);
+    let su = c1.norm();
+    if su <= 0.0 {
+        return [Vec3::zeros(); 3];
     }
-    let t = d1 / sp;
-    let k = (d2 - t * t.dot(&d2)) / (sp * sp);
-    (t, k)
+    let suu = c1.dot(&c2) / su;
+    let suuu = (c2.dot(&c2) + c1.dot(&c3) - suu * suu) / su;
+    let q1 = c1 / su;
+    let q2 = (c2 - q1 * suu) / (su * su);
+    let q3 = (c3 - q2 * (3.0 * su * suu) - q1 * suuu) / (su * su * su);
+    [q1, q2, q3]
 }
 
-/// Samples the tip path (tangent, curvature vector and its derivative by differences of the
-/// curvature vector between samples) and maps it onto the joints.
+/// Samples the tip path (tangent, curvature vector and its rate, exact at each sample, see
+/// [`frame`]) and maps it onto the joints.
 pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
     let n = machine.joint_count().min(MAX_JOINTS);
     let rotary_only = seg.rotary_only();
@@ -174,9 +181,9 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     let mut g3 = [0.0f64; 3];
     if !rotary_only {
         let curve: &dyn Curve = &*seg.curve;
-        let (t0, k0) = frame(curve, ua);
-        let (t1, k1) = frame(curve, ub);
-        let (tm, km) = frame(curve, 0.5 * (ua + ub));
+        let [t0, k0, _] = frame(curve, ua);
+        let [t1, k1, _] = frame(curve, ub);
+        let [tm, km, _] = frame(curve, 0.5 * (ua + ub));
         tip_d1_start = t0;
         tip_d1_end = t1;
         tip_d2_start = k0;
@@ -188,30 +195,50 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             }
         } else {
             // Enough samples that the turning between two is small (≤ ~0.1 rad on arcs):
-            // a difference quotient of a sinusoid then underestimates its peak by < 0.1 %;
-            // the 1.05 below covers it and the curvature between samples.
+            // a sampled sinusoid then misses its peak by < 0.1 % (|q'| by ~(0.1)²/8 = 0.13 %);
+            // the 1.005 and 1.05 below cover it and the change between samples.
             let turning = (k0.norm().max(k1.norm()).max(km.norm())) * seg.length;
-            let samples = ((turning / 0.1).ceil() as usize).clamp(16, 4096);
-            let mut prev: Option<(Vec3, f64)> = None;
+            let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
+            let du = (ub - ua) / samples as f64;
+            // Per axis, the sample where |q''| and where |q'''| peak: the peak between samples
+            // is looked for around it, on a finer grid (a narrow curvature spike of a spline
+            // or blend can fall between coarse samples).
+            let mut peaks = [[0usize; 3]; 2];
+            let mut best = [[0.0f64; 3]; 2];
+            let take = |u: f64, g1: &mut [f64; 3], g2: &mut [f64; 3], g3: &mut [f64; 3]| {
+                let [t, k, dk] = frame(curve, u);
+                for i in 0..3 {
+                    g1[i] = g1[i].max(t[i].abs() * 1.005);
+                    g2[i] = g2[i].max(k[i].abs() * 1.05);
+                    g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                }
+                (k, dk)
+            };
             for s in 0..=samples {
-                let u = ua + (ub - ua) * s as f64 / samples as f64;
-                let (t, k) = frame(curve, u);
-                let sp = curve.speed(u);
+                let (k, dk) = take(ua + du * s as f64, &mut g1, &mut g2, &mut g3);
                 g.kappa_max = g.kappa_max.max(k.norm());
                 for i in 0..3 {
-                    g1[i] = g1[i].max(t[i].abs());
-                    g2[i] = g2[i].max(k[i].abs() * 1.05);
-                }
-                if let Some((kp, spp)) = prev {
-                    let ds = 0.5 * (sp + spp) * (ub - ua) / samples as f64;
-                    if ds > 0.0 {
-                        let dk = (k - kp) / ds;
-                        for i in 0..3 {
-                            g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                    for (d, x) in [k[i].abs(), dk[i].abs()].into_iter().enumerate() {
+                        if x > best[d][i] {
+                            best[d][i] = x;
+                            peaks[d][i] = s;
                         }
                     }
                 }
-                prev = Some((k, sp));
+            }
+            const FINE: usize = 16;
+            for s in peaks.iter().flatten() {
+                let lo = ua + du * (*s as f64 - 1.0).max(0.0);
+                let hi = (ua + du * (*s as f64 + 1.0)).min(ub);
+                for f in 1..FINE {
+                    let (k, _) = take(
+                        lo + (hi - lo) * f as f64 / FINE as f64,
+                        &mut g1,
+                        &mut g2,
+                        &mut g3,
+                    );
+                    g.kappa_max = g.kappa_max.max(k.norm());
+                }
             }
         }
     }
@@ -468,8 +495,9 @@ pub fn segment_limits(
         for i in 0..n {
             let g1 = geom.g1[i];
             if g1 > 0.0 {
-                let rest =
-                    budget * machine.max_jerk[i] - geom.g3[i] * v * v * v - 3.0 * geom.g2[i] * v * a;
+                let rest = budget * machine.max_jerk[i]
+                    - geom.g3[i] * v * v * v
+                    - 3.0 * geom.g2[i] * v * a;
                 j = j.min(rest / g1);
             }
         }
