@@ -3,7 +3,7 @@
 and a path-speed (feed) limit: the oracle of crates/motion/tests/toppra_oracle.rs.
 
 stdin:  line 1 "n": the number of joints;
-        line 2 "V1 .. Vn A1 .. An": joint velocity and acceleration limits (internal units);
+        line 2 "V1 .. Vn A1 .. An": joint velocity and acceleration limits (mm/s, mm/s²);
         then one waypoint per line, "s feed q1 .. qn": the path coordinate (arc length, mm,
         strictly increasing), the feed limit on ds/dt there (mm/s; a huge value for none),
         and the joints.
@@ -29,6 +29,10 @@ def main():
     vmax, amax = np.array(lim[:n]), np.array(lim[n:2 * n])
     rows = np.array([list(map(float, l)) for l in lines[2:]])
     s, feed, q = rows[:, 0], rows[:, 1], rows[:, 2:]
+    # To metres, from the run's start: seidel's LP tolerances are absolute, and in mm (speeds
+    # of 10², accelerations of 10³) fine grids fail as "not controllable". Times are unchanged.
+    s, feed, q = (s - s[0]) / 1000.0, feed / 1000.0, q / 1000.0
+    vmax, amax = vmax / 1000.0, amax / 1000.0
     # The extra coordinate is s itself: its speed is the path speed.
     path = ta.SplineInterpolator(s, np.column_stack([q, s]))
     vlim_const = np.concatenate([vmax, [np.inf]])
@@ -38,7 +42,9 @@ def main():
         hi = np.concatenate([vlim_const[:n], [f]])
         return np.column_stack([-hi, hi])
 
-    alim = np.concatenate([amax, [1e12]])
+    # |s̈| = |T·q̈| ≤ ‖q̈‖ ≤ ‖A‖ on mill3 (q = tip): a limit on the extra coordinate's
+    # acceleration that never binds; a huge one (1e12) leaves seidel's LPs badly conditioned.
+    alim = np.concatenate([amax, [1.01 * float(np.linalg.norm(amax))]])
     vel = constraint.JointVelocityConstraintVarying(vlim)
     acc = constraint.JointAccelerationConstraint(np.column_stack([-alim, alim]))
     grid = min(20000, max(1000, 4 * len(s)))
