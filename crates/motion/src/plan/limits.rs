@@ -237,7 +237,14 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 }
             }
             const FINE: usize = 16;
-            for s in peaks.iter().flatten() {
+            // Axes often peak at the same sample: refine each sample once.
+            let mut around: Vec<usize> = (0..2)
+                .flat_map(|d| (0..3).filter(move |&i| best[d][i] > 0.0).map(move |i| (d, i)))
+                .map(|(d, i)| peaks[d][i])
+                .collect();
+            around.sort_unstable();
+            around.dedup();
+            for s in &around {
                 let lo = ua + du * (*s as f64 - 1.0).max(0.0);
                 let hi = (ua + du * (*s as f64 + 1.0)).min(ub);
                 for f in 1..FINE {
