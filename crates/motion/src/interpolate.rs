@@ -8,7 +8,6 @@
 
 use std::sync::Arc;
 
-use tezgah_geom::arclen::gauss_legendre;
 use tezgah_geom::{ArcLengthMap, Curve, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Model, Tool, ToolPose};
 
@@ -40,34 +39,21 @@ pub struct Sample {
     pub feed: f64,
 }
 
-/// s → u on one segment: identity for arc-length parametrised curves (lines), proportional for
-/// constant parametric speed (arcs, helices), otherwise an arc-length map built once per
-/// segment plus a walk: samples come in increasing s, so each u is found from the previous
-/// one by Newton on ∫ |C′| du = Δs with a second-order start (one quadrature per sample
-/// instead of the map's panel search and two or three), the quadrature split at knots.
+/// s → u on one segment: identity for arc-length parametrised curves (lines), otherwise an
+/// arc-length map built once per segment.
 struct Param {
     map: Option<ArcLengthMap>,
     scale: f64,
-    /// Breakpoints of the curve (the quadrature never crosses one).
-    breaks: Vec<f64>,
-    /// The last (u, σ) found, σ in the map's arc length.
-    last: Option<(f64, f64)>,
 }
-
-/// Largest arc-length step (mm) taken by the walk; longer jumps use the map.
-const WALK_MAX_STEP: f64 = 1.0;
 
 impl Param {
     fn new(seg: &Segment) -> Param {
         let (a, b) = seg.curve.domain();
-        let plain = |scale| Param {
-            map: None,
-            scale,
-            breaks: Vec::new(),
-            last: None,
-        };
         if seg.rotary_only() || (a == 0.0 && b == seg.length) {
-            return plain(1.0);
+            return Param {
+                map: None,
+                scale: 1.0,
+            };
         }
         // Constant parametric speed (lines, circular arcs and helices): u is proportional
         // to s, no map needed.
@@ -77,7 +63,10 @@ impl Param {
             .iter()
             .all(|&f| (sp(f) - s0).abs() <= 1e-12 * s0)
         {
-            return plain((b - a) / seg.length);
+            return Param {
+                map: None,
+                scale: (b - a) / seg.length,
+            };
         }
         match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
             Ok(m) => {
@@ -85,61 +74,22 @@ impl Param {
                 Param {
                     map: Some(m),
                     scale,
-                    breaks: seg.curve.breakpoints(),
-                    last: None,
                 }
             }
             // Fall back to a parameter proportional to length (exact for constant-speed arcs).
-            Err(_) => plain((b - a) / seg.length),
+            Err(_) => Param {
+                map: None,
+                scale: (b - a) / seg.length,
+            },
         }
     }
 
-    /// ∫ |C′| du over [u0, u1], u0 ≤ u1, split at the breakpoints between them.
-    fn length(&self, curve: &dyn Curve, u0: f64, u1: f64) -> f64 {
-        let first = self.breaks.partition_point(|&k| k <= u0);
-        let mut from = u0;
-        let mut total = 0.0;
-        for &k in self.breaks[first..].iter().take_while(|&&k| k < u1) {
-            total += gauss_legendre(curve, from, k);
-            from = k;
+    fn u(&self, seg: &Segment, s: f64) -> f64 {
+        let (a, _) = seg.curve.domain();
+        match &self.map {
+            Some(m) => m.u_at(&*seg.curve, s * self.scale),
+            None => a + s * self.scale,
         }
-        total + gauss_legendre(curve, from, u1)
-    }
-
-    fn u(&mut self, seg: &Segment, s: f64) -> f64 {
-        let (a, b) = seg.curve.domain();
-        let Some(m) = &self.map else {
-            return a + s * self.scale;
-        };
-        let sigma = s * self.scale;
-        let curve = &*seg.curve;
-        if let Some((u0, s0)) = self.last {
-            let ds = sigma - s0;
-            if (0.0..=WALK_MAX_STEP).contains(&ds) {
-                // Second-order start: u = u0 + ds/v − v′·ds²/(2v³), v = |C′|, v′ = C′·C″/v.
-                let [_, d1, d2, _] = curve.derivs(u0);
-                let v = d1.norm();
-                if v > 0.0 {
-                    let vp = d1.dot(&d2) / v;
-                    let mut u = (u0 + ds / v - vp * ds * ds / (2.0 * v * v * v)).clamp(u0, b);
-                    for _ in 0..4 {
-                        let f = self.length(curve, u0, u) - ds;
-                        if f.abs() <= 1e-13 * sigma.max(1.0) {
-                            self.last = Some((u, sigma));
-                            return u;
-                        }
-                        let sp = curve.speed(u);
-                        if sp <= 0.0 {
-                            break;
-                        }
-                        u = (u - f / sp).clamp(u0, b);
-                    }
-                }
-            }
-        }
-        let u = m.u_at(curve, sigma);
-        self.last = Some((u, sigma));
-        u
     }
 }
 
@@ -183,7 +133,7 @@ impl<'m> Interpolator<'m> {
     fn pose(
         &mut self,
         seg: &Segment,
-        param: &mut Param,
+        param: &Param,
         s: f64,
     ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
         let len = if seg.rotary_only() {
@@ -269,8 +219,7 @@ impl<'m> Interpolator<'m> {
                         param = Param::new(&piece.segments[idx]);
                     }
                     let seg = &piece.segments[idx];
-                    let (tip, rotary, joints) =
-                        self.pose(seg, &mut param, s - piece.offsets[idx])?;
+                    let (tip, rotary, joints) = self.pose(seg, &param, s - piece.offsets[idx])?;
                     let sample = Sample {
                         index: 0,
                         t: 0.0,
@@ -285,7 +234,7 @@ impl<'m> Interpolator<'m> {
                 // The piece's end, exactly (held for the final row and for dwells).
                 let seg = piece.segments.last().expect("a piece has segments");
                 let len = *piece.lengths.last().unwrap_or(&0.0);
-                let (tip, rotary, joints) = self.pose(seg, &mut param, len)?;
+                let (tip, rotary, joints) = self.pose(seg, &param, len)?;
                 self.last = Some(Sample {
                     index: self.k,
                     t: end,
@@ -394,58 +343,4 @@ pub fn run(
     }
     interp.finish(&mut sink);
     Ok(interp.duration())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::path::{Junction, SegmentFeed};
-    use tezgah_geom::Nurbs;
-
-    /// The walk agrees with the arc-length map: for random rational cubics with many knots,
-    /// walked at random increasing steps (as samples come), every u has arc length s from
-    /// the start within 1e-9 mm.
-    #[test]
-    fn walk_finds_the_arc_length_parameter() {
-        let mut seed: u64 = 0x5eed_ba11;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        for _ in 0..20 {
-            let n = 12;
-            let points: Vec<Vec3> = (0..n)
-                .map(|i| Vec3::new(i as f64 * 2.0 + next(), 3.0 * next(), next()))
-                .collect();
-            let weights: Vec<f64> = (0..n).map(|_| 0.5 + next()).collect();
-            let inner = n - 4;
-            let mut knots = vec![0.0; 4];
-            knots.extend((1..=inner).map(|i| i as f64 / (inner + 1) as f64));
-            knots.extend([1.0; 4]);
-            let curve = Nurbs::new(3, &points, &weights, knots).unwrap();
-            let map = ArcLengthMap::new(&curve, 1e-12).unwrap();
-            let length = map.length();
-            let seg = Segment {
-                curve: Box::new(curve),
-                length,
-                rotary: [[0.0; 3]; 2],
-                line: 1,
-                feed: SegmentFeed::Feed(10.0),
-                end: Junction::Stop,
-                tolerance: 0.01,
-            };
-            let mut param = Param::new(&seg);
-            assert!(param.map.is_some() && param.breaks.len() > 2);
-            let mut s = 0.0;
-            while s < length {
-                let u = param.u(&seg, s);
-                let got = map.s_at(&*seg.curve, u);
-                assert!((got - s).abs() <= 1e-9, "s {s}: arc length to u is {got}");
-                // Steps from a crawl to 2 mm (beyond the walk's reach: the map takes over).
-                s += 10f64.powf(-4.0 + 4.3 * next());
-            }
-        }
-    }
 }
