@@ -239,7 +239,11 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             const FINE: usize = 16;
             // Axes often peak at the same sample: refine each sample once.
             let mut around: Vec<usize> = (0..2)
-                .flat_map(|d| (0..3).filter(move |&i| best[d][i] > 0.0).map(move |i| (d, i)))
+                .flat_map(|d| {
+                    (0..3)
+                        .filter(move |&i| best[d][i] > 0.0)
+                        .map(move |i| (d, i))
+                })
                 .map(|(d, i)| peaks[d][i])
                 .collect();
             around.sort_unstable();
