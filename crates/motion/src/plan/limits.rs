@@ -7,7 +7,8 @@
 //!   q̇ = q'v,  q̈ = q''v² + q'a,  q⃛ = q'''v³ + 3q''va + q'j            (chain rule)
 //! so with g1, g2, g3 the largest |q'|, |q''|, |q'''| over the segment the profile limits
 //! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
-//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
+//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint for the speed, with the cross term 3q''va paid by the
+//! path acceleration (see [`segment_limits`]).
 
 use tezgah_geom::Axis;
 use tezgah_geom::{ArcLengthMap, Curve, Vec3};
