@@ -16,13 +16,6 @@ use tezgah_motion::verify::{Report, Verifier};
 use crate::plot::Trace;
 
 /// The built-in demo program (a rounded pocket outline with a helical entry).
-/// Sharper corners than this are passed at rest, not blended. A blend within a small
-/// tolerance round a sharp corner is so tight that the curvature limits make the tool creep
-/// through it, slower than stopping: the demo's 90° blends at 0.004 mm took 0.35 s each, and
-/// a dense zig-zag program ran 14.2 s with them, 8.4 s without. (The planner's blend speed,
-/// 0.07 mm/s there, is lower than curvature alone explains; to be looked at.)
-const RUN_BLEND_MAX_ANGLE_DEG: f64 = 45.0;
-
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
 /// The demo's tool table.
 pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
@@ -143,7 +136,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         &SmoothOptions {
             tolerance,
             start,
-            blend_max_angle: RUN_BLEND_MAX_ANGLE_DEG.to_radians(),
             control: pm.initial,
             ..SmoothOptions::default()
         },

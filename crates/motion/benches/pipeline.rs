@@ -1,20 +1,29 @@
-//! The whole run pipeline without writing: parse (tezgah-gcode, a dev-dependency only) →
-//! direct path → plan → interpolate at 1 ms with the machine's inverse kinematics, on `mill3`.
-//! Reported as × real time = program duration / wall time per run.
+//! The `tezgah run` pipeline without writing: parse (tezgah-gcode, a dev-dependency only) →
+//! smoothing builder (compression and corner blends, as `run` uses it) → plan → interpolate at
+//! 1 ms with the machine's inverse kinematics, on `mill3`. Reported as × real time = program
+//! duration / wall time per run, and stage by stage:
+//! * `parse`: G-code text → moves;
+//! * `smooth`: moves → path items (collected);
+//! * `plan`: path items → timed pieces (collected), the look-ahead alone;
+//! * `plan_interpolate`: plan + interpolate + inverse kinematics from the same items (so
+//!   interpolation = this − `plan`);
+//! * `whole`: all of it, as `run` does.
 //!
 //! Run briefly with `cargo bench -p tezgah-motion --bench pipeline -- --warm-up-time 1
-//! --measurement-time 5`. Each benchmark first prints its program's duration and one timed run.
+//! --measurement-time 3`. Each program first prints its duration and one timed run per stage.
 
 use std::fmt::Write;
 use std::hint::black_box;
 use std::time::Instant;
 
-use criterion::{criterion_group, criterion_main, Criterion};
-use tezgah_geom::{Pose, Vec3};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
+use tezgah_geom::{Move, Pose, Vec3};
 use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::run;
-use tezgah_motion::path::direct::{build, DirectOptions};
+use tezgah_motion::path::smooth::{self, SmoothOptions};
+use tezgah_motion::plan::lookahead::plan_all;
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::PathItem;
 
 /// Dense 3-axis surfacing: zig-zag passes of 0.05–0.3 mm segments over a smooth bump.
 fn surfacing() -> String {
@@ -59,17 +68,40 @@ fn lines_and_arcs() -> String {
     s
 }
 
-/// One full run; returns (program duration, samples).
-fn pipeline(text: &str, machine: &Machine) -> (f64, u64) {
-    let moves = tezgah_gcode::program_moves(text, tezgah_gcode::Config::default()).unwrap();
-    let items = build(&moves, Pose::ZERO, DirectOptions::default()).unwrap();
+fn parse(text: &str) -> Vec<Move> {
+    tezgah_gcode::program_moves(text, tezgah_gcode::Config::default()).unwrap()
+}
+
+/// The smoothing builder as `tezgah run` sets it up.
+fn smooth_items(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
+    smooth::build(
+        moves.iter().copied(),
+        &SmoothOptions {
+            tolerance: machine.motion.tolerance_mm,
+            start: Pose::ZERO,
+            ..SmoothOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+fn plan_options(machine: &Machine) -> PlanOptions {
+    PlanOptions {
+        period: machine.motion.period_s,
+        chord_share: smooth::CHORD_SHARE,
+        ..PlanOptions::default()
+    }
+}
+
+/// Plan, interpolate and solve the inverse kinematics; returns (program duration, samples).
+fn plan_interpolate(items: Vec<PathItem>, machine: &Machine) -> (f64, u64) {
     let pm = PlanMachine::from_machine(machine).unwrap();
     let mut n = 0u64;
     let mut acc = 0.0;
     let d = run(
         items,
         pm,
-        PlanOptions::default(),
+        plan_options(machine),
         (Vec3::zeros(), [0.0; 3]),
         |s, _| {
             n += 1;
@@ -81,19 +113,78 @@ fn pipeline(text: &str, machine: &Machine) -> (f64, u64) {
     (d, n)
 }
 
+fn plan_only(items: Vec<PathItem>, machine: &Machine) -> usize {
+    let pm = PlanMachine::from_machine(machine).unwrap();
+    plan_all(items, pm, plan_options(machine)).unwrap().len()
+}
+
+fn whole(text: &str, machine: &Machine) -> (f64, u64) {
+    let moves = parse(text);
+    plan_interpolate(smooth_items(&moves, machine), machine)
+}
+
 fn bench(c: &mut Criterion) {
     let machine = Machine::default_machine();
     for (name, text) in [("surfacing", surfacing()), ("lines_arcs", lines_and_arcs())] {
-        let t = Instant::now();
-        let (d, n) = pipeline(&text, &machine);
-        let wall = t.elapsed().as_secs_f64();
+        let moves = parse(&text);
+        let items = smooth_items(&moves, &machine);
+        let time = |f: &mut dyn FnMut()| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        };
+        let t_parse = time(&mut || {
+            black_box(parse(&text));
+        });
+        let t_smooth = time(&mut || {
+            black_box(smooth_items(&moves, &machine));
+        });
+        let fresh = || smooth_items(&moves, &machine);
+        let mut it = Some(fresh());
+        let t_plan = time(&mut || {
+            black_box(plan_only(it.take().unwrap(), &machine));
+        });
+        let mut it = Some(fresh());
+        let mut d = 0.0;
+        let mut n = 0;
+        let t_pi = time(&mut || {
+            (d, n) = plan_interpolate(it.take().unwrap(), &machine);
+        });
+        let t_whole = time(&mut || {
+            black_box(whole(&text, &machine));
+        });
         eprintln!(
-            "{name}: {} lines, program {d:.3} s, {n} samples; one run {:.4} s = {:.0}x real time",
+            "{name}: {} lines, {} path items, program {d:.3} s, {n} samples; one run: parse \
+             {:.2} ms, smooth {:.2} ms, plan {:.2} ms, interpolate+kinematics {:.2} ms, whole \
+             {:.2} ms = {:.0}x real time",
             text.lines().count(),
-            wall,
-            d / wall
+            items.len(),
+            t_parse * 1e3,
+            t_smooth * 1e3,
+            t_plan * 1e3,
+            (t_pi - t_plan) * 1e3,
+            t_whole * 1e3,
+            d / t_whole
         );
-        c.bench_function(name, |b| b.iter(|| black_box(pipeline(&text, &machine))));
+        let mut g = c.benchmark_group(name);
+        g.bench_function("parse", |b| b.iter(|| black_box(parse(&text))));
+        g.bench_function("smooth", |b| {
+            b.iter(|| black_box(smooth_items(&moves, &machine)))
+        });
+        // The items are not `Clone` (boxed curves): each iteration gets a fresh set, built
+        // outside the timing.
+        g.bench_function("plan", |b| {
+            b.iter_batched(fresh, |i| plan_only(i, &machine), BatchSize::LargeInput)
+        });
+        g.bench_function("plan_interpolate", |b| {
+            b.iter_batched(
+                fresh,
+                |i| plan_interpolate(i, &machine),
+                BatchSize::LargeInput,
+            )
+        });
+        g.bench_function("whole", |b| b.iter(|| black_box(whole(&text, &machine))));
+        g.finish();
     }
 }
 

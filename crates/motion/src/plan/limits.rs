@@ -7,9 +7,10 @@
 //!   q̇ = q'v,  q̈ = q''v² + q'a,  q⃛ = q'''v³ + 3q''va + q'j            (chain rule)
 //! so with g1, g2, g3 the largest |q'|, |q''|, |q'''| over the segment the profile limits
 //! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
-//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint, with the budget split between path and curvature.
+//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint for the speed, with the cross term 3q''va paid by the
+//! path acceleration (see [`segment_limits`]).
 
-use tezgah_geom::{Curve, Vec3};
+use tezgah_geom::{ArcLengthMap, Curve, Vec3};
 use tezgah_kinematics::Joints;
 
 use super::joints::{JointMap, PlanMachine};
@@ -28,9 +29,12 @@ pub struct PlanOptions {
     /// Share of a segment's tolerance given to the chord error at the period (the rest is for
     /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance.
     pub chord_share: f64,
-    /// Share of each joint's acceleration and jerk given to curvature on curved segments
-    /// (the rest drives the path's own acceleration and jerk).
+    /// Share of each joint's acceleration and jerk that the pure curvature terms |q''|v² and
+    /// |q'''|v³ may take on curved segments; it sets their speed cap (see [`segment_limits`]).
     pub curvature_share: f64,
+    /// Share of the jerk left after |q'''|v³ that the cross term 3|q''|·v·a may take; it caps
+    /// the path acceleration on curved segments, and the rest drives the path jerk.
+    pub cross_share: f64,
     /// Share of each joint's acceleration and jerk kept back on segments next to a junction
     /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
     /// finite differences at the period (Δv/Ts² + Δa/Ts for the jerk).
@@ -38,6 +42,9 @@ pub struct PlanOptions {
     /// A junction whose cap is below this share of the slower neighbour's speed limit is
     /// passed at rest instead (cheaper than keeping the reserve on both sides).
     pub min_junction_share: f64,
+    /// Shortest planning section (mm) of a long spline cut at its knots, so its speed follows
+    /// its curvature (see [`super::sections`]); 0 plans every segment whole.
+    pub section_length: f64,
     /// Groups of segments held in the look-ahead window.
     pub window: usize,
     /// Most segments timed by one profile.
@@ -55,8 +62,10 @@ impl Default for PlanOptions {
             period: 0.001,
             chord_share: 0.5,
             curvature_share: 0.5,
+            cross_share: 0.5,
             junction_reserve: 0.25,
             min_junction_share: 0.05,
+            section_length: 1.0,
             window: 64,
             max_group: 256,
             group_ratio: 0.8,
@@ -88,9 +97,16 @@ impl PlanOptions {
         }
         unit("chord_share", self.chord_share, true)?;
         unit("curvature_share", self.curvature_share, true)?;
+        unit("cross_share", self.cross_share, true)?;
         unit("junction_reserve", self.junction_reserve, false)?;
         unit("group_ratio", self.group_ratio, true)?;
         unit("min_junction_share", self.min_junction_share, false)?;
+        if !(self.section_length >= 0.0 && self.section_length.is_finite()) {
+            return Err(PlanError::Option {
+                name: "section_length",
+                value: self.section_length,
+            });
+        }
         if self.window == 0 || self.max_group == 0 {
             return Err(PlanError::Option {
                 name: "window/max_group",
@@ -126,20 +142,27 @@ impl Geometry {
     }
 }
 
-/// Unit tangent and curvature vector dT/ds at `u`.
-fn frame(curve: &dyn Curve, u: f64) -> (Vec3, Vec3) {
-    let [_, d1, d2, _] = curve.derivs(u);
-    let sp = d1.norm();
-    if sp <= 0.0 {
-        return (Vec3::zeros(), Vec3::zeros());
+/// The tip's derivatives by arc length at `u`: unit tangent q_s, curvature vector q_ss and its
+/// rate q_sss, by the chain rule with s_u = |C'|, s_uu = C'·C''/s_u,
+/// s_uuu = (|C''|² + C'·C''' − s_uu²)/s_u:
+///   q_s = C'/s_u,  q_ss = (C'' − q_s·s_uu)/s_u²,  q_sss = (C''' − 3q_ss·s_u·s_uu − q_s·s_uuu)/s_u³.
+/// Exact at the point, whatever the parametrisation (blends and splines are not u ∝ s).
+fn frame(curve: &dyn Curve, u: f64) -> [Vec3; 3] {
+    let [_, c1, c2, c3] = curve.derivs(u);
+    let su = c1.norm();
+    if su <= 0.0 {
+        return [Vec3::zeros(); 3];
     }
-    let t = d1 / sp;
-    let k = (d2 - t * t.dot(&d2)) / (sp * sp);
-    (t, k)
+    let suu = c1.dot(&c2) / su;
+    let suuu = (c2.dot(&c2) + c1.dot(&c3) - suu * suu) / su;
+    let q1 = c1 / su;
+    let q2 = (c2 - q1 * suu) / (su * su);
+    let q3 = (c3 - q2 * (3.0 * su * suu) - q1 * suuu) / (su * su * su);
+    [q1, q2, q3]
 }
 
-/// Samples the tip path (tangent, curvature vector and its derivative by differences of the
-/// curvature vector between samples) and maps it onto the joints.
+/// Samples the tip path (tangent, curvature vector and its rate, exact at each sample, see
+/// [`frame`]) and maps it onto the joints.
 pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanError> {
     machine.check_axes(seg)?;
     let n = machine.joint_count().min(MAX_JOINTS);
@@ -169,9 +192,9 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     let mut g3 = [0.0f64; 3];
     if !rotary_only {
         let curve: &dyn Curve = &*seg.curve;
-        let (t0, k0) = frame(curve, ua);
-        let (t1, k1) = frame(curve, ub);
-        let (tm, km) = frame(curve, 0.5 * (ua + ub));
+        let [t0, k0, _] = frame(curve, ua);
+        let [t1, k1, _] = frame(curve, ub);
+        let [tm, km, _] = frame(curve, 0.5 * (ua + ub));
         tip_d1_start = t0;
         tip_d1_end = t1;
         tip_d2_start = k0;
@@ -183,30 +206,61 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             }
         } else {
             // Enough samples that the turning between two is small (≤ ~0.1 rad on arcs):
-            // a difference quotient of a sinusoid then underestimates its peak by < 0.1 %;
-            // the 1.05 below covers it and the curvature between samples.
+            // a sampled sinusoid then misses its peak by < 0.1 % (|q'| by ~(0.1)²/8 = 0.13 %);
+            // the 1.005 and 1.05 below cover it and the change between samples.
             let turning = (k0.norm().max(k1.norm()).max(km.norm())) * seg.length;
-            let samples = ((turning / 0.1).ceil() as usize).clamp(16, 4096);
-            let mut prev: Option<(Vec3, f64)> = None;
+            let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
+            let du = (ub - ua) / samples as f64;
+            // Per axis, the sample where |q''| and where |q'''| peak: the peak between samples
+            // is looked for around it, on a finer grid (a narrow curvature spike of a spline
+            // or blend can fall between coarse samples).
+            let mut peaks = [[0usize; 3]; 2];
+            let mut best = [[0.0f64; 3]; 2];
+            let take = |u: f64, g1: &mut [f64; 3], g2: &mut [f64; 3], g3: &mut [f64; 3]| {
+                let [t, k, dk] = frame(curve, u);
+                for i in 0..3 {
+                    g1[i] = g1[i].max(t[i].abs() * 1.005);
+                    g2[i] = g2[i].max(k[i].abs() * 1.05);
+                    g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                }
+                (k, dk)
+            };
             for s in 0..=samples {
-                let u = ua + (ub - ua) * s as f64 / samples as f64;
-                let (t, k) = frame(curve, u);
-                let sp = curve.speed(u);
+                let (k, dk) = take(ua + du * s as f64, &mut g1, &mut g2, &mut g3);
                 g.kappa_max = g.kappa_max.max(k.norm());
                 for i in 0..3 {
-                    g1[i] = g1[i].max(t[i].abs());
-                    g2[i] = g2[i].max(k[i].abs() * 1.05);
-                }
-                if let Some((kp, spp)) = prev {
-                    let ds = 0.5 * (sp + spp) * (ub - ua) / samples as f64;
-                    if ds > 0.0 {
-                        let dk = (k - kp) / ds;
-                        for i in 0..3 {
-                            g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                    for (d, x) in [k[i].abs(), dk[i].abs()].into_iter().enumerate() {
+                        if x > best[d][i] {
+                            best[d][i] = x;
+                            peaks[d][i] = s;
                         }
                     }
                 }
-                prev = Some((k, sp));
+            }
+            const FINE: usize = 16;
+            // Axes often peak at the same sample: refine each sample once.
+            let mut around: Vec<usize> = (0..2)
+                .flat_map(|d| {
+                    (0..3)
+                        .filter(move |&i| best[d][i] > 0.0)
+                        .map(move |i| (d, i))
+                })
+                .map(|(d, i)| peaks[d][i])
+                .collect();
+            around.sort_unstable();
+            around.dedup();
+            for s in &around {
+                let lo = ua + du * (*s as f64 - 1.0).max(0.0);
+                let hi = (ua + du * (*s as f64 + 1.0)).min(ub);
+                for f in 1..FINE {
+                    let (k, _) = take(
+                        lo + (hi - lo) * f as f64 / FINE as f64,
+                        &mut g1,
+                        &mut g2,
+                        &mut g3,
+                    );
+                    g.kappa_max = g.kappa_max.max(k.norm());
+                }
             }
         }
     }
@@ -236,10 +290,25 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     Ok(g)
 }
 
-/// Joint derivatives by differences of the inverse kinematics at equal steps h along the
-/// segment (lines and arcs have constant parametric speed, so equal steps in u are equal in
-/// s): q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas at the ends.
-/// Margins cover the peaks between samples (the step turns the joint map by little).
+/// Most inverse-kinematics samples along one segment.
+const MAX_STEPS: usize = 8192;
+
+/// Whether the curve's parametric speed is constant (u ∝ s), checked at five parameters.
+fn constant_speed(curve: &dyn Curve) -> bool {
+    let (a, b) = curve.domain();
+    let s0 = curve.speed(a);
+    [0.25, 0.5, 0.75, 1.0]
+        .iter()
+        .all(|&f| (curve.speed(a + (b - a) * f) - s0).abs() <= 1e-12 * s0)
+}
+
+/// Joint derivatives by differences of the inverse kinematics at equal arc-length steps h
+/// along the segment: q' = ∇q/h, q'' = ∇²q/h², q''' = ∇³q/h³, one-sided second-order formulas
+/// at the ends. Margins cover the peaks between samples (the step turns the joint map by
+/// little). The samples are where the interpolator puts them: tip at u(s), rotary axes linear
+/// in s. Lines, arcs and helices have constant parametric speed (u ∝ s); a blend or spline
+/// does not, and equal steps in u there would misjudge h (and so q''' by the cube of the
+/// speed ratio), which is why an arc-length map is built for them.
 // Joint i indexes several parallel arrays (rows of q, g1…g3, ends): a range loop is clearest.
 #[allow(clippy::needless_range_loop)]
 fn numeric_joints(
@@ -250,12 +319,25 @@ fn numeric_joints(
 ) -> Result<(), PlanError> {
     let (ua, ub) = seg.curve.domain();
     let length = g.length;
-    let steps = (16 + (length / 0.5).ceil() as usize).min(512);
+    // Steps short against the tightest curvature of the tip (g.kappa_max, found exactly
+    // above): a tight blend's curvature spike is narrow, and uniform steps coarser than its
+    // width miss q'' and q''' by orders of magnitude.
+    let by_length = 16 + (length / 0.5).ceil() as usize;
+    let by_curvature = (length * g.kappa_max / 0.05).ceil() as usize;
+    let steps = by_length.max(by_curvature).min(MAX_STEPS);
     let h = length / steps as f64;
     let [r0, r1] = seg.rotary;
+    let map = if g.rotary_only || constant_speed(&*seg.curve) {
+        None
+    } else {
+        // The s → u map's error, divided by h³ in q''', must stay far below the real q'''.
+        ArcLengthMap::new(&*seg.curve, 1e-12 * seg.length.clamp(1e-3, 1.0)).ok()
+    };
     let at = |f: f64| {
         let tip = if g.rotary_only {
             seg.curve.point(ua)
+        } else if let Some(m) = &map {
+            seg.curve.point(m.u_at(&*seg.curve, f * m.length()))
         } else {
             seg.curve.point(ua + (ub - ua) * f)
         };
@@ -312,6 +394,15 @@ fn numeric_joints(
         for k in 1..m - 1 {
             g3 = g3.max(((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs());
         }
+        // q''' is largest at an end of a blend (its curvature rises from the straight line's
+        // zero at a finite rate there): one-sided second-order formulas, which the central
+        // differences above never reach.
+        let d3_start = (-5.0 * x(0) + 18.0 * x(1) - 24.0 * x(2) + 14.0 * x(3) - 3.0 * x(4))
+            / (2.0 * h * h * h);
+        let d3_end = (5.0 * x(m) - 18.0 * x(m - 1) + 24.0 * x(m - 2) - 14.0 * x(m - 3)
+            + 3.0 * x(m - 4))
+            / (2.0 * h * h * h);
+        g3 = g3.max(d3_start.abs()).max(d3_end.abs());
         g.d1_start[i] = (-3.0 * x(0) + 4.0 * x(1) - x(2)) / (2.0 * h);
         g.d1_end[i] = (3.0 * x(m) - 4.0 * x(m - 1) + x(m - 2)) / (2.0 * h);
         g.d2_start[i] = (2.0 * x(0) - 5.0 * x(1) + 4.0 * x(2) - x(3)) / (h * h);
@@ -342,30 +433,23 @@ pub enum LimitedBy {
     Idle,
 }
 
-/// Largest v ≥ 0 with c3·v³ + c1·v ≤ budget (both terms increase with v).
-fn cubic_cap(c3: f64, c1: f64, budget: f64) -> f64 {
-    if c3 <= 0.0 && c1 <= 0.0 {
-        return f64::INFINITY;
-    }
-    let f = |v: f64| c3 * v * v * v + c1 * v;
-    let mut hi = 1.0;
-    while f(hi) < budget && hi < 1e12 {
-        hi *= 2.0;
-    }
-    let mut lo = 0.0;
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid) <= budget {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
-}
-
 /// Speed, acceleration and jerk of the path profile on `seg` (see the module doc). `reserve`
 /// keeps [`PlanOptions::junction_reserve`] of the joint budgets back for junction jumps.
+///
+/// On a curved segment V, A and J are chosen jointly so that for every joint i (budget b)
+///   g1ᵢ·V ≤ Vᵢ,   g2ᵢV² + g1ᵢA ≤ b·Aᵢ,   g3ᵢV³ + 3g2ᵢ·V·A + g1ᵢJ ≤ b·Jᵢ:
+/// 1. the speed cap takes only the pure curvature terms, each within its share c
+///    ([`PlanOptions::curvature_share`]): V ≤ √(c·b·Aᵢ/g2ᵢ), V ≤ ∛(c·b·Jᵢ/g3ᵢ) (ref 000
+///    §2.5–2.8, v ≤ √(A/κ) and v ≤ (J/κ²)^⅓ per joint);
+/// 2. at the speed finally chosen (feed, chord error and joint speed may lower it) the jerk
+///    left, Rᵢ = b·Jᵢ − g3ᵢV³ ≥ (1 − c)·b·Jᵢ, is shared between the cross term and the path
+///    jerk: A ≤ x·Rᵢ/(3g2ᵢV) with x = [`PlanOptions::cross_share`], and A ≤ (b·Aᵢ − g2ᵢV²)/g1ᵢ;
+/// 3. J takes what is left: J = minᵢ (Rᵢ − 3g2ᵢ·V·A)/g1ᵢ ≥ (1 − x)·Rᵢ/g1ᵢ.
+///
+/// The cross term is thus paid by a lower path acceleration where the curvature is high, not
+/// by a lower speed: charging it at a fixed A (as a speed cap) made tight corner blends
+/// (g2 ≈ 1/r large) crawl at ~0.07 mm/s, while their speed need only obey √(A/κ) and ∛(J/κ²).
+/// A tight blend is then driven at nearly constant speed, which is what the jerk allows there.
 pub fn segment_limits(
     seg: &Segment,
     geom: &Geometry,
@@ -380,33 +464,28 @@ pub fn segment_limits(
         1.0
     };
     let curved = geom.curved();
-    let share = if curved {
-        1.0 - options.curvature_share
-    } else {
-        1.0
-    };
     let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut by = LimitedBy::JointVelocity;
     for i in 0..n {
         if geom.g1[i] > 0.0 {
             v = v.min(machine.max_velocity[i] / geom.g1[i]);
-            a = a.min(share * budget * machine.max_acceleration[i] / geom.g1[i]);
-            j = j.min(share * budget * machine.max_jerk[i] / geom.g1[i]);
+            if !curved {
+                a = a.min(budget * machine.max_acceleration[i] / geom.g1[i]);
+                j = j.min(budget * machine.max_jerk[i] / geom.g1[i]);
+            }
         }
     }
     if curved {
+        let c = options.curvature_share * budget;
         let mut vc = f64::INFINITY;
         for i in 0..n {
             let (g2, g3) = (geom.g2[i], geom.g3[i]);
-            let a_left = (1.0 - share) * budget * machine.max_acceleration[i];
-            let j_left = (1.0 - share) * budget * machine.max_jerk[i];
             if g2 > 0.0 {
-                // |q''|v² ≤ A_i share: v ≤ √(A/κ) per joint (ref 000 eq. 2.5x).
-                vc = vc.min((a_left / g2).sqrt());
+                vc = vc.min((c * machine.max_acceleration[i] / g2).sqrt());
             }
-            // |q'''|v³ + 3|q''|·v·A ≤ J_i share: v ≤ (J/κ²)^⅓ with the cross term.
-            let aa = if a.is_finite() { a } else { 0.0 };
-            vc = vc.min(cubic_cap(g3, 3.0 * g2 * aa, j_left));
+            if g3 > 0.0 {
+                vc = vc.min((c * machine.max_jerk[i] / g3).cbrt());
+            }
         }
         if vc < v {
             v = vc;
@@ -439,36 +518,27 @@ pub fn segment_limits(
         v = options.idle_rotary[0].min(feed);
         by = LimitedBy::Idle;
     }
-    if curved && v.is_finite() && a.is_finite() && j.is_finite() {
-        // The split above is a floor: at the speed finally chosen the curvature terms may
-        // need less than their share, and the path gets the rest:
-        // A = minᵢ (budget·Aᵢ − g2ᵢV²)/g1ᵢ, J = minᵢ (budget·Jᵢ − g3ᵢV³ − 3g2ᵢ·V·A)/g1ᵢ.
-        let rest = |aa: f64| {
-            let (mut a2, mut j2) = (f64::INFINITY, f64::INFINITY);
-            for i in 0..n {
-                let g1 = geom.g1[i];
-                if g1 > 0.0 {
-                    a2 = a2.min((budget * machine.max_acceleration[i] - geom.g2[i] * v * v) / g1);
-                    j2 = j2.min(
-                        (budget * machine.max_jerk[i]
-                            - geom.g3[i] * v * v * v
-                            - 3.0 * geom.g2[i] * v * aa)
-                            / g1,
-                    );
-                }
+    if curved && v.is_finite() {
+        // Steps 2 and 3 of the doc above, at the speed finally chosen.
+        let x = options.cross_share;
+        for i in 0..n {
+            let (g1, g2) = (geom.g1[i], geom.g2[i]);
+            let rest = budget * machine.max_jerk[i] - geom.g3[i] * v * v * v;
+            if g1 > 0.0 {
+                a = a.min((budget * machine.max_acceleration[i] - g2 * v * v) / g1);
             }
-            (a2, j2)
-        };
-        let (a_more, _) = rest(a);
-        let a_more = a_more.max(a);
-        let (_, j_with_more) = rest(a_more);
-        if j_with_more >= j {
-            a = a_more;
-            j = j_with_more;
-        } else {
-            // Keep the floor for A; J still gains what the curvature leaves.
-            let (_, j_floor) = rest(a);
-            j = j.max(j_floor);
+            if g2 > 0.0 && v > 0.0 {
+                a = a.min(x * rest / (3.0 * g2 * v));
+            }
+        }
+        for i in 0..n {
+            let g1 = geom.g1[i];
+            if g1 > 0.0 {
+                let rest = budget * machine.max_jerk[i]
+                    - geom.g3[i] * v * v * v
+                    - 3.0 * geom.g2[i] * v * a;
+                j = j.min(rest / g1);
+            }
         }
     }
     if !a.is_finite() {
