@@ -5,9 +5,13 @@
 //! length applied (`machine = g5x + R(p + g92) + tool`). Inverse-time feeds already arrive as
 //! a rate per move, so the planner sees one feed unit: mm/min (or mm/rev under G95).
 
-use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, StopKind};
+use std::sync::Arc;
 
-use crate::canon::{Canon, CanonSink, ControlMode, Origin, Units};
+use tezgah_geom::{
+    ArcMove, FeedMode, Move, MoveKind, Nurbs, NurbsMove, PathMode, Plane, Pose, StopKind, Vec3,
+};
+
+use crate::canon::{Canon, CanonSink, ControlMode, NurbsFeed, Origin, Units};
 use crate::interp::state_rotate_xy as rotate_xy;
 
 /// A [`CanonSink`] that turns calls into [`Move`]s and hands them to `out`.
@@ -39,6 +43,27 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
     fn machine(&self, p: Pose) -> Pose {
         (self.g5x + rotate_xy(p + self.g92, self.rotation) + self.tool)
             .scale_linear(self.units.mm())
+    }
+
+    /// A NURBS call as a move: every control point through the same affine map as an end
+    /// point, which maps the curve exactly; weights and knots are unchanged by it.
+    fn nurbs(&self, n: &NurbsFeed) -> MoveKind {
+        let end = self.machine(n.end);
+        let points: Vec<Vec3> = n
+            .points
+            .iter()
+            .map(|&[x, y, z]| Vec3::from(self.machine(Pose([x, y, z, 0.0, 0.0, 0.0])).xyz()))
+            .collect();
+        match Nurbs::new(n.order - 1, &points, &n.weights, n.knots.clone()) {
+            Ok(curve) => MoveKind::Nurbs(NurbsMove {
+                curve: Arc::new(curve),
+                end,
+            }),
+            // The interpreter validated the same curve in program coordinates, and an affine
+            // map keeps it valid; should a caller hand over one that is not, the tool still
+            // ends where the call says.
+            Err(_) => MoveKind::Feed { end },
+        }
     }
 
     fn push(&mut self, line: u32, kind: MoveKind) {
@@ -91,6 +116,10 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                         turn: rotation,
                     }),
                 );
+            }
+            Canon::NurbsFeed(n) => {
+                let kind = self.nurbs(&n);
+                self.push(line, kind);
             }
             Canon::Dwell(seconds) => self.push(line, MoveKind::Dwell { seconds }),
             Canon::SetFeedRate(f) => {

@@ -26,6 +26,8 @@ impl Interpreter {
     ) -> Result<Flow, GcodeError> {
         let plan = checks::check(block, &self.state)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
+        self.g62_guard(block, plan.motion)
+            .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.assign_parameters(block);
         self.execute_words(block, plan, sink)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))

@@ -11,6 +11,7 @@ mod control;
 mod cycles;
 mod execute;
 mod motion;
+mod spline;
 mod state;
 mod system;
 
@@ -92,6 +93,8 @@ pub struct Interpreter {
     closing_percent_sought: bool,
     /// Subroutine files loaded so far; file k of a [`LinePos`] is `files[k - 1]`.
     files: Vec<SubroutineFile>,
+    /// What spline blocks carry from block to block (G5 tangent, open G5.2 and G6.2 NURBS).
+    spline_memory: spline::SplineMemory,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -147,6 +150,7 @@ impl Interpreter {
             control: control::Control::default(),
             closing_percent_sought: false,
             files: Vec::new(),
+            spline_memory: Default::default(),
         }
     }
 

@@ -26,6 +26,15 @@ impl Interpreter {
             20 | 30 => self.arc(block, g == 20, at, sink)?,
             800 => self.comment_call(sink, "motion mode set to none".into()),
             730 | 740 | 810..=890 => self.cycle(block, g, at, sink)?,
+            50 | 51 => self.spline(block, g, at, sink)?,
+            52 => self.nurbs_point(block, at)?,
+            53 => {
+                // G5.3 closes the series and leaves no motion mode, as in LinuxCNC.
+                self.nurbs_end(at, sink)?;
+                self.state.motion = None;
+                return Ok(());
+            }
+            62 => self.g62_line(block, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);
@@ -33,7 +42,7 @@ impl Interpreter {
     }
 
     /// End point of the block's axis words, absolute, incremental or (G53) machine.
-    fn find_ends(&self, block: &Block) -> Pose {
+    pub(super) fn find_ends(&self, block: &Block) -> Pose {
         let s = &self.state;
         if block.g(ggroup::NON_MODAL) == Some(530) {
             let m = block.axes_over(s.to_machine(s.pos) + s.tool_offset);
