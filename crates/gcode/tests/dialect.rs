@@ -35,7 +35,11 @@ fn g05_1_q_switches_smoothing_and_keeps_the_motion_mode() {
 fn g05_1_needs_q0_or_q1_and_g5_1_with_ij_is_the_spline() {
     let err = program_moves("G05.1 Q2\nM2\n", Config::default()).unwrap_err();
     assert_eq!(err.kind, ErrorKind::SmoothingQ);
-    // With I and J it is LinuxCNC's quadratic spline, which waits for the NURBS moves.
-    let err = program_moves("G21 F10\nG5.1 X1 Y1 I1 J0\nM2\n", Config::default()).unwrap_err();
-    assert_eq!(err.kind, ErrorKind::Unsupported("G5.1".into()));
+    // With I and J it is LinuxCNC's quadratic spline: one NURBS move of degree 2.
+    let moves = program_moves("G21 F10\nG5.1 X1 Y1 I1 J0\nM2\n", Config::default()).unwrap();
+    let spline = moves.iter().find_map(|m| match &m.kind {
+        MoveKind::Nurbs(n) => Some(n.curve.degree()),
+        _ => None,
+    });
+    assert_eq!(spline, Some(2));
 }

@@ -12,7 +12,7 @@ use tezgah_geom::basis::MAX_DEGREE;
 use tezgah_geom::{FeedMode, Nurbs, Plane, Pose, Vec3};
 
 use crate::block::Block;
-use crate::canon::{Canon, CanonSink, NurbsDialect, NurbsFeed};
+use crate::canon::{Canon, CanonSink, NurbsDialect, NurbsFeed, Origin};
 use crate::codes::ggroup;
 use crate::error::ErrorKind;
 
@@ -392,8 +392,13 @@ impl Interpreter {
         }
         validate(order, &open.points, &open.weights, knots).map_err(|e| (e, at))?;
         let end = open.cursor;
-        self.emit(
-            sink,
+        // The move belongs to the G6.2 line that began it, where samples and reports point.
+        let origin = Origin {
+            line: open.line,
+            n: None,
+        };
+        sink.call(
+            origin,
             Canon::NurbsFeed(Box::new(NurbsFeed {
                 dialect: NurbsDialect::Fanuc,
                 order,
