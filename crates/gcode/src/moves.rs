@@ -54,7 +54,8 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
             .iter()
             .map(|&[x, y, z]| Vec3::from(self.machine(Pose([x, y, z, 0.0, 0.0, 0.0])).xyz()))
             .collect();
-        match Nurbs::new(n.order - 1, &points, &n.weights, n.knots.clone()) {
+        let degree = n.order.saturating_sub(1);
+        match Nurbs::new(degree, &points, &n.weights, n.knots.clone()) {
             Ok(curve) => MoveKind::Nurbs(NurbsMove {
                 curve: Arc::new(curve),
                 end,
