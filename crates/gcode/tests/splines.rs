@@ -295,3 +295,93 @@ fn g06_2_takes_comment_lines_and_incremental_points() {
     let inc = the_nurbs(&s);
     assert!((inc.length() - abs.length()).abs() < 1e-9);
 }
+
+mod random {
+    //! Random G06.2 blocks, valid or not: never a panic; when accepted, the move's curve starts
+    //! where the tool was and ends on the move's end point. A fair share must be accepted, so
+    //! the property is not met by rejecting everything.
+
+    use super::*;
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config as RunnerConfig, RngSeed, TestRunner};
+    use tezgah_geom::Vec3;
+
+    type Block = (usize, Vec<f64>, Vec<(f64, f64, f64, f64)>, bool, bool);
+
+    fn blocks() -> impl Strategy<Value = Block> {
+        let order = prop_oneof![9 => 2usize..=4, 1 => Just(5usize)];
+        (order, 0usize..=5).prop_flat_map(|(order, extra)| {
+            let n = (order + extra).saturating_sub(1).max(1);
+            let weight = prop_oneof![15 => 0.1..4.0f64, 1 => -0.5..0.0f64];
+            let point = (-50.0..50.0f64, -50.0..50.0f64, -5.0..5.0f64, weight);
+            (
+                Just(order),
+                proptest::collection::vec(0.0..3.0f64, n + order),
+                proptest::collection::vec(point, n),
+                proptest::bool::weighted(0.9),
+                proptest::bool::weighted(0.9),
+            )
+        })
+    }
+
+    fn program((order, mut knots, points, sorted, clamp): Block) -> (String, Vec3) {
+        if sorted {
+            knots.sort_by(f64::total_cmp);
+        }
+        let n = knots.len();
+        if clamp && n >= 2 * order {
+            let (lo, hi) = (knots[0], knots[n - 1]);
+            knots[..order].fill(lo);
+            knots[n - order..].fill(hi);
+        }
+        let mut s = String::from("G21 G90 G0 X1 Y2 Z3\nF500\n");
+        let mut end = Vec3::new(1.0, 2.0, 3.0);
+        for (i, &(x, y, z, w)) in points.iter().enumerate() {
+            let head = if i == 0 {
+                format!("G06.2 P{order} ")
+            } else {
+                String::new()
+            };
+            let r4 = |v: f64| (v * 1e4).round() / 1e4;
+            if i > 0 {
+                end = Vec3::new(r4(x), r4(y), r4(z));
+            }
+            s += &format!(
+                "{head}K{:.4} X{:.4} Y{:.4} Z{:.4} R{w:.4}\n",
+                knots[i], end.x, end.y, end.z
+            );
+        }
+        for k in &knots[points.len()..] {
+            s += &format!("K{k:.4}\n");
+        }
+        (s + "G1 X0\nM2\n", end)
+    }
+
+    #[test]
+    fn g06_2_never_panics_and_keeps_its_ends() {
+        let config = RunnerConfig {
+            rng_seed: RngSeed::Fixed(0x6062),
+            failure_persistence: None,
+            ..RunnerConfig::with_cases(512)
+        };
+        let mut runner = TestRunner::new(config);
+        let accepted = std::cell::Cell::new(0);
+        runner
+            .run(&blocks(), |block| {
+                let (text, end) = program(block);
+                let Ok(moves) = program_moves(&text, Config::default()) else {
+                    return Ok(());
+                };
+                accepted.set(accepted.get() + 1);
+                let n = nurbs_moves(&moves);
+                prop_assert_eq!(n.len(), 1);
+                let (a, b) = n[0].domain();
+                let start = Vec3::new(1.0, 2.0, 3.0);
+                prop_assert!((n[0].point(a) - start).norm() < 1e-9, "{text}");
+                prop_assert!((n[0].point(b) - end).norm() < 1e-9, "{text}");
+                Ok(())
+            })
+            .unwrap();
+        assert!(accepted.get() > 512 / 4, "only {} accepted", accepted.get());
+    }
+}
