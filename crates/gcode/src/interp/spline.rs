@@ -131,10 +131,16 @@ impl Interpreter {
             };
             points.push([end.0[0] + p, end.0[1] + q]);
             points.push([end.0[0], end.0[1]]);
-            self.spline_memory.g5_ij = [-p, -q];
         }
         let weighted: Vec<[f64; 3]> = points.iter().map(|&[x, y]| [x, y, 1.0]).collect();
-        self.emit_linuxcnc_nurbs(&weighted, points.len(), at, sink)
+        self.emit_linuxcnc_nurbs(&weighted, points.len(), at, sink)?;
+        if g == 50 {
+            // The next G5 without I and J starts along this one's end tangent.
+            if let (Some(p), Some(q)) = (block.get(b'p'), block.get(b'q')) {
+                self.spline_memory.g5_ij = [-p, -q];
+            }
+        }
+        Ok(())
     }
 
     /// G5.2: one control point (or only the first point's weight); LinuxCNC's `convert_nurbs`.
@@ -338,7 +344,7 @@ impl Interpreter {
             .fold(0.0, f64::max);
         if off > FIRST_POINT_TOLERANCE {
             let here = format!("X{:.4} Y{:.4} Z{:.4}", start.0[0], start.0[1], start.0[2]);
-            let axis_at = block.axis_words_at().unwrap_or(at);
+            let axis_at = first_axis_at(block).unwrap_or(at);
             return Err((ErrorKind::G62FirstPoint(here), axis_at));
         }
         // The curve starts exactly where the tool is.
@@ -439,18 +445,12 @@ fn validate(
 }
 
 /// Byte offset of a block's first axis word.
-trait AxisWordsAt {
-    fn axis_words_at(&self) -> Option<u32>;
-}
-
-impl AxisWordsAt for Block {
-    fn axis_words_at(&self) -> Option<u32> {
-        crate::block::AXIS_LETTERS
-            .iter()
-            .filter_map(|&c| self.word(c))
-            .map(|w| w.at)
-            .min()
-    }
+fn first_axis_at(block: &Block) -> Option<u32> {
+    crate::block::AXIS_LETTERS
+        .iter()
+        .filter_map(|&c| block.word(c))
+        .map(|w| w.at)
+        .min()
 }
 
 #[cfg(test)]
