@@ -385,6 +385,8 @@ pub enum ErrorKind {
     G62PointAfterKnots,
     #[error("G6.2 line with no open NURBS: a NURBS ends with its P-th line of K alone (too many knots?); start another with G6.2")]
     G62StrayKnot,
+    #[error("F word missing with inverse time G6.2 move")]
+    G62InverseTimeMissingF,
     #[error("G6.2 order P may be given only on the G6.2 line")]
     G62OrderRepeated,
     #[error("NURBS is not a valid curve: {0}")]

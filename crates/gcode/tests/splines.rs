@@ -296,6 +296,27 @@ fn g06_2_takes_comment_lines_and_incremental_points() {
     assert!((inc.length() - abs.length()).abs() < 1e-9);
 }
 
+#[test]
+fn g06_2_in_inverse_time_runs_its_length_in_one_over_f_minutes() {
+    // F2 under G93: half a minute for 19.0203 mm, a rate of 38.0406 mm/min, set before the move.
+    let text = g06_2(4, &X_239, &Y_239, &[1.0; 10], &K_239, "")
+        .replace("F600\n", "G93\n")
+        .replace("G06.2 P4 K0 ", "G06.2 P4 F2 K0 ")
+        .replace("G1 X0 Y0", "G1 X0 Y0 F1");
+    let moves = program_moves(&text, Config::default()).unwrap();
+    let i = moves
+        .iter()
+        .position(|m| matches!(m.kind, MoveKind::Nurbs(_)))
+        .unwrap();
+    let MoveKind::FeedRate { value } = moves[i - 1].kind else {
+        panic!("{:?}", moves[i - 1]);
+    };
+    assert!((value - 2.0 * 19.0203).abs() < 1e-3, "{value}");
+    let (msg, line, _) = located(&text.replace(" F2 ", " "));
+    assert_eq!(msg, "F word missing with inverse time G6.2 move");
+    assert_eq!(line, 4);
+}
+
 mod random {
     //! Random G06.2 blocks, valid or not: never a panic; when accepted, the move's curve starts
     //! where the tool was and ends on the move's end point. A fair share must be accepted, so

@@ -255,6 +255,6 @@ fn straight_length(d: Pose) -> f64 {
 /// The feed rate an inverse-time move is sent with: its length over its time `1/F`. LinuxCNC
 /// floors it at 0.1 units per minute (`inverse_time_rate_straight`/`_arc`), so a tiny move never
 /// gets a near-zero feed; tezgah does the same to run the same programs at the same speed.
-fn inverse_time_rate(f: f64, length: f64) -> f64 {
+pub(super) fn inverse_time_rate(f: f64, length: f64) -> f64 {
     (length * f).max(0.1)
 }

@@ -9,7 +9,7 @@
 //! one control point with one knot per line, then `order` lines of K alone.
 
 use tezgah_geom::basis::MAX_DEGREE;
-use tezgah_geom::{FeedMode, Nurbs, Plane, Pose, Vec3};
+use tezgah_geom::{Curve, FeedMode, Nurbs, Plane, Pose, Vec3};
 
 use crate::block::Block;
 use crate::canon::{Canon, CanonSink, NurbsDialect, NurbsFeed, Origin};
@@ -17,6 +17,7 @@ use crate::codes::ggroup;
 use crate::error::ErrorKind;
 
 use super::execute::Exec;
+use super::motion::inverse_time_rate;
 use super::Interpreter;
 
 /// The G6.2 code (ten times 6.2).
@@ -56,6 +57,8 @@ struct G62Block {
     closing: usize,
     /// The last control point with its A B C (incremental words are relative to it).
     cursor: Pose,
+    /// Under G93, the G6.2 line's F: the NURBS takes `1/F` minutes.
+    inverse_time: Option<f64>,
 }
 
 /// LinuxCNC's knot vector for `count` control points of order `k` (`knot_vector_creator`):
@@ -319,11 +322,8 @@ impl Interpreter {
             FeedMode::UnitsPerMinute if self.state.feed_rate == 0.0 => {
                 return Err((ErrorKind::NurbsZeroFeed, at));
             }
-            FeedMode::InverseTime => {
-                return Err((
-                    ErrorKind::Unsupported("G6.2 in inverse time (G93)".into()),
-                    at,
-                ));
+            FeedMode::InverseTime if !block.has(b'f') => {
+                return Err((ErrorKind::G62InverseTimeMissingF, at));
             }
             _ => {}
         }
@@ -336,6 +336,9 @@ impl Interpreter {
             knots: Vec::new(),
             closing: 0,
             cursor: start,
+            inverse_time: (self.state.feed_mode == FeedMode::InverseTime)
+                .then(|| block.get(b'f'))
+                .flatten(),
         };
         self.g62_point(block, &mut open, at)?;
         let first = open.points[0];
@@ -396,13 +399,19 @@ impl Interpreter {
         if last.iter().any(|&k| k != last[0]) {
             return Err((ErrorKind::G62NotClamped("last", order, order), at));
         }
-        validate(order, &open.points, &open.weights, knots).map_err(|e| (e, at))?;
+        let curve = validate(order, &open.points, &open.weights, knots).map_err(|e| (e, at))?;
         let end = open.cursor;
         // The move belongs to the G6.2 line that began it, where samples and reports point.
         let origin = Origin {
             line: open.line,
             n: None,
         };
+        if let Some(f) = open.inverse_time {
+            // As a G1 or G2 under G93: the rate that runs the curve's length in 1/F minutes.
+            let rate = inverse_time_rate(f, curve.length());
+            self.state.feed_rate = rate;
+            sink.call(origin, Canon::SetFeedRate(rate));
+        }
         sink.call(
             origin,
             Canon::NurbsFeed(Box::new(NurbsFeed {
@@ -431,16 +440,15 @@ fn push_knot(open: &mut G62Block, k: f64, at: u32) -> Exec {
 }
 
 /// The checks of the curve layer (finite values, knot multiplicities, a non-empty domain), so
-/// that the move built from the call is always a valid curve.
+/// that the move built from the call is always a valid curve; the curve, in program units.
 fn validate(
     order: usize,
     points: &[[f64; 3]],
     weights: &[f64],
     knots: &[f64],
-) -> Result<(), ErrorKind> {
+) -> Result<Nurbs, ErrorKind> {
     let pts: Vec<Vec3> = points.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
     Nurbs::new(order - 1, &pts, weights, knots.to_vec())
-        .map(|_| ())
         .map_err(|e| ErrorKind::NurbsInvalid(e.to_string()))
 }
 
