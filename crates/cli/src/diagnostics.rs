@@ -38,6 +38,7 @@ pub struct Counts {
     rapids: usize,
     feeds: usize,
     arcs: usize,
+    nurbs: usize,
     dwells: usize,
 }
 
@@ -48,6 +49,7 @@ impl CanonSink for Counts {
             Canon::StraightTraverse(_) => self.rapids += 1,
             Canon::StraightFeed(_) => self.feeds += 1,
             Canon::ArcFeed { .. } => self.arcs += 1,
+            Canon::NurbsFeed(_) => self.nurbs += 1,
             Canon::Dwell(_) => self.dwells += 1,
             _ => {}
         }
@@ -58,8 +60,8 @@ impl std::fmt::Display for Counts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "{} lines, {} rapid, {} feed, {} arc moves, {} dwells",
-            self.lines, self.rapids, self.feeds, self.arcs, self.dwells
+            "{} lines, {} rapid, {} feed, {} arc, {} NURBS moves, {} dwells",
+            self.lines, self.rapids, self.feeds, self.arcs, self.nurbs, self.dwells
         )
     }
 }

@@ -132,7 +132,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
-        moves.iter().copied(),
+        moves.iter().cloned(),
         &SmoothOptions {
             tolerance,
             start,

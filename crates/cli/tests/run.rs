@@ -156,3 +156,49 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
         "{err}"
     );
 }
+
+#[test]
+fn spline_example_runs_within_tolerance_and_limits() {
+    // examples/splines.ngc: two G06.2 NURBS (lines 6 and 21), then G5, G5 and G5.1.
+    let (csv, json) = (tmp("sp.csv"), tmp("sp.json"));
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/splines.ngc");
+    let out = tezgah()
+        .args(["run", program, "--samples"])
+        .arg(&csv)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // verify: every sample within the tolerance of the programmed curves, limits held.
+    let tolerance = report["tolerance_mm"].as_f64().unwrap();
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= tolerance);
+    for j in report["joints"].as_array().unwrap() {
+        for q in ["velocity", "acceleration", "jerk"] {
+            let peak = j[format!("peak_{q}")].as_f64().unwrap();
+            let max = j[format!("max_{q}")].as_f64().unwrap();
+            assert!(peak <= 1.005 * max, "{j}");
+        }
+    }
+    // The thesis curve (19.0203 mm at F1200 = 20 mm/s) takes at least 0.951 s; its first
+    // sample is at its start (the tool comes down there and stops).
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    let on_curve: Vec<&Vec<f64>> = rows.iter().filter(|r| r[1] == 6.0).collect();
+    let seconds = on_curve.len() as f64 * 0.001;
+    assert!(seconds >= 19.0203 / 20.0, "{seconds} s on the NURBS");
+    let first = on_curve[0];
+    assert!(first[5].hypot(first[6]) < 0.01, "{first:?}");
+    assert!(rows.iter().any(|r| r[1] == 21.0), "the second NURBS runs");
+}

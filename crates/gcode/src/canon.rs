@@ -42,6 +42,31 @@ pub enum SpindleDir {
     CounterClockwise,
 }
 
+/// Which program dialect a NURBS feed came from: it decides how `canon` prints it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NurbsDialect {
+    /// LinuxCNC's G5, G5.1 and G5.2/G5.3: printed as `rs274` prints `NURBS_FEED`.
+    LinuxCnc,
+    /// Fanuc's G06.2: printed as tezgah's own `NURBS_G6_FEED` (LinuxCNC 2.9 has no G6.2).
+    Fanuc,
+}
+
+/// The data of a NURBS feed, in program coordinates and units (A B C in degrees).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NurbsFeed {
+    pub dialect: NurbsDialect,
+    /// Order (degree + 1): 4 for a cubic.
+    pub order: usize,
+    /// Control points X Y Z; the first is the current point.
+    pub points: Vec<[f64; 3]>,
+    /// One weight per control point, all positive.
+    pub weights: Vec<f64>,
+    /// `points + order` knots, non-decreasing.
+    pub knots: Vec<f64>,
+    /// Where the move ends, all six axes (X Y Z = the last control point).
+    pub end: Pose,
+}
+
 /// One canonical call.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Canon {
@@ -84,6 +109,8 @@ pub enum Canon {
         axis_end: f64,
         abc: [f64; 3],
     },
+    /// A NURBS curve (G5, G5.1, G5.2/G5.3, G06.2). Boxed: control points make it large.
+    NurbsFeed(Box<NurbsFeed>),
     Dwell(f64),
     Comment(String),
     Message(String),
@@ -210,6 +237,11 @@ impl fmt::Display for Canon {
                 "ARC_FEED({first_end:.4}, {second_end:.4}, {first_axis:.4}, {second_axis:.4}, {rotation}, {axis_end:.4}, {:.4}, {:.4}, {:.4})",
                 abc[0], abc[1], abc[2]
             ),
+            NurbsFeed(n) => match n.dialect {
+                // rs274 2.9's saicanon prints only the number of control points.
+                NurbsDialect::LinuxCnc => write!(f, "NURBS_FEED({}, ...)", n.points.len()),
+                NurbsDialect::Fanuc => write_nurbs_g6(f, n),
+            },
             Dwell(s) => write!(f, "DWELL({s:.4})"),
             Comment(s) => write!(f, "COMMENT(\"{s}\")"),
             Message(s) => write!(f, "MESSAGE(\"{s}\")"),
@@ -258,6 +290,22 @@ impl fmt::Display for Canon {
     }
 }
 
+/// `NURBS_G6_FEED(order, n, X Y Z W; …, K k0 k1 …, A, B, C)`: tezgah's own call for G06.2,
+/// every number in `%.4f` as rs274 prints positions.
+fn write_nurbs_g6(f: &mut fmt::Formatter<'_>, n: &NurbsFeed) -> fmt::Result {
+    write!(f, "NURBS_G6_FEED({}, {}, ", n.order, n.points.len())?;
+    for (k, (p, w)) in n.points.iter().zip(&n.weights).enumerate() {
+        let sep = if k == 0 { "" } else { "; " };
+        write!(f, "{sep}{:.4} {:.4} {:.4} {:.4}", p[0], p[1], p[2], w)?;
+    }
+    f.write_str(", K")?;
+    for k in &n.knots {
+        write!(f, " {k:.4}")?;
+    }
+    let e = &n.end.0;
+    write!(f, ", {:.4}, {:.4}, {:.4})", e[3], e[4], e[5])
+}
+
 impl Canon {
     /// Whether this call moves the machine or sets the feed in force: the calls that the
     /// differential tests compare numerically.
@@ -267,6 +315,7 @@ impl Canon {
             Canon::StraightTraverse(_)
                 | Canon::StraightFeed(_)
                 | Canon::ArcFeed { .. }
+                | Canon::NurbsFeed(_)
                 | Canon::Dwell(_)
                 | Canon::SetFeedRate(_)
         )

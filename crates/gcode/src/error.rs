@@ -365,4 +365,59 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
+
+    // --- splines: LinuxCNC's G5, G5.1, G5.2/G5.3 (its wording) ---
+    #[error("Splines must be in the XY plane")]
+    SplineNotXyPlane,
+    #[error("Splines may not have motion in Z, A, B, or C")]
+    SplineOffPlaneMotion,
+    #[error("Must specify both I and J with G5.1")]
+    G51NeedsIJ,
+    #[error("Must specify both I and J, or neither")]
+    G5IJBothOrNeither,
+    #[error("Must specify both P and Q with G5")]
+    G5NeedsPQ,
+    #[error("You must specify both X and Y coordinates for Control Points")]
+    NurbsNeedsXY,
+    #[error("Can specify P without X and Y only for the first control point")]
+    NurbsBareWeight,
+    #[error("Must specify positive weight P for every Control Point")]
+    NurbsWeight,
+    #[error("Cannot make a NURBS with 0 feedrate")]
+    NurbsZeroFeed,
+    #[error("Cannot use G5.3 without G5.2 first")]
+    G53WithoutG52,
+    #[error("You must specify a number of control points at least equal to the order L = {0}")]
+    NurbsTooFewPoints(usize),
+    /// tezgah's own: the curve layer evaluates NURBS up to a fixed degree.
+    #[error("NURBS order L{0} is above the highest order tezgah evaluates ({1})")]
+    NurbsOrderTooHigh(usize, usize),
+
+    // --- Fanuc's G06.2 NURBS block (tezgah's own wording) ---
+    #[error("G6.2 order P{0} must be 2, 3 or 4 (P4 = cubic, the default)")]
+    G62Order(String),
+    #[error("G6.2 control point without its knot: every control point line needs a K word")]
+    G62KnotMissing,
+    #[error("G6.2 weight R{0} must be positive")]
+    G62Weight(String),
+    #[error("G6.2 knots must not decrease: K{0} follows K{1}")]
+    G62KnotDecreasing(String, String),
+    #[error("G6.2 knots must be clamped: the {0} {1} knots must be equal (order P{2})")]
+    G62NotClamped(&'static str, usize, usize),
+    #[error("G6.2 order P{0} needs at least {0} control points; the NURBS has {1}")]
+    G62TooFewPoints(usize, usize),
+    #[error("G6.2 first control point must be the current point ({0})")]
+    G62FirstPoint(String),
+    #[error("G6.2 NURBS begun on line {0} is unfinished: it has {1} of its {2} closing knot lines (K alone); a NURBS of n control points and order P needs n + P knots")]
+    G62Unfinished(u32, usize, usize),
+    #[error("G6.2 control point after the closing knot lines (K alone) began")]
+    G62PointAfterKnots,
+    #[error("G6.2 line with no open NURBS: a NURBS ends with its P-th line of K alone (too many knots?); start another with G6.2")]
+    G62StrayKnot,
+    #[error("F word missing with inverse time G6.2 move")]
+    G62InverseTimeMissingF,
+    #[error("G6.2 order P may be given only on the G6.2 line")]
+    G62OrderRepeated,
+    #[error("NURBS is not a valid curve: {0}")]
+    NurbsInvalid(String),
 }

@@ -9,11 +9,14 @@
 //! length is not added along Z: moves carry the tool tip, and the length travels in a
 //! [`MoveKind::ToolControl`] move, for the kinematics to apply along the tool axis.
 
+use std::sync::Arc;
+
 use tezgah_geom::{
-    ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, StopKind, ToolControl,
+    ArcMove, FeedMode, Move, MoveKind, Nurbs, NurbsMove, PathMode, Plane, Pose, StopKind,
+    ToolControl, Vec3,
 };
 
-use crate::canon::{Canon, CanonSink, ControlMode, Origin, Units};
+use crate::canon::{Canon, CanonSink, ControlMode, NurbsFeed, Origin, Units};
 use crate::interp::state_rotate_xy as rotate_xy;
 
 /// A [`CanonSink`] that turns calls into [`Move`]s and hands them to `out`.
@@ -65,10 +68,14 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
     /// Machine position in mm of program point `p` (program units); remembers it as the
     /// current point.
     fn machine(&mut self, p: Pose) -> Pose {
-        let tipless =
-            (self.g5x + rotate_xy(p + self.g92, self.rotation)).scale_linear(self.units.mm());
+        let tipless = self.tipless_of(p);
         self.tipless = tipless;
         self.with_tool(tipless)
+    }
+
+    /// Machine position in mm of program point `p` without any tool offset.
+    fn tipless_of(&self, p: Pose) -> Pose {
+        (self.g5x + rotate_xy(p + self.g92, self.rotation)).scale_linear(self.units.mm())
     }
 
     /// A tip-less point as the moves carry it: with the tool offset added when TCP is off.
@@ -88,6 +95,31 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
         };
         let at = self.with_tool(self.tipless);
         self.push(line, MoveKind::ToolControl { control, at });
+    }
+
+    /// A NURBS call as a move: every control point through the same affine map as an end
+    /// point, which maps the curve exactly; weights and knots are unchanged by it.
+    fn nurbs(&mut self, n: &NurbsFeed) -> MoveKind {
+        let end = self.machine(n.end);
+        let points: Vec<Vec3> = n
+            .points
+            .iter()
+            .map(|&[x, y, z]| {
+                let p = self.with_tool(self.tipless_of(Pose([x, y, z, 0.0, 0.0, 0.0])));
+                Vec3::from(p.xyz())
+            })
+            .collect();
+        let degree = n.order.saturating_sub(1);
+        match Nurbs::new(degree, &points, &n.weights, n.knots.clone()) {
+            Ok(curve) => MoveKind::Nurbs(NurbsMove {
+                curve: Arc::new(curve),
+                end,
+            }),
+            // The interpreter validated the same curve in program coordinates, and an affine
+            // map keeps it valid; should a caller hand over one that is not, the tool still
+            // ends where the call says.
+            Err(_) => MoveKind::Feed { end },
+        }
     }
 
     fn push(&mut self, line: u32, kind: MoveKind) {
@@ -159,6 +191,10 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                         turn: rotation,
                     }),
                 );
+            }
+            Canon::NurbsFeed(n) => {
+                let kind = self.nurbs(&n);
+                self.push(line, kind);
             }
             Canon::Dwell(seconds) => self.push(line, MoveKind::Dwell { seconds }),
             Canon::SetFeedRate(f) => {

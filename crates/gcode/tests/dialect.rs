@@ -35,7 +35,35 @@ fn g05_1_q_switches_smoothing_and_keeps_the_motion_mode() {
 fn g05_1_needs_q0_or_q1_and_g5_1_with_ij_is_the_spline() {
     let err = program_moves("G05.1 Q2\nM2\n", Config::default()).unwrap_err();
     assert_eq!(err.kind, ErrorKind::SmoothingQ);
-    // With I and J it is LinuxCNC's quadratic spline, which waits for the NURBS moves.
-    let err = program_moves("G21 F10\nG5.1 X1 Y1 I1 J0\nM2\n", Config::default()).unwrap_err();
-    assert_eq!(err.kind, ErrorKind::Unsupported("G5.1".into()));
+    // With I and J it is LinuxCNC's quadratic spline: one NURBS move of degree 2.
+    let moves = program_moves("G21 F10\nG5.1 X1 Y1 I1 J0\nM2\n", Config::default()).unwrap();
+    let spline = moves.iter().find_map(|m| match &m.kind {
+        MoveKind::Nurbs(n) => Some(n.curve.degree()),
+        _ => None,
+    });
+    assert_eq!(spline, Some(2));
+}
+
+#[test]
+fn splines_are_refused_under_cutter_compensation() {
+    for spline in [
+        "G5 I1 J0 P-1 Q0 X10 Y0",
+        "G5.1 I1 J1 X10 Y0",
+        "G5.2 X1 Y1 P1\nX2 Y0 P1\nX3 Y1 P1\nG5.3",
+        "G6.2 P3 K0 X0 Y0 Z0\nK0 X1 Y1 Z0\nK0 X2 Y0 Z0\nK1\nK1\nK1",
+    ] {
+        let program = format!("G21 G0 X0 Y0\nG41.1 D1\nF100\n{spline}\nM2\n");
+        let err = tezgah_gcode::Interpreter::new(tezgah_gcode::Config::default())
+            .run(
+                &program,
+                &mut Vec::<(tezgah_gcode::Origin, tezgah_gcode::Canon)>::new(),
+            )
+            .expect_err(spline);
+        assert_eq!(
+            err.kind.to_string(),
+            "Cannot convert spline with cutter radius compensation",
+            "{spline}"
+        );
+        assert_eq!(err.span.line, 4, "{spline}");
+    }
 }

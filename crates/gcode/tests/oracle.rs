@@ -34,10 +34,11 @@ const ABS_TOL: f64 = 1e-4;
 const REL_TOL: f64 = 1e-9;
 
 /// Names of the calls `Canon::is_motion` selects, as `rs274` prints them.
-const MOTION_CALLS: [&str; 5] = [
+const MOTION_CALLS: [&str; 6] = [
     "STRAIGHT_TRAVERSE",
     "STRAIGHT_FEED",
     "ARC_FEED",
+    "NURBS_FEED",
     "DWELL",
     "SET_FEED_RATE",
 ];
@@ -230,6 +231,23 @@ enum Item {
     },
     /// A contour cut with cutter radius compensation: see [`CompContour`].
     Comp(CompContour),
+    /// LinuxCNC's G5 (I J given or taken from the previous G5) or G5.1: X Y end words (one
+    /// may be missing), sometimes a Z word (an error: splines stay in XY).
+    Spline {
+        quadratic: bool,
+        ij: Option<(f64, f64)>,
+        pq: (f64, f64),
+        end: (Option<f64>, Option<f64>),
+        z: Option<f64>,
+        f: f64,
+    },
+    /// G5.2 with (X, Y, weight) control points and an optional order L, then G5.3. A weight
+    /// of zero after the first point is an error both must report.
+    Nurbs {
+        points: Vec<(f64, f64, f64)>,
+        order: Option<u8>,
+        f: f64,
+    },
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
@@ -314,6 +332,8 @@ struct Writer {
     tool_offset: bool,
     /// A G43, G43.1 or G49 was written: no M6 from then on.
     tool_length_used: bool,
+    /// A G5, G5.1 or G5.2 was written: no M6 from then on (see `Item::Tool`).
+    spline_used: bool,
     /// O-word labels used so far (each loop gets its own).
     labels: u32,
     /// Which of `SUBROUTINES` the program calls (their bodies follow M2).
@@ -333,6 +353,7 @@ impl Writer {
             changed_tool: false,
             tool_offset: false,
             tool_length_used: false,
+            spline_used: false,
             rotation_used: false,
             labels: 0,
             used_subs: [false; SUBROUTINES.len()],
@@ -765,8 +786,9 @@ impl Writer {
                 // does not copy that: a program has tool length words or M6, not both (no M6
                 // after G43/G43.1/G49 here, no G43/G43.1/G49 after M6 below).
                 // The same re-read loses an XY rotation's effect on the point, so no M6 once a
-                // G10 has given a rotation either (and no rotation after M6, below).
-                let change = if self.tool_length_used || self.rotation_used {
+                // G10 has given a rotation either (and no rotation after M6, below). Nor once a
+                // spline was made: rs274's canon prints NURBS_FEED without moving its point.
+                let change = if self.tool_length_used || self.rotation_used || self.spline_used {
                     &0
                 } else {
                     change
@@ -902,6 +924,58 @@ impl Writer {
                     self.text.push_str("G91\n");
                 }
                 self.forget();
+            }
+            Item::Spline {
+                quadratic,
+                ij,
+                pq,
+                end,
+                z,
+                f,
+            } => {
+                // Mostly select G17 first: outside it every spline is an error.
+                let g17 = if self.plane != 0 && pq.0 >= -15.0 {
+                    self.plane = 0;
+                    "G17 "
+                } else {
+                    ""
+                };
+                let mut words = format!(
+                    "{}{g17}G{}",
+                    Self::extra(deco),
+                    if *quadratic { "5.1" } else { "5" }
+                );
+                let axes: Axes = [end.0, end.1, *z, None, None, None];
+                words.push_str(&axis_words(&axes));
+                if let Some((i, j)) = ij {
+                    words.push_str(&format!(" I{} J{}", num(*i), num(*j)));
+                }
+                if !*quadratic {
+                    words.push_str(&format!(" P{} Q{}", num(pq.0), num(pq.1)));
+                }
+                words.push_str(&self.feed_word(*f, false));
+                self.block(deco, &words);
+                self.move_to(&axes);
+                self.spline_used = true;
+            }
+            Item::Nurbs { points, order, f } => {
+                for (k, (x, y, w)) in points.iter().enumerate() {
+                    let mut words = format!("X{} Y{} P{}", num(*x), num(*y), num(*w));
+                    if k == 0 {
+                        words = format!("G5.2 {words}");
+                        if let Some(l) = order {
+                            words.push_str(&format!(" L{l}"));
+                        }
+                        words.push_str(&self.feed_word(*f, false));
+                    }
+                    self.block(deco, &words);
+                }
+                self.block(deco, "G5.3");
+                self.spline_used = true;
+                // Every point is relative to the start under G91: the end is the last one.
+                if let Some(&(x, y, _)) = points.last() {
+                    self.move_to(&[Some(x), Some(y), None, None, None, None]);
+                }
             }
             Item::Comment(c) => self.block(deco, COMMENTS[*c]),
             Item::Faulty(k) => self.block(deco, FAULTY[*k]),
@@ -1178,6 +1252,8 @@ fn item() -> impl Strategy<Value = Item> {
             .prop_map(|(sub, args)| Item::Call { sub, args }),
         1 => (0..COMMENTS.len()).prop_map(Item::Comment),
         3 => comp_contour().prop_map(Item::Comp),
+        3 => spline(),
+        2 => nurbs(),
     ];
     // About one program in twelve ends early on an error.
     prop_oneof![
@@ -1218,6 +1294,66 @@ fn comp_contour() -> impl Strategy<Value = CompContour> {
                 f,
             },
         )
+}
+
+/// G5 or G5.1 with words drawn so that most blocks are valid.
+fn spline() -> impl Strategy<Value = Item> {
+    let pair = || (value(20.0), value(20.0));
+    (
+        any::<bool>(),
+        proptest::option::weighted(0.7, pair()),
+        pair(),
+        (
+            proptest::option::weighted(0.9, value(40.0)),
+            proptest::option::weighted(0.9, value(40.0)),
+        ),
+        proptest::option::weighted(0.01, value(10.0)),
+        feed(),
+    )
+        .prop_map(|(quadratic, ij, pq, mut end, z, f)| {
+            if end.0.is_none() && end.1.is_none() {
+                end.0 = Some(1.0);
+            }
+            // G5.1 needs both I and J; leave them out only rarely there.
+            let ij = if quadratic {
+                ij.or(Some((1.0, 0.5)))
+            } else {
+                ij
+            };
+            Item::Spline {
+                quadratic,
+                ij,
+                pq,
+                end,
+                z,
+                f,
+            }
+        })
+}
+
+/// A G5.2 … G5.3 series of 1 to 7 points.
+fn nurbs() -> impl Strategy<Value = Item> {
+    let point = || {
+        (
+            value(40.0),
+            value(40.0),
+            prop_oneof![80 => positive(0.1, 5.0), 1 => Just(0.0)],
+        )
+    };
+    // Mostly enough points for the order (the start point counts as one).
+    let count = prop_oneof![1 => 1usize..=2, 8 => 3usize..=7];
+    (
+        count.prop_flat_map(move |n| proptest::collection::vec(point(), n)),
+        proptest::option::weighted(0.5, 2u8..=5),
+        feed(),
+    )
+        .prop_map(|(mut points, order, f)| {
+            // The first line's weight must be positive for tezgah (rs274 takes any).
+            if points[0].2 == 0.0 {
+                points[0].2 = 1.0;
+            }
+            Item::Nurbs { points, order, f }
+        })
 }
 
 fn program() -> impl Strategy<Value = Vec<(Item, Deco)>> {
@@ -1411,6 +1547,7 @@ fn agrees_with_rs274() {
     let counter = AtomicUsize::new(0);
     let rejected = AtomicUsize::new(0);
     let motions = AtomicUsize::new(0);
+    let nurbs = AtomicUsize::new(0);
     let result = runner.run(&program(), |items| {
         let text = render(&items);
         let k = counter.fetch_add(1, Ordering::Relaxed);
@@ -1423,6 +1560,11 @@ fn agrees_with_rs274() {
             rejected.fetch_add(1, Ordering::Relaxed);
         }
         motions.fetch_add(theirs.motion().len(), Ordering::Relaxed);
+        let splines = theirs
+            .motion()
+            .into_iter()
+            .filter(|c| call_name(c) == "NURBS_FEED");
+        nurbs.fetch_add(splines.count(), Ordering::Relaxed);
         match compare(&theirs, &ours) {
             None => Ok(()),
             Some(why) => Err(TestCaseError::fail(format!(
@@ -1436,9 +1578,10 @@ fn agrees_with_rs274() {
     match result {
         Ok(()) => eprintln!(
             "rs274 and tezgah agree on {} random programs (seed {seed:#x}): {} motion calls \
-             compared, {} programs rejected by both",
+             compared ({} NURBS_FEED), {} programs rejected by both",
             counter.load(Ordering::Relaxed),
             motions.load(Ordering::Relaxed),
+            nurbs.load(Ordering::Relaxed),
             rejected.load(Ordering::Relaxed)
         ),
         Err(TestError::Fail(why, _)) => panic!("tezgah disagrees with rs274: {why}"),

@@ -28,7 +28,9 @@ pub use bezier::Bezier;
 pub use curve::{Curve, Vec3};
 pub use error::CurveError;
 pub use line::Line;
-pub use moves::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, StopKind, ToolControl, Turn};
+pub use moves::{
+    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, StopKind, ToolControl, Turn,
+};
 pub use nurbs::Nurbs;
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};

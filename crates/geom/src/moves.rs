@@ -4,6 +4,9 @@
 //! offsets and tool length already applied). Each move carries the 1-based source line it came
 //! from so that samples, reports and errors can point back at the program.
 
+use std::sync::Arc;
+
+use crate::nurbs::Nurbs;
 use crate::pose::Pose;
 
 /// The plane of an arc: G17 (XY), G18 (ZX) or G19 (YZ).
@@ -42,8 +45,23 @@ pub struct ArcMove {
     pub turn: Turn,
 }
 
+/// A NURBS feed move (G5, G5.1, G5.2/G5.3, G06.2): the whole curve is one move.
+///
+/// The curve's control points are tool-tip positions in mm, in the same frame as every other
+/// move's end (work offsets, XY rotation and tool length applied: all three are affine maps, and
+/// a NURBS mapped point by point through an affine map is the mapped curve). The curve starts at
+/// the position before the move. Rotary axes run from their start values to `end`'s in
+/// proportion to arc length, as along an arc.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NurbsMove {
+    /// Shared, so that copying a move never copies its control points.
+    pub curve: Arc<Nurbs>,
+    /// End of the move (all six axes); its X Y Z is the curve's last point.
+    pub end: Pose,
+}
+
 /// What a move does.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum MoveKind {
     /// G0: straight line at the machine's rapid speed.
     Rapid { end: Pose },
@@ -51,6 +69,8 @@ pub enum MoveKind {
     Feed { end: Pose },
     /// G2/G3: arc or helix at the programmed feed.
     Arc(ArcMove),
+    /// G5, G5.1, G5.2/G5.3, G06.2: a NURBS curve at the programmed feed.
+    Nurbs(NurbsMove),
     /// G4: wait, motion stopped.
     Dwell { seconds: f64 },
     /// The feed in force from here on, mm/min (or 1/min in inverse time, mm/rev with G95).
@@ -130,7 +150,7 @@ pub enum StopKind {
 }
 
 /// One move with the source line it came from.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Move {
     pub line: u32,
     pub kind: MoveKind,

@@ -99,7 +99,7 @@ fn bench(c: &mut Criterion) {
         };
         g.bench_function(name, |b| {
             b.iter(|| {
-                let sm = Smoother::new(program.iter().copied(), opts.clone()).unwrap();
+                let sm = Smoother::new(program.iter().cloned(), opts.clone()).unwrap();
                 let mut n = 0usize;
                 for item in sm {
                     black_box(item.unwrap());

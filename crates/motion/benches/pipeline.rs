@@ -75,7 +75,7 @@ fn parse(text: &str) -> Vec<Move> {
 /// The smoothing builder as `tezgah run` sets it up.
 fn smooth_items(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
     smooth::build(
-        moves.iter().copied(),
+        moves.iter().cloned(),
         &SmoothOptions {
             tolerance: machine.motion.tolerance_mm,
             start: Pose::ZERO,

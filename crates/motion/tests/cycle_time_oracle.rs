@@ -75,7 +75,7 @@ fn moves_of(text: &str) -> Vec<Move> {
 
 fn items_of(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
     smooth::build(
-        moves.iter().copied(),
+        moves.iter().cloned(),
         &SmoothOptions {
             tolerance: machine.motion.tolerance_mm,
             start: Pose::ZERO,

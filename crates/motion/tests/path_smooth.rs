@@ -399,7 +399,7 @@ fn ratio(moves: &[Move], verts: &[Vec3]) -> (usize, usize, usize, f64) {
         start,
         ..SmoothOptions::default()
     };
-    let mut sm = Smoother::new(moves.iter().copied(), opts).unwrap();
+    let mut sm = Smoother::new(moves.iter().cloned(), opts).unwrap();
     let items: Vec<PathItem> = sm.by_ref().collect::<Result<_, _>>().unwrap();
     let stats = sm.stats();
     check_path(&items, verts).unwrap();

@@ -30,7 +30,7 @@ fn saw(deg: f64) -> Vec<Move> {
 
 fn items(moves: &[Move]) -> Vec<PathItem> {
     smooth::build(
-        moves.iter().copied(),
+        moves.iter().cloned(),
         &SmoothOptions {
             tolerance: 0.01,
             start: Pose::ZERO,

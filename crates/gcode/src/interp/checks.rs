@@ -60,7 +60,7 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
             if covets_axes {
                 return Err((ErrorKind::TwoGCodesUseAxes, at_g(ggroup::NON_MODAL)));
             }
-            if !axes && !matches!(m, 0 | 10 | 20 | 30 | 52) {
+            if !axes && !matches!(m, 0 | 10 | 20 | 30 | 52 | 53) {
                 return Err((ErrorKind::AllAxesMissingWithMotion, at_g(ggroup::MOTION)));
             }
             Some(m)
@@ -78,6 +78,8 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
             }
             m => m,
         },
+        // Fanuc's G6.2: the lines of K alone that close a NURBS carry no axis words.
+        None if state.motion == Some(62) && block.has(b'k') => Some(62),
         None => None,
     };
     check_g_codes(block, state, motion)?;
@@ -199,7 +201,7 @@ fn check_other_words(
     rule(b'j', ij_user, ErrorKind::JWordUnused)?;
     rule(
         b'k',
-        arc || matches!(motion, Some(330 | 331 | 760 | 870)),
+        arc || matches!(motion, Some(330 | 331 | 760 | 870 | 62)),
         ErrorKind::KWordUnused,
     )?;
     rule(
@@ -216,7 +218,7 @@ fn check_other_words(
         || block.g(ggroup::PATH_CONTROL) == Some(640)
         || matches!(
             motion,
-            Some(50 | 52 | 740 | 760 | 820 | 840 | 860 | 880 | 890)
+            Some(50 | 52 | 62 | 740 | 760 | 820 | 840 | 860 | 880 | 890)
         )
         || matches!(m(mgroup::OVERRIDE), Some(50..=53))
         || m(mgroup::SUBPROGRAM) == Some(98)
@@ -234,7 +236,7 @@ fn check_other_words(
     rule(b'q', q_user, ErrorKind::QWordUnused)?;
     rule(
         b'r',
-        arc || g10 || cycle || matches!(m(mgroup::SPINDLE), Some(19)),
+        arc || g10 || cycle || motion == Some(62) || matches!(m(mgroup::SPINDLE), Some(19)),
         ErrorKind::RWordUnused,
     )?;
     Ok(())

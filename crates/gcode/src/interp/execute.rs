@@ -31,6 +31,8 @@ impl Interpreter {
         }
         let plan = checks::check(block, &self.state)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
+        self.g62_guard(block, plan.motion)
+            .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.assign_parameters(block)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.execute_words(block, plan, sink)

@@ -13,6 +13,7 @@ mod control;
 mod cycles;
 mod execute;
 mod motion;
+mod spline;
 mod state;
 mod system;
 mod tcp;
@@ -113,6 +114,8 @@ pub struct Interpreter {
     closing_percent_sought: bool,
     /// Subroutine files loaded so far; file k of a [`LinePos`] is `files[k - 1]`.
     files: Vec<SubroutineFile>,
+    /// What spline blocks carry from block to block (G5 tangent, open G5.2 and G6.2 NURBS).
+    spline_memory: spline::SplineMemory,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -176,6 +179,7 @@ impl Interpreter {
             comp: comp::CutterComp::default(),
             closing_percent_sought: false,
             files: Vec::new(),
+            spline_memory: Default::default(),
         };
         interp.restore_parameters();
         interp

@@ -22,11 +22,25 @@ impl Interpreter {
         if !matches!(g, 730 | 740 | 810..=890) {
             self.state.cycle_initial_level = None;
         }
+        // LinuxCNC refuses G5/G5.1 under cutter compensation; tezgah refuses every spline
+        // there (LinuxCNC would send a G5.2 NURBS uncompensated, cutting the wrong contour).
+        if matches!(g, 50 | 51 | 52 | 62) && self.comp.side.is_some() {
+            return Err((CompError::Spline.into(), at));
+        }
         match g {
             0 | 10 => self.straight(block, g == 0, at, sink)?,
             20 | 30 => self.arc(block, g == 20, at, sink)?,
             800 => self.comment_call(sink, "motion mode set to none".into()),
             730 | 740 | 810..=890 => self.cycle(block, g, at, sink)?,
+            50 | 51 => self.spline(block, g, at, sink)?,
+            52 => self.nurbs_point(block, at)?,
+            53 => {
+                // G5.3 closes the series and leaves no motion mode, as in LinuxCNC.
+                self.nurbs_end(at, sink)?;
+                self.state.motion = None;
+                return Ok(());
+            }
+            62 => self.g62_line(block, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);
@@ -34,7 +48,7 @@ impl Interpreter {
     }
 
     /// End point of the block's axis words, absolute, incremental or (G53) machine.
-    fn find_ends(&self, block: &Block) -> Pose {
+    pub(super) fn find_ends(&self, block: &Block) -> Pose {
         let s = &self.state;
         if block.g(ggroup::NON_MODAL) == Some(530) {
             let m = block.axes_over(s.to_machine(s.pos) + s.tool_offset);
@@ -284,6 +298,6 @@ fn straight_length(d: Pose) -> f64 {
 /// The feed rate an inverse-time move is sent with: its length over its time `1/F`. LinuxCNC
 /// floors it at 0.1 units per minute (`inverse_time_rate_straight`/`_arc`), so a tiny move never
 /// gets a near-zero feed; tezgah does the same to run the same programs at the same speed.
-fn inverse_time_rate(f: f64, length: f64) -> f64 {
+pub(super) fn inverse_time_rate(f: f64, length: f64) -> f64 {
     (length * f).max(0.1)
 }

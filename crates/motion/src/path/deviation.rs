@@ -7,7 +7,7 @@
 //! sharp corner short is seen here). Nearest pieces are found with a bounding-box filter.
 
 use tezgah_geom::deviation::{closest_point, maximise, point_segment_distance, DEFAULT_SAMPLES};
-use tezgah_geom::{Arc, Curve, Line, Move, MoveKind, Pose, Vec3};
+use tezgah_geom::{Arc, Curve, Line, Move, MoveKind, Nurbs, Pose, Vec3};
 
 use crate::path::PathItem;
 
@@ -15,6 +15,7 @@ use crate::path::PathItem;
 enum Prog {
     Line(Line),
     Arc(Arc),
+    Nurbs(std::sync::Arc<Nurbs>),
 }
 
 struct Boxed<T> {
@@ -70,23 +71,24 @@ fn programmed(start: Pose, moves: &[Move]) -> (Vec<Boxed<Prog>>, Vec<Vec3>) {
     let mut out = Vec::new();
     let mut vertices = vec![Vec3::from(start.xyz())];
     for m in moves {
-        let (item, end) = match m.kind {
-            MoveKind::Rapid { end } | MoveKind::Feed { end } => {
+        let (item, end) = match &m.kind {
+            &MoveKind::Rapid { end } | &MoveKind::Feed { end } => {
                 match Line::new(Vec3::from(pos.xyz()), Vec3::from(end.xyz())) {
                     Ok(l) => (Prog::Line(l), end),
                     Err(_) => continue,
                 }
             }
-            MoveKind::Arc(a) => match Arc::from_move(&pos, &a) {
+            MoveKind::Arc(a) => match Arc::from_move(&pos, a) {
                 Ok(arc) => (Prog::Arc(arc), a.end),
                 Err(_) => continue,
             },
             // A TCP switch moves nothing; the next move starts from the point read anew.
-            MoveKind::ToolControl { at, .. } => {
+            &MoveKind::ToolControl { at, .. } => {
                 pos = at;
                 vertices.push(Vec3::from(pos.xyz()));
                 continue;
             }
+            MoveKind::Nurbs(n) => (Prog::Nurbs(n.curve.clone()), n.end),
             _ => continue,
         };
         let (lo, hi) = match &item {
@@ -94,6 +96,11 @@ fn programmed(start: Pose, moves: &[Move]) -> (Vec<Boxed<Prog>>, Vec<Vec3>) {
             // Chord sagitta between 64 samples of an arc is tiny; pad by a tenth of the radius
             // over 64 to stay a true bound.
             Prog::Arc(a) => bbox_of(a, a.radius().max(a.end_radius()) * 0.01),
+            // A NURBS lies in the convex hull of its control points: a true bound.
+            Prog::Nurbs(c) => c.control_points().iter().fold(
+                (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY)),
+                |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+            ),
         };
         out.push(Boxed { item, lo, hi });
         pos = end;
@@ -109,6 +116,10 @@ fn prog_distance(p: &Prog, q: &Vec3) -> f64 {
             let (u0, u1) = a.domain();
             closest_point(a, q, u0, u1, 16).distance
         }),
+        Prog::Nurbs(c) => {
+            let (u0, u1) = c.domain();
+            closest_point(c.as_ref(), q, u0, u1, 16 * c.control_points().len()).distance
+        }
     }
 }
 

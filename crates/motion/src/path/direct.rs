@@ -143,23 +143,23 @@ impl Direct {
     /// Takes one move; finished items are appended to `out`.
     pub fn push(&mut self, m: &Move, out: &mut Vec<PathItem>) -> Result<(), DirectError> {
         let line = m.line;
-        let (curve, end, rapid): (Box<dyn Curve + Send + Sync>, Pose, bool) = match m.kind {
-            MoveKind::FeedRate { value } => {
+        let (curve, end, rapid): (Box<dyn Curve + Send + Sync>, Pose, bool) = match &m.kind {
+            &MoveKind::FeedRate { value } => {
                 self.feed_rate = value;
                 return Ok(());
             }
-            MoveKind::FeedMode(mode) => {
+            &MoveKind::FeedMode(mode) => {
                 self.feed_mode = mode;
                 return Ok(());
             }
-            MoveKind::PathMode(mode) => {
+            &MoveKind::PathMode(mode) => {
                 self.path_mode = mode;
                 return Ok(());
             }
             // The direct builder never compresses: G05.1 changes nothing here.
             MoveKind::Smoothing(_) => return Ok(()),
             // TCP switched: stop; the next move starts from the same point read the new way.
-            MoveKind::ToolControl { control, at } => {
+            &MoveKind::ToolControl { control, at } => {
                 if !at.0.iter().all(|v| v.is_finite()) {
                     return Err(DirectError::NotFinite { line });
                 }
@@ -168,7 +168,7 @@ impl Direct {
                 self.position = at;
                 return Ok(());
             }
-            MoveKind::Dwell { seconds } => {
+            &MoveKind::Dwell { seconds } => {
                 if !(seconds.is_finite() && seconds >= 0.0) {
                     return Err(DirectError::BadDwell { line, seconds });
                 }
@@ -176,7 +176,7 @@ impl Direct {
                 out.push(PathItem::Dwell { seconds, line });
                 return Ok(());
             }
-            MoveKind::Stop(kind) => {
+            &MoveKind::Stop(kind) => {
                 // M1 is honoured only with optional stop on, which `run` does not set.
                 if kind != StopKind::OptionalPause {
                     self.flush(Junction::Stop, out);
@@ -184,19 +184,22 @@ impl Direct {
                 }
                 return Ok(());
             }
-            MoveKind::Rapid { end } | MoveKind::Feed { end } => {
+            &MoveKind::Rapid { end } | &MoveKind::Feed { end } => {
                 let a = Vec3::from(self.position.xyz());
                 let b = Vec3::from(end.xyz());
                 let l = Line::new(a, b).map_err(|_| DirectError::NotFinite { line })?;
                 (Box::new(l), end, matches!(m.kind, MoveKind::Rapid { .. }))
             }
             MoveKind::Arc(arc) => {
-                let c = Arc::from_move(&self.position, &arc).map_err(|e| DirectError::BadArc {
+                let c = Arc::from_move(&self.position, arc).map_err(|e| DirectError::BadArc {
                     line,
                     reason: e.to_string(),
                 })?;
                 (Box::new(c), arc.end, false)
             }
+            // One curve segment, never split: a corner or tangent junction at each end as for
+            // an arc.
+            MoveKind::Nurbs(n) => (Box::new((*n.curve).clone()), n.end, false),
         };
         if !end.0.iter().all(|v| v.is_finite()) {
             return Err(DirectError::NotFinite { line });

@@ -204,6 +204,8 @@ pub enum CompError {
     ToolOffset,
     #[error("Cannot use canned cycles with cutter compensation on")]
     CannedCycle,
+    #[error("Cannot convert spline with cutter radius compensation")]
+    Spline,
 }
 
 /// The (first, second, normal) axis indices of the compensation plane.

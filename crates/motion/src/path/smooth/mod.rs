@@ -231,16 +231,16 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
     fn tokenise(&mut self, mv: Move) -> Result<Option<Tok>, PathError> {
         let line = mv.line;
         let m = &mut self.modal;
-        let (geo, end) = match mv.kind {
-            MoveKind::FeedRate { value } => {
+        let (geo, end) = match &mv.kind {
+            &MoveKind::FeedRate { value } => {
                 m.feed = Some(value);
                 return Ok(None);
             }
-            MoveKind::FeedMode(f) => {
+            &MoveKind::FeedMode(f) => {
                 m.feed_mode = f;
                 return Ok(None);
             }
-            MoveKind::PathMode(p) => {
+            &MoveKind::PathMode(p) => {
                 match p {
                     PathMode::ExactStop => m.mode = Mode::ExactStop,
                     PathMode::ExactPath => m.mode = Mode::ExactPath,
@@ -256,11 +256,11 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 return Ok(None);
             }
             // Fanuc's G05.1 Q1/Q0 switches compression of short moves on and off.
-            MoveKind::Smoothing(on) => {
+            &MoveKind::Smoothing(on) => {
                 self.opts.compress = on;
                 return Ok(None);
             }
-            MoveKind::ToolControl { control, at } => {
+            &MoveKind::ToolControl { control, at } => {
                 if control == m.control && at == m.pos {
                     return Ok(None);
                 }
@@ -275,21 +275,24 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 m.pos = at;
                 return Ok(Some(Tok::Control(control)));
             }
-            MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
-            MoveKind::Stop(StopKind::Pause)
-            | MoveKind::Stop(StopKind::OptionalPause)
-            | MoveKind::Stop(StopKind::PalletPause)
-            | MoveKind::Stop(StopKind::End) => return Ok(Some(Tok::Stop { line })),
-            MoveKind::Rapid { end } | MoveKind::Feed { end } => {
+            &MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
+            &MoveKind::Stop(StopKind::Pause)
+            | &MoveKind::Stop(StopKind::OptionalPause)
+            | &MoveKind::Stop(StopKind::PalletPause)
+            | &MoveKind::Stop(StopKind::End) => return Ok(Some(Tok::Stop { line })),
+            &MoveKind::Rapid { end } | &MoveKind::Feed { end } => {
                 let l = Line::new(Vec3::from(m.pos.xyz()), Vec3::from(end.xyz()))
                     .map_err(|source| PathError::Curve { line, source })?;
                 (Geo::Line(l), end)
             }
             MoveKind::Arc(a) => {
-                let arc = Arc::from_move(&m.pos, &a)
+                let arc = Arc::from_move(&m.pos, a)
                     .map_err(|source| PathError::Curve { line, source })?;
                 (Geo::Arc(Box::new(arc)), a.end)
             }
+            // A programmed NURBS is one piece: compression takes only lines, so it is never
+            // refitted, and its ends are blended or cornered like an arc's.
+            MoveKind::Nurbs(n) => (Geo::Spline(Box::new((*n.curve).clone())), n.end),
         };
         if !end.0.iter().all(|c| c.is_finite()) {
             return Err(PathError::Curve {
