@@ -266,6 +266,12 @@ pub enum ErrorKind {
     WordsAfterOWord,
     #[error("Nested subroutine definition")]
     NestedSubroutine,
+    #[error("line:{0} sub: o|{1}| found in illegal location")]
+    SubInIllegalLocation(u32, String),
+    #[error("line:{0} redefining sub: o|{1}| already defined")]
+    SubRedefined(u32, String),
+    #[error("Failed to find sub 'O{0}' before EOF")]
+    SkippedPastPercent(String),
     #[error("Unable to find subroutine o{0}")]
     SubroutineNotFound(String),
     #[error("{0} o{1} without a matching start")]

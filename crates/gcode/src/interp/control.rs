@@ -161,6 +161,18 @@ impl Control {
     pub fn skipping(&self) -> bool {
         self.skip.is_some()
     }
+
+    /// The label a skip looks for, if one is under way.
+    pub fn skip_label(&self) -> Option<String> {
+        Some(match self.skip.as_ref()? {
+            Skip::Call { label, .. } | Skip::FanucCall { label, .. } => label.to_string(),
+            Skip::Definition(l)
+            | Skip::Branch(l)
+            | Skip::PastIf(l)
+            | Skip::PastLoop(l, _)
+            | Skip::DoCondition(l) => l.to_string(),
+        })
+    }
 }
 
 impl Interpreter {
@@ -315,7 +327,17 @@ impl Interpreter {
             OKeyword::Sub if !self.control.frames.is_empty() => {
                 return Err((ErrorKind::NestedSubroutine, o.at));
             }
+            // A definition met again in the program's flow (after a call jumped to it from
+            // before, with no M2 between): LinuxCNC's "illegal location" and redefinition errors.
             OKeyword::Sub => {
+                if let Some(&body) = self.control.subs.get(label) {
+                    let kind = if body == line.next() {
+                        ErrorKind::SubInIllegalLocation(line.number, label.to_string())
+                    } else {
+                        ErrorKind::SubRedefined(line.number, label.to_string())
+                    };
+                    return Err((kind, o.at));
+                }
                 self.control.subs.insert(label.clone(), line.next());
                 self.control.skip = Some(Skip::Definition(label.clone()));
             }

@@ -398,6 +398,13 @@ impl Interpreter {
             .map_err(|(kind, byte)| GcodeError::new(kind, line.span(byte)))?;
         if let Some(flow) = self.percent_line(line)? {
             if flow == Flow::End {
+                // The closing `%` ends the text: a skip still looking for its O-word fails
+                // (after FINISH, as rs274 reports it).
+                if let Some(label) = self.control.skip_label() {
+                    sink.call(Origin::default(), Canon::Finish);
+                    let kind = ErrorKind::SkippedPastPercent(label);
+                    return Err(GcodeError::new(kind, line.span(0)));
+                }
                 // Moves cutter compensation still holds are not lost at the closing `%`
                 // (LinuxCNC drops them; only M0/M1/M2/M30 release them there).
                 self.flush_comp(sink)
