@@ -145,7 +145,7 @@ fn fit_run(run: &[Piece], share: f64) -> Fit {
         return Fit::Hook { start, end };
     }
     let mut piece = Piece::new(
-        Geo::Spline(Box::new(fit.curve)),
+        Geo::Spline(std::sync::Arc::new(fit.curve)),
         first.rotary,
         first.line,
         first.feed,
