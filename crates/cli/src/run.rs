@@ -23,6 +23,29 @@ use crate::plot::Trace;
 /// 0.07 mm/s there, is lower than curvature alone explains; to be looked at.)
 const RUN_BLEND_MAX_ANGLE_DEG: f64 = 45.0;
 
+/// The smoothing options: the builder's defaults, `run`'s blend angle, then what the machine
+/// file's `[path]` table sets.
+fn smooth_options(
+    path: &tezgah_kinematics::machine::PathSettings,
+    tolerance: f64,
+    start: Pose,
+) -> SmoothOptions {
+    let d = SmoothOptions::default();
+    SmoothOptions {
+        tolerance,
+        start,
+        blend_max_angle: path
+            .blend_max_angle_deg
+            .unwrap_or(RUN_BLEND_MAX_ANGLE_DEG)
+            .to_radians(),
+        compress_corner_angle: path
+            .compress_corner_angle_deg
+            .map_or(d.compress_corner_angle, f64::to_radians),
+        short_segment: path.short_segment_mm.unwrap_or(d.short_segment),
+        ..d
+    }
+}
+
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
 /// The demo's tool table.
 pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
@@ -128,12 +151,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
         moves.iter().copied(),
-        &SmoothOptions {
-            tolerance,
-            start,
-            blend_max_angle: RUN_BLEND_MAX_ANGLE_DEG.to_radians(),
-            ..SmoothOptions::default()
-        },
+        &smooth_options(&machine.path, tolerance, start),
     )
     .map_err(|e| miette!("{e}"))?;
     let segments = items
