@@ -271,7 +271,7 @@ proptest! {
         steps in prop::collection::vec(
             (-0.2..0.2f64, 0.05..0.3f64, -0.02..0.02f64)
                 .prop_map(|(turn, len, dz)| Step::Line { turn, len, dz, da: 0.0 }),
-            4..200),
+            4..120),
         tol in tolerance(),
         window in prop_oneof![Just(512usize), 5..40usize],
     ) {
