@@ -16,6 +16,30 @@ use tezgah_motion::verify::{Report, Verifier};
 use crate::plot::Trace;
 
 /// The built-in demo program (a rounded pocket outline with a helical entry).
+/// The smoothing options: the builder's defaults, then what the machine file's `[path]` table
+/// sets.
+fn smooth_options(
+    path: &tezgah_kinematics::machine::PathSettings,
+    tolerance: f64,
+    start: Pose,
+    control: tezgah_geom::ToolControl,
+) -> SmoothOptions {
+    let d = SmoothOptions::default();
+    SmoothOptions {
+        tolerance,
+        start,
+        control,
+        blend_max_angle: path
+            .blend_max_angle_deg
+            .map_or(d.blend_max_angle, f64::to_radians),
+        compress_corner_angle: path
+            .compress_corner_angle_deg
+            .map_or(d.compress_corner_angle, f64::to_radians),
+        short_segment: path.short_segment_mm.unwrap_or(d.short_segment),
+        ..d
+    }
+}
+
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
 /// The demo's tool table.
 pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
@@ -133,12 +157,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
         moves.iter().cloned(),
-        &SmoothOptions {
-            tolerance,
-            start,
-            control: pm.initial,
-            ..SmoothOptions::default()
-        },
+        &smooth_options(&machine.path, tolerance, start, pm.initial),
     )
     .map_err(|e| miette!("{e}"))?;
     let segments = items

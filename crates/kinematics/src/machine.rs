@@ -94,6 +94,8 @@ struct RawMachine {
     kinematics: RawKinematics,
     motion: RawMotion,
     #[serde(default)]
+    path: RawPath,
+    #[serde(default)]
     joint: Vec<RawJoint>,
 }
 
@@ -127,6 +129,15 @@ struct RawMotion {
     tolerance_mm: f64,
 }
 
+/// `[path]`: the smoothing builder's options (issue 4); every field optional.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawPath {
+    compress_corner_angle_deg: Option<f64>,
+    short_segment_mm: Option<f64>,
+    blend_max_angle_deg: Option<f64>,
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawJoint {
@@ -151,6 +162,19 @@ pub struct Motion {
     pub period_s: f64,
     /// Path deviation allowed for smoothing, chord error and segmentation, mm.
     pub tolerance_mm: f64,
+}
+
+/// The optional `[path]` table: smoothing options for this machine. `None` leaves the path
+/// builder's default (`tezgah_motion::path::smooth::SmoothOptions`); the kinematics crate only
+/// validates the values (positive, angles at most 180°).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct PathSettings {
+    /// Largest turn between consecutive moves inside a compressed run, degrees.
+    pub compress_corner_angle_deg: Option<f64>,
+    /// Longest G1 move counted as short for compression, mm.
+    pub short_segment_mm: Option<f64>,
+    /// Largest turn that is blended, degrees (sharper corners are passed at rest).
+    pub blend_max_angle_deg: Option<f64>,
 }
 
 /// One `[[joint]]`, in machine-file units (mm or degrees).
@@ -211,6 +235,8 @@ pub struct Machine {
     pub kinematics: Model,
     /// `[motion]`.
     pub motion: Motion,
+    /// `[path]` (optional).
+    pub path: PathSettings,
     /// `[[joint]]`, in file order (the order of joint values everywhere).
     pub joints: Vec<Joint>,
     /// `[kinematics] tcp`: when tool-centre-point control is on.
@@ -356,6 +382,25 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
         period_s: positive("motion.period_s", raw.motion.period_s)?,
         tolerance_mm: positive("motion.tolerance_mm", raw.motion.tolerance_mm)?,
     };
+    let angle = |field: &str, v: Option<f64>| -> Result<Option<f64>, MachineError> {
+        match v {
+            Some(a) if a > 180.0 => Err(invalid(field, format!("{a} is more than 180 degrees"))),
+            Some(a) => positive(field, a).map(Some),
+            None => Ok(None),
+        }
+    };
+    let path = PathSettings {
+        compress_corner_angle_deg: angle(
+            "path.compress_corner_angle_deg",
+            raw.path.compress_corner_angle_deg,
+        )?,
+        short_segment_mm: raw
+            .path
+            .short_segment_mm
+            .map(|v| positive("path.short_segment_mm", v))
+            .transpose()?,
+        blend_max_angle_deg: angle("path.blend_max_angle_deg", raw.path.blend_max_angle_deg)?,
+    };
     let joints = raw
         .joint
         .into_iter()
@@ -385,6 +430,7 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
         name: raw.name,
         kinematics,
         motion,
+        path,
         joints,
         tcp,
     })

@@ -11,8 +11,8 @@ use std::f64::consts::PI;
 use path_support::*;
 use proptest::prelude::*;
 use tezgah_geom::{Move, PathMode, Pose, Vec3};
-use tezgah_motion::path::deviation;
 use tezgah_motion::path::smooth::{build, SmoothOptions};
+use tezgah_motion::path::{deviation, Junction};
 
 /// One step of a random program.
 #[derive(Debug, Clone)]
@@ -254,6 +254,35 @@ proptest! {
                     prop_assert!(p.iter().all(|c| c.is_finite()), "{:?}", s);
                 }
             }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Issue 4's C² requirement where the program allows it: a G64 program of short moves that
+    /// turn gently (compressed runs, the spline cuts for the planner, blends between runs and
+    /// the lines a hooked fit leaves) has only `Smooth` joints up to its final stop — no
+    /// `Tangent` (curvature jump) and no `Corner` — and `check_path` measures each one:
+    /// position, unit tangent and curvature vector continue within 1e-9.
+    #[test]
+    fn gentle_dense_runs_are_g2_everywhere(
+        steps in prop::collection::vec(
+            (-0.2..0.2f64, 0.05..0.3f64, -0.02..0.02f64)
+                .prop_map(|(turn, len, dz)| Step::Line { turn, len, dz, da: 0.0 }),
+            4..120),
+        tol in tolerance(),
+        window in prop_oneof![Just(512usize), 5..40usize],
+    ) {
+        check(&steps, tol, window)?;
+        let (moves, _) = program(&steps, tol);
+        let opts = SmoothOptions { window, ..SmoothOptions::default() };
+        let items = build(moves, &opts).map_err(|e| TestCaseError::fail(format!("{e}")))?;
+        let segs = segments(&items);
+        for (i, s) in segs.iter().enumerate() {
+            let want = if i + 1 == segs.len() { Junction::Stop } else { Junction::Smooth };
+            prop_assert_eq!(s.end, want, "segment {} of {}", i, segs.len());
         }
     }
 }

@@ -17,7 +17,7 @@
 use super::params::{check_points, parameters, Parameterisation};
 use super::pieces::Pieces;
 use crate::banded::Banded;
-use crate::basis::{basis_funs, find_span, MAX_DEGREE, W};
+use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
 use crate::curve::{Curve, Vec3};
 use crate::deviation::{closest_point, maximise, point_segment_distance, Deviation};
 use crate::error::CurveError;
@@ -26,6 +26,24 @@ use crate::nurbs::Nurbs;
 /// Rounds of knot insertion before giving up; each round halves every offending span, so 64
 /// rounds reach spans far below any meaningful parameter resolution.
 const MAX_ROUNDS: usize = 64;
+/// Fairing bandwidth, in data spacings. The least squares minimises
+/// `Σ |C(t_k) − Q_k|² + λ ∫ |C″(u)|² du` (a smoothing spline; Reinsch 1967, Piegl & Tiller §9.4
+/// name fairing as the companion of approximation); by Silverman's (1984) equivalent kernel the
+/// bandwidth is `h = (λ/ρ)^{1/4}` with `ρ ≈ m` points per unit parameter, so
+/// `λ = FAIRING⁴ / m³` damps wiggles shorter than `FAIRING` data spacings and leaves the
+/// shape (bias ~ κh²) far inside the tolerance. It stops the spline folding into the vertices
+/// of uneven data where refinement gives it knot spans far shorter than the data spacing.
+const FAIRING: f64 = 0.5;
+/// Rounds that keep the fairing term; refinement goes on without it, so it still converges
+/// where the band needs sharper bends than the fairing allows.
+const FAIR_ROUNDS: usize = 24;
+
+/// `λ` for `m` segments (see [`FAIRING`]).
+fn fairing_weight(m: usize) -> f64 {
+    let m = m.max(1) as f64;
+    FAIRING.powi(4) / (m * m * m)
+}
+
 /// Samples per segment for the deviation checks (then refined).
 const SAMPLES: usize = 8;
 
@@ -62,16 +80,52 @@ pub fn approximate(
     }
     check_points(points, p, 2)?;
     let t = parameters(points, method, p)?;
+    // Faired first. Where the tolerance band is much narrower than the chords' sag, fairing
+    // only makes refinement chase the band with ever more knots; a faired fit that needs more
+    // control points than there are points has stopped approximating, and the plain
+    // refinement (which converges toward the polyline itself) is used instead.
+    match refine(points, p, tolerance, &t, true) {
+        Ok(a) => Ok(a),
+        Err(_) => refine(points, p, tolerance, &t, false),
+    }
+}
+
+/// The refinement loop of [`approximate`] on parameters `t`, with or without fairing.
+fn refine(
+    points: &[Vec3],
+    p: usize,
+    tolerance: f64,
+    t: &[f64],
+    fair: bool,
+) -> Result<Approximation, CurveError> {
     let mut interior: Vec<f64> = Vec::new();
     let mut data: Vec<(f64, Vec3)> = t.iter().copied().zip(points.iter().copied()).collect();
     let mut best = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {
-        densify(&mut data, &interior, p, &t, points);
-        let curve = least_squares(&data, &interior, p)?;
+        densify(&mut data, &interior, p, t, points);
+        if fair && interior.len() + p + 1 > points.len() {
+            return Err(CurveError::NotConverged {
+                tolerance,
+                achieved: best,
+                iterations: round,
+            });
+        }
+        let lambda = if fair && round <= FAIR_ROUNDS {
+            fairing_weight(points.len() - 1)
+        } else {
+            0.0
+        };
+        // Over very short knot spans the fairing entries (~λ/h³) can dwarf the data's and trip
+        // the banded solver's relative pivot test: then solve without it.
+        let curve = match least_squares(&data, &interior, p, lambda) {
+            Ok(c) => c,
+            Err(_) if lambda > 0.0 => least_squares(&data, &interior, p, 0.0)?,
+            Err(e) => return Err(e),
+        };
         let fast = Pieces::new(&curve);
         let check = |quick| match &fast {
-            Some(f) => measure(f, points, &t, &interior, tolerance, quick),
-            None => measure(&curve, points, &t, &interior, tolerance, quick),
+            Some(f) => measure(f, points, t, &interior, tolerance, quick),
+            None => measure(&curve, points, t, &interior, tolerance, quick),
         };
         // A samples-only pass finds the violations of the early rounds at a fraction of the
         // cost; only when it finds none does the refined check (the one that can accept) run.
@@ -82,7 +136,7 @@ pub fn approximate(
         if worst <= tolerance {
             return Ok(Approximation {
                 curve,
-                params: t,
+                params: t.to_vec(),
                 max_deviation: worst,
                 rounds: round,
             });
@@ -254,7 +308,12 @@ fn densify(data: &mut Vec<(f64, Vec3)>, interior: &[f64], p: usize, t: &[f64], p
 
 /// Least squares with the end control points pinned to the end data (A9.7's formulation):
 /// minimise `Σ |C(t_k) − Q_k|²` over the interior control points.
-fn least_squares(data: &[(f64, Vec3)], interior: &[f64], p: usize) -> Result<Nurbs, CurveError> {
+fn least_squares(
+    data: &[(f64, Vec3)],
+    interior: &[f64],
+    p: usize,
+    lambda: f64,
+) -> Result<Nurbs, CurveError> {
     let mut knots = vec![0.0; p + 1];
     knots.extend_from_slice(interior);
     knots.extend(std::iter::repeat_n(1.0, p + 1));
@@ -296,11 +355,75 @@ fn least_squares(data: &[(f64, Vec3)], interior: &[f64], p: usize) -> Result<Nur
                 }
             }
         }
+        if lambda > 0.0 {
+            add_fairing(&mut a, &mut rhs, &knots, p, n, q0, qm, lambda);
+        }
         a.solve(&mut rhs)?;
         ctrl.extend(rhs);
     }
     ctrl.push(qm);
     Nurbs::bspline(p, &ctrl, knots)
+}
+
+/// Add `λ ∫ N_i″ N_j″ du` to the normal equations (the pinned end control points move to the
+/// right-hand side). `N″` of a cubic is linear on each knot span, so 2-point Gauss–Legendre
+/// is exact for the products up to degree 3; higher degrees use 4 points (exact to degree 7).
+#[allow(clippy::too_many_arguments)]
+fn add_fairing(
+    a: &mut Banded,
+    rhs: &mut [Vec3],
+    knots: &[f64],
+    p: usize,
+    n: usize,
+    q0: Vec3,
+    qm: Vec3,
+    lambda: f64,
+) {
+    const G2: [(f64, f64); 2] = [
+        (-0.577_350_269_189_625_8, 1.0),
+        (0.577_350_269_189_625_8, 1.0),
+    ];
+    const G4: [(f64, f64); 4] = [
+        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    ];
+    if p < 2 {
+        return;
+    }
+    let rule: &[(f64, f64)] = if p <= 3 { &G2 } else { &G4 };
+    let mut ders = [[0.0; W]; MAX_DER + 1];
+    for s in p..=n {
+        let (u0, u1) = (knots[s], knots[s + 1]);
+        if u1 <= u0 {
+            continue;
+        }
+        let half = 0.5 * (u1 - u0);
+        for &(x, w) in rule {
+            let u = u0 + half * (1.0 + x);
+            ders_basis_funs(knots, s, u, p, 2, &mut ders);
+            let d2 = &ders[2];
+            let wl = lambda * w * half;
+            for j in 0..=p {
+                let i = s - p + j;
+                if i == 0 || i == n {
+                    continue;
+                }
+                for l in 0..=p {
+                    let c = s - p + l;
+                    let v = wl * d2[j] * d2[l];
+                    if c == 0 {
+                        rhs[i - 1] -= q0 * v;
+                    } else if c == n {
+                        rhs[i - 1] -= qm * v;
+                    } else {
+                        a.add(i - 1, c - 1, v);
+                    }
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -315,11 +438,78 @@ mod tests {
             .map(|i| i as f64 / 200.0)
             .map(|u| (u, f(u)))
             .collect();
-        let c = least_squares(&data, &[0.25, 0.5, 0.75], 3).unwrap();
+        let c = least_squares(&data, &[0.25, 0.5, 0.75], 3, 0.0).unwrap();
         let res = data
             .iter()
             .map(|(u, q)| (c.point(*u) - q).norm())
             .fold(0.0, f64::max);
         assert!(res < 1e-12, "{res}");
+    }
+
+    /// `∫ |C″|²` by the midpoint rule on 4000 points (enough to compare fits).
+    fn bending(c: &Nurbs) -> f64 {
+        let n = 4000;
+        (0..n)
+            .map(|i| {
+                let u = (i as f64 + 0.5) / n as f64;
+                c.derivs(u)[2].norm_squared() / n as f64
+            })
+            .sum()
+    }
+
+    #[test]
+    fn fairing_leaves_a_line_alone() {
+        // C″ = 0 for points on a line: the pinned ends' share of the fairing term must cancel
+        // exactly, whatever λ, or the line bends.
+        let data: Vec<(f64, Vec3)> = (0..=50)
+            .map(|i| i as f64 / 50.0)
+            .map(|u| (u, Vec3::new(3.0 * u - 1.0, 2.0 * u, -u)))
+            .collect();
+        for lambda in [1e-6, 1e-2, 10.0] {
+            let c = least_squares(&data, &[0.2, 0.3, 0.7], 3, lambda).unwrap();
+            let res = data
+                .iter()
+                .map(|(u, q)| (c.point(*u) - q).norm())
+                .fold(0.0, f64::max);
+            assert!(res < 1e-10, "λ = {lambda}: {res}");
+        }
+    }
+
+    #[test]
+    fn more_fairing_bends_less() {
+        // Penalised least squares: the penalty at the optimum never grows with λ, and the data
+        // misfit never shrinks. Noisy samples of a wave on many knots.
+        let data: Vec<(f64, Vec3)> = (0..=120)
+            .map(|i| {
+                let u = i as f64 / 120.0;
+                let noise = 0.01 * (((i * 7919) % 13) as f64 / 6.0 - 1.0);
+                (u, Vec3::new(10.0 * u, (6.0 * u).sin() + noise, 0.0))
+            })
+            .collect();
+        let knots: Vec<f64> = (1..40).map(|i| i as f64 / 40.0).collect();
+        let misfit = |c: &Nurbs| {
+            data.iter()
+                .map(|(u, q)| (c.point(*u) - q).norm_squared())
+                .sum::<f64>()
+        };
+        let mut last = (f64::INFINITY, 0.0);
+        for lambda in [0.0, 1e-8, 1e-6, 1e-4, 1e-2] {
+            let c = least_squares(&data, &knots, 3, lambda).unwrap();
+            let (b, m) = (bending(&c), misfit(&c));
+            assert!(
+                b <= last.0 * (1.0 + 1e-9),
+                "λ = {lambda}: bending {b} after {}",
+                last.0
+            );
+            assert!(
+                m >= last.1 * (1.0 - 1e-9),
+                "λ = {lambda}: misfit {m} after {}",
+                last.1
+            );
+            last = (b, m);
+        }
+        // And it does something: the strongest fairing bends less than half as much.
+        let free = bending(&least_squares(&data, &knots, 3, 0.0).unwrap());
+        assert!(last.0 < 0.5 * free, "{} vs {free}", last.0);
     }
 }

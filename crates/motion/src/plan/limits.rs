@@ -42,9 +42,6 @@ pub struct PlanOptions {
     /// A junction whose cap is below this share of the slower neighbour's speed limit is
     /// passed at rest instead (cheaper than keeping the reserve on both sides).
     pub min_junction_share: f64,
-    /// Shortest planning section (mm) of a long spline cut at its knots, so its speed follows
-    /// its curvature (see [`super::sections`]); 0 plans every segment whole.
-    pub section_length: f64,
     /// Groups of segments held in the look-ahead window.
     pub window: usize,
     /// Most segments timed by one profile.
@@ -65,7 +62,6 @@ impl Default for PlanOptions {
             cross_share: 0.5,
             junction_reserve: 0.25,
             min_junction_share: 0.05,
-            section_length: 1.0,
             window: 64,
             max_group: 256,
             group_ratio: 0.8,
@@ -101,12 +97,6 @@ impl PlanOptions {
         unit("junction_reserve", self.junction_reserve, false)?;
         unit("group_ratio", self.group_ratio, true)?;
         unit("min_junction_share", self.min_junction_share, false)?;
-        if !(self.section_length >= 0.0 && self.section_length.is_finite()) {
-            return Err(PlanError::Option {
-                name: "section_length",
-                value: self.section_length,
-            });
-        }
         if self.window == 0 || self.max_group == 0 {
             return Err(PlanError::Option {
                 name: "window/max_group",

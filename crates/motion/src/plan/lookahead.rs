@@ -16,7 +16,6 @@ use super::limits::{
     analyse, has_jump, inside_group, junction_cap, segment_limits, Geometry, PlanOptions,
     SegmentLimits,
 };
-use super::sections::sections;
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
 use crate::profile::{max_reachable_speed, solve, Limits, Profile, ProfileError};
@@ -122,12 +121,7 @@ impl Planner {
     /// Takes one path item.
     pub fn push(&mut self, item: PathItem) -> Result<(), PlanError> {
         match item {
-            PathItem::Segment(seg) => {
-                for section in sections(seg, self.options.section_length) {
-                    self.push_segment(section)?;
-                }
-                Ok(())
-            }
+            PathItem::Segment(seg) => self.push_segment(seg),
             PathItem::Dwell { seconds, line } => {
                 if !(seconds.is_finite() && seconds >= 0.0) {
                     return Err(PlanError::BadDwell { line, seconds });

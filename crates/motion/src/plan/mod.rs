@@ -4,13 +4,13 @@
 //!
 //! Modules: [`joints`] (the machine's joint limits seen along the path), [`limits`] (the speed
 //! limit and profile limits of one segment, and the junction cap), [`lookahead`] (grouping,
-//! backward and forward passes, one [`crate::Profile`] per group of segments), [`sections`]
-//! (long splines planned in sections cut at their knots).
+//! backward and forward passes, one [`crate::Profile`] per group of segments). Long splines
+//! arrive cut at their knots where their curvature level changes (the path stage's job), so a
+//! segment's speed follows its own curvature.
 
 pub mod joints;
 pub mod limits;
 pub mod lookahead;
-pub mod sections;
 
 pub use joints::{JointMap, PlanMachine};
 pub use limits::{Geometry, PlanOptions, SegmentLimits};

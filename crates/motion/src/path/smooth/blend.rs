@@ -170,14 +170,37 @@ pub(crate) struct Placed {
     pub deviation: f64,
 }
 
-/// Distance from `q` to the piece's geometry over `[u0, u1]`.
-fn distance_to(p: &Piece, q: &Vec3, u0: f64, u1: f64) -> f64 {
+/// Distance from `q` to the piece's geometry over `[u0, u1]`; `cuts` are the piece's knots
+/// in that range with both ends ([`cuts`]), found once per leg rather than per sample: a
+/// spline's knot vector has hundreds of entries and the blend measure calls this ~50 times.
+fn distance_to(p: &Piece, q: &Vec3, cuts: &[f64]) -> f64 {
+    let (u0, u1) = (cuts[0], cuts[cuts.len() - 1]);
     match &p.geo {
         Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
         Geo::Arc(a) => crate::path::deviation::arc_distance(a, q, u0, u1)
-            .unwrap_or_else(|| closest_point(a, q, u0, u1, 8).distance),
-        g => crate::path::deviation::closest_on_spans(g, q, u0, u1),
+            .unwrap_or_else(|| closest_point(a.as_ref(), q, u0, u1, 8).distance),
+        g => cuts
+            .windows(2)
+            .map(|w| closest_point(g, q, w[0], w[1], 8).distance)
+            .fold(f64::INFINITY, f64::min),
     }
+}
+
+/// `[u0, the piece's knots strictly inside, u1]` (just the ends for lines and arcs).
+fn cuts(p: &Piece, u0: f64, u1: f64) -> Vec<f64> {
+    let mut c = vec![u0];
+    if let Geo::Spline(n) = &p.geo {
+        let k = n.knots();
+        let lo = k.partition_point(|&x| x <= u0);
+        let hi = k.partition_point(|&x| x < u1);
+        for &x in &k[lo..hi.max(lo)] {
+            if c.last() != Some(&x) {
+                c.push(x);
+            }
+        }
+    }
+    c.push(u1);
+    c
 }
 
 /// Place a blend between `a` (incoming, trimmed up to `a.u1`) and `b` (outgoing, from `b.u0`)
@@ -247,15 +270,11 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             // Both directions, measured: the corner to the blend, and the blend to the two
             // programmed pieces around the corner.
             let to_corner = closest_point(&curve, &corner, 0.0, 1.0, 16).distance;
+            let (ca, cb) = (cuts(a, ua, a.geo.domain().1), cuts(b, b.geo.domain().0, ub));
             let away = maximise(
                 |u| {
                     let q = curve.point(u);
-                    distance_to(a, &q, ua, a.geo.domain().1).min(distance_to(
-                        b,
-                        &q,
-                        b.geo.domain().0,
-                        ub,
-                    ))
+                    distance_to(a, &q, &ca).min(distance_to(b, &q, &cb))
                 },
                 0.0,
                 1.0,

@@ -196,6 +196,8 @@ pub struct Stats {
     pub blends: usize,
     /// Junctions left as corners (G61, or where blending was impossible).
     pub corners: usize,
+    /// Extra segments made by cutting splines where their curvature level changes.
+    pub spline_cuts: usize,
     /// Largest corner deviation of a blend, mm (closed form for line–line, measured otherwise).
     pub max_blend_deviation: f64,
 }
@@ -292,7 +294,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
             }
             // A programmed NURBS is one piece: compression takes only lines, so it is never
             // refitted, and its ends are blended or cornered like an arc's.
-            MoveKind::Nurbs(n) => (Geo::Spline(Box::new((*n.curve).clone())), n.end),
+            MoveKind::Nurbs(n) => (Geo::Spline(n.curve.clone()), n.end),
         };
         if !end.0.iter().all(|c| c.is_finite()) {
             return Err(PathError::Curve {
@@ -402,14 +404,38 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         Ok(more)
     }
 
+    /// Emit a piece ending with `end`. A spline goes out as several segments, cut at its knots
+    /// where its curvature level changes ([`Piece::curvature_chunks`]): the planner limits the
+    /// speed of a segment by the largest curvature anywhere in it, so one tight spot must not
+    /// slow a whole compressed row. The cuts are C² (inside a cubic spline), so they are
+    /// `Smooth` junctions.
+    fn emit(&mut self, a: Piece, end: Junction) {
+        let chunks = a.curvature_chunks();
+        let n = chunks.len();
+        for (i, (u0, u1)) in chunks.into_iter().enumerate() {
+            if i + 1 == n {
+                let mut last = a;
+                last.u0 = u0;
+                self.push_segment(last.into_segment(end));
+                return;
+            }
+            let mut part = a.clone();
+            part.u0 = u0;
+            part.u1 = u1;
+            self.stats.spline_cuts += 1;
+            self.push_segment(part.into_segment(Junction::Smooth));
+        }
+    }
+
     fn flush(&mut self, end: Junction) {
         if let Some(a) = self.pending.take() {
-            self.emit(a.into_segment(end));
+            self.emit(a, end);
         }
     }
 
     /// Queues a segment under the tool control in force.
-    fn emit(&mut self, mut seg: Segment) {
+    /// Out with a segment, under the tool control in force.
+    fn push_segment(&mut self, mut seg: Segment) {
         seg.control = self.control;
         self.out.push_back(PathItem::Segment(seg));
     }
@@ -418,7 +444,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
     /// blend) and trims `b`'s start.
     fn join(&mut self, mut a: Piece, b: &mut Piece) {
         if a.mode == Mode::ExactStop {
-            self.emit(a.into_segment(Junction::Stop));
+            self.emit(a, Junction::Stop);
             return;
         }
         let blendable = a.mode == Mode::Continuous
@@ -472,8 +498,8 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 b.u0 = p.ub;
                 self.stats.blends += 1;
                 self.stats.max_blend_deviation = self.stats.max_blend_deviation.max(p.deviation);
-                self.emit(a.into_segment(Junction::Smooth));
-                self.emit(seg);
+                self.emit(a, Junction::Smooth);
+                self.push_segment(seg);
             }
             Err(NoBlend::Tangent { same_curvature }) => {
                 let end = if same_curvature {
@@ -481,11 +507,11 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 } else {
                     Junction::Tangent
                 };
-                self.emit(a.into_segment(end));
+                self.emit(a, end);
             }
             Err(NoBlend::Corner) => {
                 self.stats.corners += 1;
-                self.emit(a.into_segment(Junction::Corner));
+                self.emit(a, Junction::Corner);
             }
         }
     }

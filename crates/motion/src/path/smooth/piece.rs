@@ -2,6 +2,8 @@
 //! on it: its curve, the parameter range left after the blends either side trimmed it, and the
 //! move's feed, rotary axes, line and mode. Becomes one [`Segment`] when emitted.
 
+use std::sync::Arc as Shared;
+
 use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, Trimmed, Vec3};
 
 use crate::path::{Junction, Segment, SegmentFeed};
@@ -9,6 +11,11 @@ use crate::path::{Junction, Segment, SegmentFeed};
 /// Arc-length tolerance for the pieces that need a map (splines, arcs of changing radius): far
 /// below any path tolerance, so leg lengths and segment lengths are exact for the planner.
 pub(crate) const MAP_TOLERANCE: f64 = 1e-9;
+
+/// Largest ratio of span curvatures kept in one segment when a spline is cut for the planner.
+const CURVATURE_RATIO: f64 = 2.0;
+/// Curvature (1/mm) below which a span counts as flat for the cut (radius 50 mm).
+const FLAT_CURVATURE: f64 = 0.02;
 
 /// The path mode a piece was programmed under.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -27,8 +34,9 @@ pub(crate) enum Geo {
     Line(Line),
     /// Boxed like splines: lines, the common case, then set the size of a piece.
     Arc(Box<Arc>),
-    /// Boxed: splines are rare next to lines, and a small enum keeps pieces cheap to move.
-    Spline(Box<Nurbs>),
+    /// Shared: splines are rare next to lines, a small enum keeps pieces cheap to move, and
+    /// the segments a spline is cut into (see [`Piece::curvature_chunks`]) share one curve.
+    Spline(Shared<Nurbs>),
 }
 
 impl Curve for Geo {
@@ -81,7 +89,7 @@ impl Curve for Geo {
 pub(crate) struct Piece {
     pub geo: Geo,
     /// Arc-length map, only where arc length is not linear in the parameter.
-    pub map: Option<Box<ArcLengthMap>>,
+    pub map: Option<Shared<ArcLengthMap>>,
     /// Length of the untrimmed curve, mm.
     pub full_length: f64,
     pub u0: f64,
@@ -115,7 +123,7 @@ impl Piece {
             Geo::Spline(_) => true,
         };
         let map = if needs_map {
-            ArcLengthMap::new(&geo, MAP_TOLERANCE).ok().map(Box::new)
+            ArcLengthMap::new(&geo, MAP_TOLERANCE).ok().map(Shared::new)
         } else {
             None
         };
@@ -198,6 +206,44 @@ impl Piece {
             Geo::Spline(n) => n.control_points().len(),
             _ => 0,
         }
+    }
+
+    /// The trimmed range `[u0, u1]` cut into parameter ranges of similar curvature: for a
+    /// spline, consecutive knot spans stay together while the largest span curvature of the
+    /// group is at most [`CURVATURE_RATIO`] times the smallest (curvatures below
+    /// [`FLAT_CURVATURE`] count as that floor); lines and arcs stay whole. This is reference
+    /// 000 §2.6's split of a NURBS at its curvature peaks, done at knots so every cut is C².
+    pub fn curvature_chunks(&self) -> Vec<(f64, f64)> {
+        let Geo::Spline(c) = &self.geo else {
+            return vec![(self.u0, self.u1)];
+        };
+        let mut cuts = vec![self.u0];
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        let bps = c.breakpoints();
+        let inside: Vec<f64> = bps
+            .into_iter()
+            .filter(|&u| u > self.u0 && u < self.u1)
+            .chain(std::iter::once(self.u1))
+            .collect();
+        let mut a = self.u0;
+        for &b in &inside {
+            // The span's curvature at its ends and three inner points: a cubic span's
+            // curvature varies slowly enough for grouping (a cut in the wrong place only
+            // costs a little speed, never tolerance).
+            let k = (0..=4)
+                .map(|i| c.curvature(a + (b - a) * i as f64 / 4.0))
+                .fold(FLAT_CURVATURE, f64::max);
+            let (nlo, nhi) = (lo.min(k), hi.max(k));
+            if nhi > CURVATURE_RATIO * nlo && a > self.u0 {
+                cuts.push(a);
+                (lo, hi) = (k, k);
+            } else {
+                (lo, hi) = (nlo, nhi);
+            }
+            a = b;
+        }
+        cuts.push(self.u1);
+        cuts.windows(2).map(|w| (w[0], w[1])).collect()
     }
 
     /// Whether the tip moves at all.
