@@ -67,3 +67,31 @@ fn splines_are_refused_under_cutter_compensation() {
         assert_eq!(err.span.line, 4, "{spline}");
     }
 }
+
+/// `EQ` and `NE` compare within LinuxCNC 2.9's `TOLERANCE_EQUAL`, 0.0001 (rs274 found
+/// `EXP[-9.2104] EQ SIN[0]` true, e^−9.2104 being 0.99994e-4).
+#[test]
+fn eq_and_ne_compare_within_a_ten_thousandth() {
+    let cases = [
+        ("[EXP[-9.2104] EQ SIN[0]]", 1.0),
+        ("[0.0002 EQ 0]", 0.0),
+        ("[0.00009 NE 0]", 0.0),
+        ("[0.0001 NE 0]", 1.0),
+        ("[-0.00005 EQ 0.00004]", 1.0),
+    ];
+    for (expr, want) in cases {
+        let program = format!("#1 = {expr}\n(DEBUG,#1)\nM2\n");
+        let mut calls: Vec<(tezgah_gcode::Origin, tezgah_gcode::Canon)> = Vec::new();
+        tezgah_gcode::Interpreter::new(tezgah_gcode::Config::default())
+            .run(&program, &mut calls)
+            .unwrap();
+        let shown = calls
+            .iter()
+            .find_map(|(_, c)| match c {
+                tezgah_gcode::Canon::Message(m) => Some(m.clone()),
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(shown, format!("{want:.6}"), "{expr}");
+    }
+}
