@@ -113,5 +113,6 @@ fn joint_line(
         end: Junction::Stop,
         tolerance: next.tolerance,
         control: ToolControl::Joints,
+        tool_axis_travel: None,
     })
 }

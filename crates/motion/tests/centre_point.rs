@@ -253,3 +253,27 @@ fn with_tcp_off_an_axis_without_a_joint_is_refused_not_ignored() {
         "{err}"
     );
 }
+
+/// DESIGN.md: under TCP a block that only turns the tool takes F in degrees per minute of the
+/// tool axis's rotation. At A30, a C turn of 90° swings the axis (sin A sin C, sin A cos C,
+/// cos A) along a cone through 90°·sin 30° = 45°: at F600 (10°/s) that is 4.5 s plus the
+/// speed's rise and fall, not the 9 s the C axis's own travel would take. The A turn of 30°
+/// from A0 turns the axis by 30°: 3 s.
+#[test]
+fn a_block_that_only_turns_the_tool_takes_f_as_the_tool_axis_rotation() {
+    let program = "G21 G90 G94 G64\nG43.4 H1\nG0 X0 Y0 Z20 A0 C0\nG1 A30 F600\nG1 C90\nM2\n";
+    let out = run_program(program);
+    assert_within_limits(&out.report);
+    let span = |line: u32| {
+        let ts: Vec<f64> = out
+            .samples
+            .iter()
+            .filter(|(s, _, _)| s.line == line)
+            .map(|(s, _, _)| s.t)
+            .collect();
+        ts.last().unwrap() - ts.first().unwrap()
+    };
+    let (a_turn, c_turn) = (span(4), span(5));
+    assert!((3.0..3.1).contains(&a_turn), "A30: {a_turn} s");
+    assert!((4.5..4.6).contains(&c_turn), "C90 at A30: {c_turn} s");
+}

@@ -42,6 +42,7 @@ fn segment(curve: Bezier, feed: f64) -> Segment {
         end: Junction::Smooth,
         tolerance: 0.01,
         control: Default::default(),
+        tool_axis_travel: None,
     }
 }
 

@@ -219,6 +219,7 @@ impl Direct {
             end: Junction::Stop,
             tolerance: self.tolerance(),
             control: self.control,
+            tool_axis_travel: None,
         };
         if seg.rotary_only() && seg.rotary_travel() <= 0.0 {
             // Nothing moves: a repeated point.

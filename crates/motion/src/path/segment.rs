@@ -52,6 +52,11 @@ pub struct Segment {
     pub tolerance: f64,
     /// How the program axes reach the joints along this segment (TCP on or off).
     pub control: ToolControl,
+    /// Under tool-centre-point control, the angle (degrees) the tool axis turns through on a
+    /// segment that only turns it, which times the segment (DESIGN.md: F is then degrees per
+    /// minute of that rotation). Set by the planner, which knows the machine; `None` times a
+    /// rotary-only segment by its largest axis travel.
+    pub tool_axis_travel: Option<f64>,
 }
 
 impl Segment {
@@ -61,8 +66,14 @@ impl Segment {
         self.length <= f64::EPSILON
     }
 
-    /// The largest rotary travel of the segment, degrees.
+    /// The travel (degrees) that times a rotary-only segment: the tool axis's turn where the
+    /// planner set it, else the largest rotary axis travel.
     pub fn rotary_travel(&self) -> f64 {
+        self.tool_axis_travel.unwrap_or_else(|| self.axis_travel())
+    }
+
+    /// The largest rotary axis travel of the segment, degrees.
+    pub fn axis_travel(&self) -> f64 {
         let [a, b] = self.rotary;
         (0..3).map(|i| (b[i] - a[i]).abs()).fold(0.0, f64::max)
     }

@@ -15,6 +15,11 @@ use tezgah_kinematics::tcp::ProgramPose;
 use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
 
 use super::PlanError;
+
+/// Steps along a rotary-only segment at which the tool axis is sampled to measure its turn:
+/// between samples the axis path is close to a great circle, so the sum of the angles between
+/// consecutive axes is within ~1e-4 (relative) of its turn at 64 steps.
+const SWEEP_STEPS: usize = 64;
 use crate::path::Segment;
 
 /// A program axis "moves" along a segment when its ends or middle differ by more than this
@@ -113,6 +118,39 @@ impl PlanMachine {
     /// switching TCP change what the program axes mean.
     fn orients(&self) -> bool {
         !matches!(self.model, Model::Cartesian(_) | Model::LinearDelta(_))
+    }
+
+    /// The angle (degrees) the tool axis turns through along a rotary-only segment under
+    /// tool-centre-point control on a machine whose rotaries orient the tool: the length of
+    /// its path on the unit sphere, summed over [`SWEEP_STEPS`] steps of the program angles
+    /// (which move linearly). `None` for any other segment, or where the axis stands still
+    /// (C turning at the pole): the axes' own travel times those.
+    pub fn tool_axis_sweep(&self, seg: &Segment) -> Option<f64> {
+        let ToolControl::CentrePoint { tool_length } = seg.control else {
+            return None;
+        };
+        if !seg.rotary_only() || !self.orients() {
+            return None;
+        }
+        let tool = Tool::with_length(tool_length);
+        let tip = seg.curve.point(seg.curve.domain().0);
+        let [r0, r1] = seg.rotary;
+        let mut previous = Joints::zeros(self.joint_count());
+        let mut axis_at = |f: f64| -> Option<Vec3> {
+            let rotary = [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f);
+            let q = self.joints(seg.control, &tip, &rotary, &previous).ok()?;
+            previous = q;
+            Some(self.model.forward(&q, &tool).ok()?.axis.into_inner())
+        };
+        let mut last = axis_at(0.0)?;
+        let mut sweep = 0.0;
+        for k in 1..=SWEEP_STEPS {
+            let next = axis_at(k as f64 / SWEEP_STEPS as f64)?;
+            sweep += last.angle(&next);
+            last = next;
+        }
+        let degrees = sweep.to_degrees();
+        (degrees > 1e-9).then_some(degrees)
     }
 
     /// The direct map under `control`, or `None` where the joints come from the TCP inverse.

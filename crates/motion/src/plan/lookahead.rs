@@ -152,7 +152,9 @@ impl Planner {
         self.out.pop_front()
     }
 
-    fn push_segment(&mut self, seg: Segment) -> Result<(), PlanError> {
+    fn push_segment(&mut self, mut seg: Segment) -> Result<(), PlanError> {
+        // A block that only turns the tool under TCP is timed by the tool axis's turn.
+        seg.tool_axis_travel = self.machine.tool_axis_sweep(&seg);
         let geom = analyse(&seg, &self.machine)?;
         if geom.length <= 0.0 {
             return Ok(());

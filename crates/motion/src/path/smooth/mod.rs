@@ -493,6 +493,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     end: Junction::Smooth,
                     tolerance: a.tolerance.min(b.tolerance),
                     control: self.control,
+                    tool_axis_travel: None,
                 };
                 a.u1 = p.ua;
                 b.u0 = p.ub;

@@ -292,6 +292,7 @@ impl Piece {
             tolerance: self.tolerance,
             // The builder stamps the control in force when it emits the segment.
             control: tezgah_geom::ToolControl::Joints,
+            tool_axis_travel: None,
         }
     }
 }
