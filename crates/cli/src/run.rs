@@ -192,7 +192,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let mut write_error: Option<std::io::Error> = None;
     let mut count: u64 = 0;
     let mut line_buf = String::with_capacity(256);
-    let sink = |s: &Sample, seg: Option<&std::sync::Arc<tezgah_motion::Segment>>| {
+    let sink = |s: &Sample, seg: &[std::sync::Arc<tezgah_motion::Segment>]| {
         verifier.push(s, seg);
         if let Some(t) = trace.as_mut() {
             t.push(s, &scales);

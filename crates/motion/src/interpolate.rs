@@ -105,6 +105,10 @@ pub struct Interpolator {
     t0: f64,
     last: Option<Sample>,
     joints: Joints,
+    /// The segments the path has entered since the last sample, starting with that sample's
+    /// own: at speed, short segments and blends can be entered and left within one period,
+    /// and the chord between two samples then runs past them.
+    passed: Vec<Arc<Segment>>,
 }
 
 impl Interpolator {
@@ -117,6 +121,7 @@ impl Interpolator {
             t0: 0.0,
             last: None,
             joints: start,
+            passed: Vec::new(),
         }
     }
 
@@ -163,25 +168,26 @@ impl Interpolator {
         Ok((tip, rotary, q))
     }
 
-    fn emit(
-        &mut self,
-        mut s: Sample,
-        sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>),
-        seg: Option<&Arc<Segment>>,
-    ) {
+    /// Hands one sample to the sink with the path it lies on: the segments passed since the
+    /// previous sample, ending with the sample's own (none while standing still).
+    fn emit(&mut self, mut s: Sample, sink: &mut impl FnMut(&Sample, &[Arc<Segment>])) {
         s.index = self.k;
         s.t = self.k as f64 * self.period;
-        sink(&s, seg);
+        sink(&s, &self.passed);
         // `last` is not updated here: a piece stores its exact end pose when it is done, and
         // dwells and the final row repeat it (a copy per sample was ~10 % of sampling lines).
         self.k += 1;
+        // The next chord starts on this sample's segment.
+        if self.passed.len() > 1 {
+            self.passed.drain(..self.passed.len() - 1);
+        }
     }
 
     /// Samples one planned item.
     pub fn push(
         &mut self,
         item: &Planned,
-        sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>),
+        sink: &mut impl FnMut(&Sample, &[Arc<Segment>]),
     ) -> Result<(), InterpolateError> {
         match item {
             Planned::Motion(piece) => {
@@ -189,6 +195,7 @@ impl Interpolator {
                 let end = self.t0 + duration;
                 let mut idx = 0;
                 let mut param = Param::new(&piece.segments[0]);
+                self.passed.push(piece.segments[0].clone());
                 while (self.k as f64) * self.period < end {
                     let tau = (self.k as f64 * self.period - self.t0).max(0.0);
                     let st = piece.profile.state_at(tau);
@@ -198,6 +205,7 @@ impl Interpolator {
                     let before = idx;
                     while idx + 1 < piece.segments.len() && s > piece.offsets[idx + 1] {
                         idx += 1;
+                        self.passed.push(piece.segments[idx].clone());
                     }
                     if idx != before {
                         param = Param::new(&piece.segments[idx]);
@@ -213,8 +221,11 @@ impl Interpolator {
                         joints,
                         feed: st.v,
                     };
-                    self.emit(sample, sink, Some(seg));
+                    self.emit(sample, sink);
                 }
+                // Segments after the last sample are passed before the next one.
+                self.passed
+                    .extend(piece.segments[idx + 1..].iter().cloned());
                 // The piece's end, exactly (held for the final row and for dwells).
                 let seg = piece.segments.last().expect("a piece has segments");
                 let len = *piece.lengths.last().unwrap_or(&0.0);
@@ -231,12 +242,14 @@ impl Interpolator {
                 self.t0 = end;
             }
             Planned::Dwell { seconds, line } => {
+                // Standing still: no chord.
+                self.passed.clear();
                 let end = self.t0 + seconds;
                 while (self.k as f64) * self.period < end {
                     if let Some(mut s) = self.last {
                         s.line = *line;
                         s.feed = 0.0;
-                        self.emit(s, sink, None);
+                        self.emit(s, sink);
                     } else {
                         break;
                     }
@@ -274,10 +287,11 @@ impl Interpolator {
     }
 
     /// The final row: the final position at rest, at the first grid time at or after the end.
-    pub fn finish(&mut self, sink: &mut impl FnMut(&Sample, Option<&Arc<Segment>>)) {
+    pub fn finish(&mut self, sink: &mut impl FnMut(&Sample, &[Arc<Segment>])) {
         if let Some(mut s) = self.last {
             s.feed = 0.0;
-            self.emit(s, sink, None);
+            self.passed.clear();
+            self.emit(s, sink);
         }
     }
 }
@@ -310,7 +324,7 @@ pub fn run(
     machine: PlanMachine,
     options: crate::plan::PlanOptions,
     start: (Vec3, [f64; 3]),
-    mut sink: impl FnMut(&Sample, Option<&Arc<Segment>>),
+    mut sink: impl FnMut(&Sample, &[Arc<Segment>]),
 ) -> Result<f64, RunError> {
     let period = options.period;
     let mut interp = Interpolator::new(&machine, period, Joints::zeros(machine.joint_count()));

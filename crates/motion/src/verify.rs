@@ -147,23 +147,30 @@ impl Verifier {
         }
     }
 
-    /// Takes one sample and the segment it lies on (None while standing still).
-    pub fn push(&mut self, s: &Sample, seg: Option<&Arc<Segment>>) {
+    /// Takes one sample and the path it lies on: the segments passed since the previous
+    /// sample, ending with the sample's own (empty while standing still).
+    pub fn push(&mut self, s: &Sample, path: &[Arc<Segment>]) {
         self.differences(s.joints, s.line);
+        let seg = path.last();
         if let Some(seg) = seg {
             let d = distance_to(seg, &s.tip);
             self.deviation(d, s.line);
-            // The chord to the previous sample: its midpoint against the two segments. Across
-            // a tool-control switch (at rest) the tip is read two ways: no chord there.
+            // The chord to the previous sample: its midpoint against the path between the two
+            // samples — every segment passed, not only the two ends: at speed, short segments
+            // and blends are entered and left within one period and the chord runs past them.
+            // Across a tool-control switch (at rest) the tip is read two ways: no chord there.
             let same_reading = match &self.last {
                 Some((_, Some(ps))) => ps.control == seg.control,
                 _ => true,
             };
             if let (Some((p, pseg)), true) = (&self.last, same_reading) {
                 let mid = 0.5 * (p.tip + s.tip);
-                let mut dm = distance_to(seg, &mid);
+                let mut dm = path
+                    .iter()
+                    .map(|g| distance_to(g, &mid))
+                    .fold(f64::INFINITY, f64::min);
                 if let Some(ps) = pseg {
-                    if !Arc::ptr_eq(ps, seg) {
+                    if !path.iter().any(|g| Arc::ptr_eq(g, ps)) {
                         dm = dm.min(distance_to(ps, &mid));
                     }
                 }

@@ -38,10 +38,10 @@ fn run_program(program: &str) -> Out {
         pm,
         PlanOptions::default(),
         (Vec3::zeros(), [0.0; 3]),
-        |s: &Sample, seg: Option<&Arc<Segment>>| {
+        |s: &Sample, seg: &[Arc<Segment>]| {
             verifier.push(s, seg);
-            let end = seg.map(|g| g.curve.point(g.curve.domain().1));
-            samples.push((*s, seg.map(|g| g.control), end));
+            let end = seg.last().map(|g| g.curve.point(g.curve.domain().1));
+            samples.push((*s, seg.last().map(|g| g.control), end));
         },
     )
     .unwrap();
@@ -216,8 +216,8 @@ fn a_switch_at_a_point_whose_joints_agree_needs_no_take_up() {
         pm,
         PlanOptions::default(),
         (Vec3::zeros(), [0.0; 3]),
-        |s: &Sample, seg: Option<&Arc<Segment>>| {
-            if let Some(g) = seg {
+        |s: &Sample, seg: &[Arc<Segment>]| {
+            if let Some(g) = seg.last() {
                 if lines.last() != Some(&(g.line, g.control)) {
                     lines.push((g.line, g.control));
                 }

@@ -529,3 +529,71 @@ fn planner_streams_with_bounded_memory() {
     }
     assert_eq!(emitted, pushed);
 }
+
+/// Bug: a junction speed the backward pass had promised became unreachable when the window
+/// grew. A jerk-limited ramp gains less speed over a distance the faster it starts, so the
+/// highest entry speed from which a short segment reaches its end speed in one ramp *falls*
+/// when that end speed rises from rest: here 0.05 mm at J = 50000 reaches 5 mm/s from rest
+/// but only 4.77 mm/s from 1 mm/s. With a window of one group, the 5 mm line is committed to
+/// end at 5 mm/s while the short segment is still last (it must stop); when the 1 mm/s line
+/// arrives, the short segment's end may rise to 1 mm/s, its bound fell to 4.77, and the
+/// forward pass failed ("end speed 1 cannot be reached from 5"). Braking 5 → 1 mm/s takes
+/// 0.054 mm, braking to rest exactly the 0.05 mm: the plan must take that.
+#[test]
+fn a_committed_junction_speed_stays_reachable_when_the_window_grows() {
+    use tezgah_motion::plan::lookahead::plan_all;
+    use tezgah_motion::plan::Planned;
+    let moves = [
+        f(1, 600.0),
+        feed(2, 5.0, 0.0, 0.0),
+        f(3, 1800.0),
+        feed(4, 5.05, 0.0, 0.0),
+        f(5, 60.0),
+        feed(6, 5.1, 0.0, 0.0),
+    ];
+    let items = build(&moves, Pose::ZERO, DirectOptions::default()).unwrap();
+    let machine = PlanMachine::from_machine(&Machine::default_machine()).unwrap();
+    let options = PlanOptions {
+        window: 1,
+        ..PlanOptions::default()
+    };
+    let planned = plan_all(items, machine, options).unwrap();
+    let pieces: Vec<_> = planned
+        .iter()
+        .filter_map(|p| match p {
+            Planned::Motion(piece) => Some(piece),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(pieces.len(), 3);
+    // (0.05² · 50000)^⅓ = 5 mm/s: the speed from which 0.05 mm is exactly a stop.
+    assert!((pieces[0].profile.end().v - 5.0).abs() < 1e-9);
+    assert!(pieces[1].profile.end().v.abs() < 1e-6);
+    for w in pieces.windows(2) {
+        assert!((w[0].profile.end().v - w[1].profile.start().v).abs() < 1e-9);
+    }
+    for p in &pieces {
+        assert!((p.profile.distance() - p.length()).abs() < 1e-9 * p.length().max(1.0));
+    }
+}
+
+/// Bug: verify measured the chord between two samples only against the segments of its two
+/// ends. At 50 mm/s a 1 ms chord is 0.05 mm and spans three collinear 0.03 mm lines; its
+/// midpoint lies on the middle one, up to 0.015 mm beyond the ends of the outer two, and was
+/// reported as a deviation above the 0.01 mm tolerance although every chord lies on the path.
+#[test]
+fn chords_across_several_short_segments_are_measured_against_all_of_them() {
+    let mut moves = vec![f(1, 3000.0)];
+    for k in 0..200u32 {
+        moves.push(feed(2 + k, 0.03 * (k + 1) as f64, 0.0, 0.0));
+    }
+    let out = run_moves(&moves);
+    let top = out.samples.iter().map(|s| s.feed).fold(0.0, f64::max);
+    assert!((top - 50.0).abs() < 1e-9, "reaches the feed: {top}");
+    assert!(
+        out.report.max_deviation < 1e-12,
+        "{} at line {}",
+        out.report.max_deviation,
+        out.report.max_deviation_line
+    );
+}

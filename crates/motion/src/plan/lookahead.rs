@@ -18,7 +18,7 @@ use super::limits::{
 };
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
-use crate::profile::{max_reachable_speed, solve, Limits, Profile, ProfileError};
+use crate::profile::{max_reachable_speed, max_start_speed, solve, solve_at_most, Limits, Profile};
 
 /// A timed group of segments.
 #[derive(Debug, Clone)]
@@ -53,9 +53,12 @@ struct Group {
     length: f64,
     limits: Limits,
     end_cap: f64,
-    /// Highest entry speed from which the rest of the window can still stop (backward pass);
-    /// NaN until computed.
+    /// Highest entry speed from which the rest of the window can still stop (backward pass):
+    /// the bound the forward pass must respect; NaN until computed.
     backward: f64,
+    /// Highest entry speed from which the end speed aimed at is reached in one ramp (at most
+    /// `backward`): the entry speed the forward pass aims at; NaN until computed.
+    aimed: f64,
 }
 
 enum Entry {
@@ -295,6 +298,7 @@ impl Planner {
             limits,
             end_cap,
             backward: f64::NAN,
+            aimed: f64::NAN,
         }));
         self.commit_full()
     }
@@ -307,27 +311,41 @@ impl Planner {
     }
 
     /// Backward pass from the window's end (where the plan stops), stopping early where the
-    /// answer did not change since the last pass (window growth only raises these speeds).
+    /// answer did not change since the last pass. Two speeds per group:
+    ///
+    /// * `backward`, the highest entry speed from which *some* end speed within the next
+    ///   group's bound is reachable ([`max_start_speed`]). It only grows with that end speed,
+    ///   so window growth only raises it: a speed the forward pass has already committed to
+    ///   stays admissible when the window grows.
+    /// * `aimed`, the highest entry speed from which the next group's aimed entry is reached in
+    ///   one ramp ([`max_reachable_speed`] from it). A jerk-limited ramp gains less speed over
+    ///   a distance the faster it starts, so this can fall when a later junction allows more;
+    ///   but entering at `backward` where `aimed` is lower can leave only a speed far below the
+    ///   next junction's (often rest), so the forward pass aims here and uses `backward` only
+    ///   as the bound that keeps every committed speed reachable.
     fn backward(&mut self) -> Result<(), PlanError> {
-        let mut next = 0.0;
+        let (mut next, mut next_aimed) = (0.0, 0.0);
         for entry in self.window.iter_mut().rev() {
             match entry {
                 Entry::Group(g) => {
-                    let end = g.end_cap.min(next).min(g.limits.max_velocity());
-                    let reach = max_reachable_speed(end, g.length, &g.limits).map_err(|e| {
-                        PlanError::Profile {
-                            line: g.segments[0].line,
-                            source: e,
-                        }
-                    })?;
-                    let start = reach.min(g.limits.max_velocity());
-                    if start == g.backward {
+                    let err = |e| PlanError::Profile {
+                        line: g.segments[0].line,
+                        source: e,
+                    };
+                    let cap = g.end_cap.min(g.limits.max_velocity());
+                    let start = max_start_speed(cap.min(next), g.length, &g.limits).map_err(err)?;
+                    let aimed = max_reachable_speed(cap.min(next_aimed), g.length, &g.limits)
+                        .map_err(err)?
+                        .min(start);
+                    if start == g.backward && aimed == g.aimed {
                         break;
                     }
                     g.backward = start;
+                    g.aimed = aimed;
                     next = start;
+                    next_aimed = aimed;
                 }
-                _ => next = 0.0,
+                _ => (next, next_aimed) = (0.0, 0.0),
             }
         }
         Ok(())
@@ -351,29 +369,22 @@ impl Planner {
             }
             Entry::Group(g) => g,
         };
-        let next_start = match self.window.front() {
-            Some(Entry::Group(n)) => n.backward,
-            _ => 0.0,
+        let (next_start, next_aimed) = match self.window.front() {
+            Some(Entry::Group(n)) => (n.backward, n.aimed),
+            _ => (0.0, 0.0),
         };
         let line = g.segments[0].line;
         let err = |source| PlanError::Profile { line, source };
         let v0 = self.v_start.min(g.limits.max_velocity());
-        let target = g
-            .end_cap
-            .min(next_start)
-            .min(g.limits.max_velocity())
-            .max(0.0);
+        let cap = g.end_cap.min(g.limits.max_velocity()).max(0.0);
         let up = max_reachable_speed(v0, g.length, &g.limits).map_err(err)?;
-        let v1 = target.min(up);
-        let profile = match solve(g.length, v0, v1, &g.limits) {
+        let profile = match solve(g.length, v0, cap.min(next_aimed).min(up), &g.limits) {
             Ok(p) => p,
-            Err(ProfileError::EndSpeedUnreachable { reachable, .. })
-                if reachable <= v1 * (1.0 + 1e-9) + 1e-12 =>
-            {
-                // Lower the junction speed, never raise it.
-                solve(g.length, v0, reachable, &g.limits).map_err(err)?
-            }
-            Err(e) => return Err(err(e)),
+            // The aimed speed is out of reach (rounding, or the window grew since this entry
+            // speed was committed and the aim fell). v0 is at most this group's `backward`,
+            // so some end speed up to the next group's `backward` is reachable: the junction
+            // speed is lowered to the highest such, never raised.
+            Err(_) => solve_at_most(g.length, v0, cap.min(next_start), &g.limits).map_err(err)?,
         };
         self.v_start = profile.end().v.max(0.0);
         let mut offsets = Vec::with_capacity(g.lengths.len());

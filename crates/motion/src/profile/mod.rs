@@ -18,7 +18,7 @@ pub use error::{ProfileError, SpeedKind};
 pub use limits::{LimitKind, Limits, LimitsError};
 pub use phases::{Profile, State};
 pub use reach::{
-    max_reachable_speed, min_reachable_speed, min_stopping_distance, speed_change_distance,
-    speed_change_time,
+    max_reachable_speed, max_start_speed, min_reachable_speed, min_stopping_distance,
+    solve_at_most, speed_change_distance, speed_change_time,
 };
 pub use solve::solve;

@@ -81,6 +81,15 @@ pub fn solve(distance: f64, v0: f64, v1: f64, limits: &Limits) -> Result<Profile
             // distance and ends within SPEED_TOL of v1.
             return Ok(b.profile(v0, limits));
         }
+        if v1 < v0 {
+            // Braking, v0 may be the highest start from which v1 is reachable, up to rounding
+            // (a backward pass finds it by speeding up from v1): that speed-up, run backward,
+            // uses exactly the distance.
+            let back = reach::reach_up(v1, distance, limits);
+            if (back.speed - v0).abs() <= SPEED_TOL * limits.max_velocity() {
+                return Ok(back.reversed(v0, limits));
+            }
+        }
         return Err(ProfileError::EndSpeedUnreachable {
             start: v0,
             requested: v1,
