@@ -61,6 +61,15 @@ impl Curve for Geo {
             Geo::Spline(c) => c.point(u),
         }
     }
+    // Forwarded so that a spline's arc-length quadrature evaluates first derivatives only
+    // (the default would compute all three through `derivs`).
+    fn d1(&self, u: f64) -> Vec3 {
+        match self {
+            Geo::Line(c) => c.d1(u),
+            Geo::Arc(c) => c.d1(u),
+            Geo::Spline(c) => c.d1(u),
+        }
+    }
     fn curvature(&self, u: f64) -> f64 {
         match self {
             Geo::Line(c) => c.curvature(u),
