@@ -201,6 +201,7 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 let value = f * self.units.mm();
                 self.push(line, MoveKind::FeedRate { value });
             }
+            Canon::SetSpindleSpeed(rpm) => self.push(line, MoveKind::SpindleSpeed { rpm }),
             Canon::SetFeedMode(m) => {
                 let mode = if m == 1 {
                     FeedMode::UnitsPerRevolution

@@ -77,6 +77,9 @@ pub enum MoveKind {
     FeedRate { value: f64 },
     /// G93/G94/G95.
     FeedMode(FeedMode),
+    /// S: the spindle speed from here on, rev/min. Under G95 the feed (mm/rev) times it is the
+    /// feed along the path; the spindle is taken to run at the programmed speed.
+    SpindleSpeed { rpm: f64 },
     /// G61 / G61.1 / G64 P Q.
     PathMode(PathMode),
     /// Fanuc's `G05.1 Q1` (true) / `Q0`: runs of short moves may be compressed into splines.

@@ -597,3 +597,42 @@ fn chords_across_several_short_segments_are_measured_against_all_of_them() {
         out.report.max_deviation_line
     );
 }
+
+/// G95: F in mm per spindle revolution, times the programmed S. A 30 mm line at F0.1 mm/rev
+/// and S2000 runs at 200 mm/min = 3.333 mm/s: 9 s plus the speed's rise and fall (well under
+/// 0.1 s at mill3's accelerations); at S1000 twice as long. Without S the move is refused.
+#[test]
+fn feed_per_revolution_is_f_times_the_spindle_speed() {
+    let moves = |rpm: Option<f64>| {
+        let mut m = vec![
+            Move {
+                line: 1,
+                kind: MoveKind::FeedMode(FeedMode::UnitsPerRevolution),
+            },
+            Move {
+                line: 1,
+                kind: MoveKind::FeedRate { value: 0.1 },
+            },
+        ];
+        if let Some(rpm) = rpm {
+            m.push(Move {
+                line: 1,
+                kind: MoveKind::SpindleSpeed { rpm },
+            });
+        }
+        m.push(Move {
+            line: 2,
+            kind: MoveKind::Feed {
+                end: Pose([30.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+            },
+        });
+        m
+    };
+    let fast = run_moves(&moves(Some(2000.0)));
+    assert_within_limits(&fast);
+    assert!((9.0..9.1).contains(&fast.duration), "{}", fast.duration);
+    let slow = run_moves(&moves(Some(1000.0)));
+    assert!((18.0..18.1).contains(&slow.duration), "{}", slow.duration);
+    let refused = build(&moves(None), Pose::ZERO, DirectOptions::default());
+    assert!(refused.unwrap_err().to_string().contains("G95"));
+}

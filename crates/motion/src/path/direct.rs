@@ -15,7 +15,7 @@ use super::segment::{Junction, PathItem, Segment, SegmentFeed};
 pub enum DirectError {
     #[error("line {line}: feed move with no feed rate (F0 or no F)")]
     NoFeed { line: u32 },
-    #[error("line {line}: feed per revolution (G95) needs a spindle speed model, not supported")]
+    #[error("line {line}: feed per revolution (G95) with no spindle speed (S)")]
     FeedPerRevolution { line: u32 },
     #[error("line {line}: bad arc: {reason}")]
     BadArc { line: u32, reason: String },
@@ -58,6 +58,8 @@ pub struct Direct {
     position: Pose,
     feed_rate: f64,
     feed_mode: FeedMode,
+    /// Programmed spindle speed (rev/min), for G95.
+    spindle_rpm: f64,
     path_mode: PathMode,
     pending: Option<Segment>,
     control: ToolControl,
@@ -91,6 +93,7 @@ impl Direct {
             position: start,
             feed_rate: 0.0,
             feed_mode: FeedMode::UnitsPerMinute,
+            spindle_rpm: 0.0,
             path_mode: PathMode::default(),
             pending: None,
             control: options.control,
@@ -128,16 +131,13 @@ impl Direct {
         if rapid {
             return Ok(SegmentFeed::Rapid);
         }
-        match self.feed_mode {
-            FeedMode::UnitsPerRevolution => Err(DirectError::FeedPerRevolution { line }),
-            _ if !(self.feed_rate > 0.0 && self.feed_rate.is_finite()) => {
-                Err(DirectError::NoFeed { line })
-            }
-            // G93: F is 1/minutes for the move.
-            FeedMode::InverseTime => Ok(SegmentFeed::InverseTime(60.0 / self.feed_rate)),
-            // G94: mm/min → mm/s (deg/min → deg/s for a rotary-only move).
-            FeedMode::UnitsPerMinute => Ok(SegmentFeed::Feed(self.feed_rate / 60.0)),
-        }
+        SegmentFeed::programmed(self.feed_mode, self.feed_rate, self.spindle_rpm).ok_or(
+            if self.feed_mode == FeedMode::UnitsPerRevolution && self.feed_rate > 0.0 {
+                DirectError::FeedPerRevolution { line }
+            } else {
+                DirectError::NoFeed { line }
+            },
+        )
     }
 
     /// Takes one move; finished items are appended to `out`.
@@ -150,6 +150,10 @@ impl Direct {
             }
             &MoveKind::FeedMode(mode) => {
                 self.feed_mode = mode;
+                return Ok(());
+            }
+            &MoveKind::SpindleSpeed { rpm } => {
+                self.spindle_rpm = rpm;
                 return Ok(());
             }
             &MoveKind::PathMode(mode) => {

@@ -19,6 +19,26 @@ pub enum SegmentFeed {
     InverseTime(f64),
 }
 
+impl SegmentFeed {
+    /// The feed of a programmed (non-rapid) move: `value` is the F in force (mm/min, deg/min
+    /// for rotary-only moves; 1/min under G93; mm/rev under G95, turned into mm/min by the
+    /// spindle speed `rpm`, the spindle taken to run at its programmed speed). `None` when the
+    /// numbers cannot time a move (F or, under G95, S not positive and finite).
+    pub fn programmed(mode: tezgah_geom::FeedMode, value: f64, rpm: f64) -> Option<SegmentFeed> {
+        use tezgah_geom::FeedMode;
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(value) {
+            return None;
+        }
+        Some(match mode {
+            FeedMode::UnitsPerMinute => SegmentFeed::Feed(value / 60.0),
+            FeedMode::InverseTime => SegmentFeed::InverseTime(60.0 / value),
+            FeedMode::UnitsPerRevolution if positive(rpm) => SegmentFeed::Feed(value * rpm / 60.0),
+            FeedMode::UnitsPerRevolution => return None,
+        })
+    }
+}
+
 /// What joins a segment to the next one.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Junction {

@@ -18,8 +18,8 @@ pub enum PathError {
     /// A feed move with a feed that is not finite and positive.
     #[error("line {line}: feed {value} is not a positive finite number")]
     Feed { line: u32, value: f64 },
-    /// G95 (feed per revolution) needs the spindle speed, which the path stage does not know.
-    #[error("line {line}: feed per revolution (G95) is not supported by the path stage")]
+    /// G95 (feed per revolution) with no spindle speed to turn it into a feed.
+    #[error("line {line}: feed per revolution (G95) with no spindle speed (S)")]
     FeedPerRevolution { line: u32 },
     /// A tolerance (options or `G64 P`) that is not finite and positive.
     #[error("line {line}: path tolerance {value} mm is not a positive finite number")]

@@ -161,6 +161,8 @@ struct Modal {
     pos: Pose,
     feed: Option<f64>,
     feed_mode: FeedMode,
+    /// Programmed spindle speed (rev/min), for G95.
+    spindle_rpm: f64,
     mode: Mode,
     tolerance: f64,
     control: ToolControl,
@@ -211,6 +213,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 pos: opts.start,
                 feed: None,
                 feed_mode: FeedMode::UnitsPerMinute,
+                spindle_rpm: 0.0,
                 mode: Mode::Continuous,
                 tolerance: opts.tolerance,
                 control: opts.control,
@@ -240,6 +243,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
             }
             &MoveKind::FeedMode(f) => {
                 m.feed_mode = f;
+                return Ok(None);
+            }
+            &MoveKind::SpindleSpeed { rpm } => {
+                m.spindle_rpm = rpm;
                 return Ok(None);
             }
             &MoveKind::PathMode(p) => {
@@ -313,13 +320,8 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 if !(v.is_finite() && v > 0.0) {
                     return Err(PathError::Feed { line, value: v });
                 }
-                match m.feed_mode {
-                    FeedMode::UnitsPerMinute => SegmentFeed::Feed(v / 60.0),
-                    FeedMode::InverseTime => SegmentFeed::InverseTime(60.0 / v),
-                    FeedMode::UnitsPerRevolution => {
-                        return Err(PathError::FeedPerRevolution { line })
-                    }
-                }
+                SegmentFeed::programmed(m.feed_mode, v, m.spindle_rpm)
+                    .ok_or(PathError::FeedPerRevolution { line })?
             }
         };
         m.pos = end;
