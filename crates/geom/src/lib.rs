@@ -37,6 +37,6 @@ pub use nurbs::Nurbs;
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};
 pub use surface::{
-    FundamentalForms, NurbsSurface, PrincipalCurvatures, SurfaceDerivs, SurfaceError,
+    ClosestPoint, FundamentalForms, NurbsSurface, PrincipalCurvatures, SurfaceDerivs, SurfaceError,
 };
 pub use trim::Trimmed;

@@ -399,3 +399,123 @@ proptest! {
             "II/I={} euler={} k1={} k2={}", second / first, euler, pc.k1, pc.k2);
     }
 }
+
+#[test]
+fn closest_point_on_sphere_and_torus_is_the_radial_foot() {
+    let r = 7.0;
+    let sphere = revolve([(r, 0.0, 1.0), (r, r, FRAC_1_SQRT_2), (0.0, r, 1.0)]);
+    let (big, t) = (20.0, 4.0);
+    let torus = revolve([
+        (big + t, 0.0, 1.0),
+        (big + t, t, FRAC_1_SQRT_2),
+        (big, t, 1.0),
+    ]);
+    for (a, b) in grid(12) {
+        // Directions inside the octant, away from the pole (where u is undefined).
+        let (theta, phi) = (0.05 + 1.4 * a, 0.05 + 1.3 * b);
+        let dir = Vec3::new(phi.cos() * theta.cos(), phi.cos() * theta.sin(), phi.sin());
+        for scale in [0.3, 0.9, 1.0, 1.5, 3.0] {
+            let q = dir * (r * scale);
+            let c = sphere.closest_point(&q, 1e-12).unwrap();
+            assert!(
+                (c.distance - (r * scale - r).abs()).abs() < 1e-12,
+                "{q} {c:?}"
+            );
+            assert!((c.point - dir * r).norm() < 1e-9, "{q} {c:?}");
+        }
+        // Torus: q off the tube centre along the outward tube direction.
+        let (c_dir, tube) = (
+            Vec3::new(theta.cos(), theta.sin(), 0.0),
+            Vec3::new(phi.cos() * theta.cos(), phi.cos() * theta.sin(), phi.sin()),
+        );
+        for off in [0.5, 3.9, 4.0, 6.0] {
+            let q = c_dir * big + tube * off;
+            let c = torus.closest_point(&q, 1e-12).unwrap();
+            assert!((c.distance - (off - t).abs()).abs() < 1e-12, "{q} {c:?}");
+            assert!(
+                (c.point - (c_dir * big + tube * t)).norm() < 1e-7,
+                "{q} {c:?}"
+            );
+        }
+    }
+    assert_eq!(
+        sphere.closest_point(&Vec3::zeros(), 0.0),
+        Err(SurfaceError::Tolerance(0.0))
+    );
+    assert_eq!(
+        sphere.closest_point(&Vec3::new(f64::NAN, 0.0, 0.0), 1e-9),
+        Err(SurfaceError::QueryNotFinite)
+    );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn closest_point_finds_a_point_just_off_the_surface(
+        s in height_field(), u in 0.0f64..=1.0, v in 0.0f64..=1.0, off in -1.0f64..1.0
+    ) {
+        let (u0, u1) = s.domain_u();
+        let (v0, v1) = s.domain_v();
+        let (u, v) = (u0 + (u1 - u0) * u, v0 + (v1 - v0) * v);
+        let n = s.normal(u, v).unwrap();
+        let q = s.point(u, v) + n.into_inner() * off;
+        let c = s.closest_point(&q, 1e-12).unwrap();
+        prop_assert!(c.distance <= off.abs() + 1e-12, "{:?} off={}", c, off);
+        prop_assert!((c.point - s.point(c.u, c.v)).norm() == 0.0);
+        // Strictly inside a knot-span cell the foot is a perpendicular one (on a knot line of a
+        // degree-1 field it may sit on a crease instead).
+        let d = s.derivs(c.u, c.v);
+        let r = c.point - q;
+        let inside = |t: f64, knots: &[f64]| knots.iter().all(|&k| k != t);
+        if inside(c.u, s.knots_u()) && inside(c.v, s.knots_v()) {
+            prop_assert!(r.dot(&d.su).abs() <= 1e-9 * d.su.norm(), "{:?}", c);
+            prop_assert!(r.dot(&d.sv).abs() <= 1e-9 * d.sv.norm(), "{:?}", c);
+        }
+        // No sample of a dense grid is nearer (the search is global, not just local).
+        for (a, b) in grid(40) {
+            let x = s.point(u0 + (u1 - u0) * a, v0 + (v1 - v0) * b);
+            prop_assert!(c.distance <= (x - q).norm() + 1e-12, "{:?} beaten by {} at {}", c, x, (x - q).norm());
+        }
+    }
+}
+
+/// A random rational height field, the shape of a machined free-form patch: control points on
+/// a 10 mm grid in x, y with heights within ±3 mm, degrees 1–4, weights 0.5–2.
+fn height_field() -> impl Strategy<Value = NurbsSurface> {
+    (1usize..=4, 1usize..=4, 0usize..=3, 0usize..=3).prop_flat_map(|(p, q, eu, ev)| {
+        let (rows, cols) = (p + 1 + eu, q + 1 + ev);
+        (
+            prop::collection::vec(-3.0f64..3.0, rows * cols),
+            prop::collection::vec(0.5f64..2.0, rows * cols),
+            prop::collection::vec(0.2f64..1.0, eu + 1),
+            prop::collection::vec(0.2f64..1.0, ev + 1),
+        )
+            .prop_map(move |(z, w, iu, iv)| {
+                let pts: Vec<Vec3> = (0..rows * cols)
+                    .map(|k| Vec3::new(10.0 * (k / cols) as f64, 10.0 * (k % cols) as f64, z[k]))
+                    .collect();
+                NurbsSurface::new(p, q, &pts, &w, knots(p, &iu), knots(q, &iv))
+                    .expect("generated surface is valid")
+            })
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    /// On wild surfaces (a degree-4 piece can fold between the seeds) the search is local:
+    /// what it returns is a local minimum — no nearby parameter pair is nearer.
+    #[test]
+    fn closest_point_is_a_local_minimum_on_random_surfaces(s in surface(), q in vec3(30.0)) {
+        let (u0, u1) = s.domain_u();
+        let (v0, v1) = s.domain_v();
+        let c = s.closest_point(&q, 1e-12).unwrap();
+        prop_assert!((c.point - q).norm() == c.distance);
+        let (hu, hv) = (1e-4 * (u1 - u0), 1e-4 * (v1 - v0));
+        for (a, b) in [(-1.0, -1.0), (-1.0, 0.0), (-1.0, 1.0), (0.0, -1.0), (0.0, 1.0), (1.0, -1.0), (1.0, 0.0), (1.0, 1.0)] {
+            let x = s.point((c.u + a * hu).clamp(u0, u1), (c.v + b * hv).clamp(v0, v1));
+            prop_assert!(c.distance <= (x - q).norm() + 1e-12, "{:?} beaten by {} at {}", c, x, (x - q).norm());
+        }
+    }
+}
