@@ -3,7 +3,8 @@
 //! It sits at the bottom of the crate stack: the G-code interpreter emits [`Move`]s built from
 //! these types, and the planner, kinematics and CAM consume them without knowing about G-code.
 //! The curve layer ([`Curve`] and its implementations, [`ArcLengthMap`], [`fit`],
-//! [`deviation`]) is what the path builder turns moves into.
+//! [`deviation`]) is what the path builder turns moves into; the surface layer ([`NurbsSurface`])
+//! is what CAM machines.
 
 pub mod arc;
 pub mod arclen;
@@ -20,6 +21,7 @@ pub mod moves;
 pub mod nurbs;
 pub mod pose;
 pub mod quintic;
+pub mod surface;
 pub mod trim;
 
 pub use arc::{Arc, Helix};
@@ -34,4 +36,7 @@ pub use moves::{
 pub use nurbs::Nurbs;
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};
+pub use surface::{
+    ClosestPoint, FundamentalForms, NurbsSurface, PrincipalCurvatures, SurfaceDerivs, SurfaceError,
+};
 pub use trim::Trimmed;

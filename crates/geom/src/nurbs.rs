@@ -73,43 +73,7 @@ impl Nurbs {
                 return Err(CurveError::Weight { index, value });
             }
         }
-        for i in 1..knots.len() {
-            if knots[i] < knots[i - 1] {
-                return Err(CurveError::KnotsDecreasing {
-                    index: i,
-                    value: knots[i],
-                });
-            }
-        }
-        let n = points.len() - 1;
-        let (lo, hi) = (knots[degree], knots[n + 1]);
-        if lo >= hi {
-            return Err(CurveError::EmptyDomain);
-        }
-        let mut i = 0;
-        while i < knots.len() {
-            let mut j = i;
-            while j + 1 < knots.len() && knots[j + 1] == knots[i] {
-                j += 1;
-            }
-            let m = j - i + 1;
-            let inside = knots[i] > lo && knots[i] < hi;
-            if m > degree + 1 || (inside && m > degree) {
-                return Err(CurveError::KnotMultiplicity {
-                    value: knots[i],
-                    multiplicity: m,
-                    degree,
-                });
-            }
-            i = j + 1;
-        }
-        let first = (degree..=n)
-            .find(|&s| knots[s] < knots[s + 1])
-            .unwrap_or(degree);
-        let last = (degree..=n)
-            .rev()
-            .find(|&s| knots[s] < knots[s + 1])
-            .unwrap_or(n);
+        let (first, last) = domain_spans(degree, &knots)?;
         let cw = points
             .iter()
             .zip(weights)
@@ -214,6 +178,23 @@ impl Nurbs {
         Ok((left, right))
     }
 
+    /// A curve from homogeneous control points whose degree, knots and weights the caller has
+    /// already validated with [`domain_spans`] (a NURBS surface building its iso curves).
+    pub(crate) fn from_valid_homogeneous(
+        degree: usize,
+        cw: Vec<Vector4<f64>>,
+        knots: Vec<f64>,
+        (first, last): (usize, usize),
+    ) -> Nurbs {
+        Nurbs {
+            degree,
+            knots,
+            cw,
+            first,
+            last,
+        }
+    }
+
     fn from_homogeneous(
         degree: usize,
         cw: Vec<Vector4<f64>>,
@@ -260,8 +241,53 @@ impl Nurbs {
     }
 }
 
+/// Knot-vector checks shared by curves and surfaces (`knots.len()` already equals control
+/// points + degree + 1, all finite): non-decreasing, a non-empty domain `[u_p, u_{n+1}]`, no
+/// knot repeated more than `degree` times inside the domain or `degree + 1` times anywhere.
+/// Returns the first and last non-empty span of the domain (for A2.1 at the domain ends).
+pub(crate) fn domain_spans(degree: usize, knots: &[f64]) -> Result<(usize, usize), CurveError> {
+    for i in 1..knots.len() {
+        if knots[i] < knots[i - 1] {
+            return Err(CurveError::KnotsDecreasing {
+                index: i,
+                value: knots[i],
+            });
+        }
+    }
+    let n = knots.len() - degree - 2;
+    let (lo, hi) = (knots[degree], knots[n + 1]);
+    if lo >= hi {
+        return Err(CurveError::EmptyDomain);
+    }
+    let mut i = 0;
+    while i < knots.len() {
+        let mut j = i;
+        while j + 1 < knots.len() && knots[j + 1] == knots[i] {
+            j += 1;
+        }
+        let m = j - i + 1;
+        let inside = knots[i] > lo && knots[i] < hi;
+        if m > degree + 1 || (inside && m > degree) {
+            return Err(CurveError::KnotMultiplicity {
+                value: knots[i],
+                multiplicity: m,
+                degree,
+            });
+        }
+        i = j + 1;
+    }
+    let first = (degree..=n)
+        .find(|&s| knots[s] < knots[s + 1])
+        .unwrap_or(degree);
+    let last = (degree..=n)
+        .rev()
+        .find(|&s| knots[s] < knots[s + 1])
+        .unwrap_or(n);
+    Ok((first, last))
+}
+
 /// Binomial coefficients up to 3 for A4.2.
-const BIN: [[f64; 4]; 4] = [
+pub(crate) const BIN: [[f64; 4]; 4] = [
     [1.0, 0.0, 0.0, 0.0],
     [1.0, 1.0, 0.0, 0.0],
     [1.0, 2.0, 1.0, 0.0],
