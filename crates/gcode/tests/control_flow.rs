@@ -106,8 +106,20 @@ fn runaway_loop_and_recursion_are_stopped() {
         r.unwrap_err().kind,
         ErrorKind::RunawayLoop("1".into(), 1000)
     );
-    let (_, r) = messages("o9 sub\no9 call\no9 endsub\no9 call\nM2\n", cfg);
+    let (_, r) = messages("o9 sub\no9 call\no9 endsub\no9 call\nM2\n", cfg.clone());
     assert_eq!(r.unwrap_err().kind, ErrorKind::CallsTooDeep(8));
+    // A loop left open inside another (a `repeat` or `while` with no end) must not hide the
+    // outer loop's passes from the guard (found by fuzzing: it ran for ever and the loop stack
+    // grew without bound).
+    for inner in ["o6 repeat [3]", "o7 while [1]", "o8 do"] {
+        let program = format!("o2 while [1]\n{inner}\nG0 X1\no2 endwhile\nM2\n");
+        let (_, r) = messages(&program, cfg.clone());
+        assert_eq!(
+            r.unwrap_err().kind,
+            ErrorKind::RunawayLoop("2".into(), 1000),
+            "{inner}"
+        );
+    }
 }
 
 #[test]

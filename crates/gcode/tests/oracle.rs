@@ -1084,10 +1084,16 @@ fn expression() -> impl Strategy<Value = String> {
         let funcs = [
             "ABS", "COS", "SIN", "SQRT", "FIX", "FUP", "ROUND", "EXP", "LN", "ACOS", "ASIN",
         ];
+        // ROUND's argument is kept within ±10⁶: LinuxCNC rounds through a C `int`, undefined
+        // beyond ±2³¹ (x86 gives −2147483648), where tezgah rounds the double.
+        let call = |f: &str, a: String| match f {
+            "ROUND" => format!("ROUND[[{a}] MOD 1000000]"),
+            _ => format!("{f}[{a}]"),
+        };
         prop_oneof![
             (inner.clone(), 0..ops.len(), inner.clone())
                 .prop_map(move |(a, o, b)| format!("{a} {} {b}", ops[o])),
-            (0..funcs.len(), inner.clone()).prop_map(move |(f, a)| format!("{}[{a}]", funcs[f])),
+            (0..funcs.len(), inner.clone()).prop_map(move |(f, a)| call(funcs[f], a)),
             (inner.clone(), inner.clone()).prop_map(|(a, b)| format!("ATAN[{a}]/[{b}]")),
             inner.prop_map(|a| format!("[{a}]")),
         ]

@@ -404,7 +404,11 @@ impl Interpreter {
                 let l = self
                     .innermost_loop(label, LoopKind::While)
                     .ok_or_else(|| unmatched("endwhile"))?;
-                return Ok(Flow::Jump(l.start));
+                let start = l.start;
+                // Loops opened inside and never closed end here: the head runs again as the
+                // same loop (its passes counted by the guard, the stack not growing).
+                self.unwind_to_loop(label);
+                return Ok(Flow::Jump(start));
             }
             OKeyword::Repeat => {
                 let n = o
@@ -487,6 +491,14 @@ impl Interpreter {
     /// `while`: the head of a `while` loop, or the end of a `do` loop.
     fn while_line(&mut self, o: &OWord, line: LineRef) -> Exec<Flow> {
         let label = &o.label;
+        // The loop this line belongs to may have loops left open inside it: they end here.
+        let own = self.control.loops.iter().rposition(|l| {
+            l.label == *label
+                && (l.kind == LoopKind::Do || (l.kind == LoopKind::While && l.start == line.pos()))
+        });
+        if let Some(i) = own {
+            self.control.loops.truncate(i + 1);
+        }
         let top = self.control.loops.last();
         let closes_do = top.is_some_and(|l| l.label == *label && l.kind == LoopKind::Do);
         let again = top.is_some_and(|l| l.label == *label && l.start == line.pos());
