@@ -270,6 +270,10 @@ pub enum ErrorKind {
     SubInIllegalLocation(u32, String),
     #[error("line:{0} redefining sub: o|{1}| already defined")]
     SubRedefined(u32, String),
+    #[error("L{0} repeats of the cycle are more than {1}")]
+    TooManyRepeats(u32, u64),
+    #[error("G{0} with Q{1} would make more than {2} pecks")]
+    TooManyPecks(u32, f64, u64),
     #[error("Failed to find sub 'O{0}' before EOF")]
     SkippedPastPercent(String),
     #[error("Unable to find subroutine o{0}")]

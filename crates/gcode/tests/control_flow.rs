@@ -108,6 +108,31 @@ fn runaway_loop_and_recursion_are_stopped() {
     );
     let (_, r) = messages("o9 sub\no9 call\no9 endsub\no9 call\nM2\n", cfg.clone());
     assert_eq!(r.unwrap_err().kind, ErrorKind::CallsTooDeep(8));
+    // A peck smaller than the depth's last bit (found by fuzzing) never reaches the bottom.
+    let (_, r) = messages(
+        "G21 F100\nG0 Z5\nG83 X1 Z-3 R1 Q0.000000000000000000000000000000007\nM2\n",
+        cfg.clone(),
+    );
+    assert_eq!(
+        r.unwrap_err().kind,
+        ErrorKind::TooManyPecks(83, 7e-33, 1000)
+    );
+    let (_, r) = messages("G21 F100\nG0 Z5\nG73 X1 Z-3 R1 Q0.001\nM2\n", cfg.clone());
+    assert_eq!(
+        r.unwrap_err().kind,
+        ErrorKind::TooManyPecks(73, 0.001, 1000)
+    );
+    let (_, r) = messages(
+        "G21 F100\nG0 Z5\nG91 G81 X1 Z-3 R1 L2000000000\nM2\n",
+        cfg.clone(),
+    );
+    assert_eq!(
+        r.unwrap_err().kind,
+        ErrorKind::TooManyRepeats(2_000_000_000, 1000)
+    );
+    // 4 mm in 0.01 mm pecks: 400, within the guard.
+    let (_, r) = messages("G21 F100\nG0 Z5\nG83 X1 Z-3 R1 Q0.01\nM2\n", cfg.clone());
+    assert!(r.is_ok(), "{r:?}");
     // A loop left open inside another (a `repeat` or `while` with no end) must not hide the
     // outer loop's passes from the guard (found by fuzzing: it ran for ever and the loop stack
     // grew without bound).

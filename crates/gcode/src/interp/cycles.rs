@@ -77,6 +77,11 @@ impl Interpreter {
             Some(l) => l as u32,
             None => 1,
         };
+        // The loop guard bounds L as it bounds loops (L2000000000 would drill for ever).
+        let limit = self.cfg.limits.max_loop_iterations;
+        if u64::from(repeats) > limit {
+            return err(ErrorKind::TooManyRepeats(repeats, limit));
+        }
         let (first, second, normal) = plane.axes();
         let (plane_name, normal_letter) = match plane {
             Plane::XY => ("xy", 'z'),
@@ -273,6 +278,14 @@ impl Interpreter {
             Units::Inches => PECK_CLEARANCE_INCH,
             Units::Millimeters => PECK_CLEARANCE_INCH * 25.4,
         };
+        // A Q far below the depth makes pecks without end (in LinuxCNC too: once Q is below
+        // the depth's last bit, the depth stops changing): the loop guard bounds their number.
+        let pecks = ((h.r - h.bottom) / q).ceil();
+        let limit = self.cfg.limits.max_loop_iterations;
+        if pecks.is_nan() || pecks > limit as f64 {
+            let code = if full { 83 } else { 73 };
+            return Err((ErrorKind::TooManyPecks(code, q, limit), at));
+        }
         let mut depth = h.r - q;
         while depth > h.bottom {
             self.cycle_move(h, depth, true, sink);
