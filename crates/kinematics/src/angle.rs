@@ -68,6 +68,41 @@ pub fn unwrap_within(a: f64, previous: f64, min: f64, max: f64) -> Option<f64> {
     }
 }
 
+/// Cephes' rational approximation of atan(t)/t − 1 on |t| ≤ 0.66: numerator and denominator
+/// coefficients, shared by [`atan2`] and [`atan2_pair`].
+const ATAN_P: [f64; 5] = [
+    -8.750_608_600_031_904e-1,
+    -1.615_753_718_733_365e1,
+    -7.500_855_792_314_705e1,
+    -1.228_866_684_490_136_2e2,
+    -6.485_021_904_942_025e1,
+];
+const ATAN_Q: [f64; 5] = [
+    2.485_846_490_142_306_3e1,
+    1.650_270_098_316_988_6e2,
+    4.328_810_604_912_903e2,
+    4.853_903_996_359_137e2,
+    1.945_506_571_482_614e2,
+];
+/// tan(3π/8), the bound of the steep reduction.
+const T3P8: f64 = 2.414_213_562_373_095;
+/// π/2 − fl(π/2), the bits of π/2 a double drops.
+const MOREBITS: f64 = 6.123_233_995_736_766e-17;
+
+/// The numerator polynomial of the rational, at z = t².
+#[inline(always)]
+fn atan_p(z: f64) -> f64 {
+    let p = ATAN_P;
+    (((p[0] * z + p[1]) * z + p[2]) * z + p[3]) * z + p[4]
+}
+
+/// The (monic) denominator polynomial of the rational, at z = t².
+#[inline(always)]
+fn atan_q(z: f64) -> f64 {
+    let q = ATAN_Q;
+    ((((z + q[0]) * z + q[1]) * z + q[2]) * z + q[3]) * z + q[4]
+}
+
 /// atan2 with the same accuracy as the C library's (checked against it to 1e-15 in the tests)
 /// at a fraction of the cost: Cephes' `atan` (S. L. Moshier: rational approximation on
 /// |t| ≤ 0.66 after reduction by tan(3π/8) and π/4), with the reduction applied to (y, x)
@@ -75,22 +110,6 @@ pub fn unwrap_within(a: f64, previous: f64, min: f64, max: f64) -> Option<f64> {
 /// and Y-Z-C-A inverses need two per pose, and libm's took a third of their time.
 #[inline(always)]
 pub fn atan2(y: f64, x: f64) -> f64 {
-    const P: [f64; 5] = [
-        -8.750_608_600_031_904e-1,
-        -1.615_753_718_733_365e1,
-        -7.500_855_792_314_705e1,
-        -1.228_866_684_490_136_2e2,
-        -6.485_021_904_942_025e1,
-    ];
-    const Q: [f64; 5] = [
-        2.485_846_490_142_306_3e1,
-        1.650_270_098_316_988_6e2,
-        4.328_810_604_912_903e2,
-        4.853_903_996_359_137e2,
-        1.945_506_571_482_614e2,
-    ];
-    const T3P8: f64 = 2.414_213_562_373_095; // tan(3π/8)
-    const MOREBITS: f64 = 6.123_233_995_736_766e-17; // π/2 − fl(π/2)
     if x == 0.0 || !x.is_finite() || !y.is_finite() {
         // zeros, infinities and NaN: the library's exact conventions
         return y.atan2(x);
@@ -109,8 +128,7 @@ pub fn atan2(y: f64, x: f64) -> f64 {
         )
     };
     let z = t * t;
-    let p = (((P[0] * z + P[1]) * z + P[2]) * z + P[3]) * z + P[4];
-    let q = ((((z + Q[0]) * z + Q[1]) * z + Q[2]) * z + Q[3]) * z + Q[4];
+    let (p, q) = (atan_p(z), atan_q(z));
     let r = base + (t * (z * p / q) + t + extra);
     let r = if x < 0.0 { PI - r } else { r };
     if y.is_sign_negative() {
@@ -128,22 +146,6 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 /// off the pole); a lane outside that falls back to the library.
 #[inline(always)]
 pub fn atan2_pair(y: [f64; 2], x: [f64; 2]) -> [f64; 2] {
-    const P: [f64; 5] = [
-        -8.750_608_600_031_904e-1,
-        -1.615_753_718_733_365e1,
-        -7.500_855_792_314_705e1,
-        -1.228_866_684_490_136_2e2,
-        -6.485_021_904_942_025e1,
-    ];
-    const Q: [f64; 5] = [
-        2.485_846_490_142_306_3e1,
-        1.650_270_098_316_988_6e2,
-        4.328_810_604_912_903e2,
-        4.853_903_996_359_137e2,
-        1.945_506_571_482_614e2,
-    ];
-    const T3P8: f64 = 2.414_213_562_373_095;
-    const MOREBITS: f64 = 6.123_233_995_736_766e-17;
     let ordinary = |i: usize| y[i].is_finite() && x[i].is_finite() && (y[i] != 0.0 || x[i] != 0.0);
     if !(ordinary(0) && ordinary(1)) {
         return [y[0].atan2(x[0]), y[1].atan2(x[1])];
@@ -192,8 +194,8 @@ pub fn atan2_pair(y: [f64; 2], x: [f64; 2]) -> [f64; 2] {
     let mut pz = [0.0; 2];
     let mut qz = [0.0; 2];
     for i in 0..2 {
-        pz[i] = (((P[0] * z[i] + P[1]) * z[i] + P[2]) * z[i] + P[3]) * z[i] + P[4];
-        qz[i] = ((((z[i] + Q[0]) * z[i] + Q[1]) * z[i] + Q[2]) * z[i] + Q[3]) * z[i] + Q[4];
+        pz[i] = atan_p(z[i]);
+        qz[i] = atan_q(z[i]);
     }
     let ratio = [pz[0] / qz[0], pz[1] / qz[1]];
     for i in 0..2 {

@@ -108,27 +108,25 @@ impl Interpreter {
     fn straight(&mut self, block: &Block, rapid: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
         self.comp.arc_not_allowed = false;
         let end = self.find_ends(block);
-        if self.comp.active() {
-            if !rapid {
-                if let Some(f) = self.feed_for_move(block, false, at)? {
-                    let length = straight_length(end - self.comp_start());
-                    self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
-                }
+        if !rapid {
+            // The inverse-time length is the programmed one, also while compensating.
+            if let Some(f) = self.feed_for_move(block, false, at)? {
+                let length = straight_length(end - self.comp_start());
+                self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
             }
+        }
+        if self.comp.active() {
             if block.g(ggroup::NON_MODAL) == Some(530) {
                 return Err((CompError::G53.into(), at));
             }
             return self.straight_comp(rapid, end, sink).map_err(|k| (k, at));
         }
-        if rapid {
-            self.emit(sink, Canon::StraightTraverse(end));
+        let call = if rapid {
+            Canon::StraightTraverse(end)
         } else {
-            if let Some(f) = self.feed_for_move(block, false, at)? {
-                let length = straight_length(end - self.state.pos);
-                self.set_inverse_time_rate(inverse_time_rate(f, length), sink);
-            }
-            self.emit(sink, Canon::StraightFeed(end));
-        }
+            Canon::StraightFeed(end)
+        };
+        self.emit(sink, call);
         self.state.pos = end;
         Ok(())
     }
