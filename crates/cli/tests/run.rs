@@ -13,6 +13,17 @@ fn tmp(name: &str) -> std::path::PathBuf {
     d.join(name)
 }
 
+/// The run succeeded (else its output is shown) and its JSON report, read back.
+fn succeeded_with_report(out: &std::process::Output, json: &std::path::Path) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
+}
+
 #[test]
 fn demo_run_writes_samples_report_and_plots() {
     let (csv, json, plots) = (tmp("s.csv"), tmp("r.json"), tmp("plots"));
@@ -114,14 +125,7 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let report = succeeded_with_report(&out, &json);
     let joints = report["joints"].as_array().unwrap();
     assert_eq!(joints.len(), 5);
     assert_eq!(joints[4]["unit"], "deg");
@@ -169,14 +173,7 @@ fn spline_example_runs_within_tolerance_and_limits() {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let report = succeeded_with_report(&out, &json);
     // verify: every sample within the tolerance of the programmed curves, limits held.
     let tolerance = report["tolerance_mm"].as_f64().unwrap();
     assert!(report["max_deviation_mm"].as_f64().unwrap() <= tolerance);
