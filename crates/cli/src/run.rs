@@ -40,9 +40,9 @@ fn smooth_options(
     }
 }
 
-pub const DEMO: &str = include_str!("../demo/demo.ngc");
+pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
 /// The demo's tool table.
-pub const DEMO_TOOLS: &str = include_str!("../demo/tools.tbl");
+pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
 
 /// Samples after which a progress bar is shown (about a minute of machining at 1 ms).
 const PROGRESS_SAMPLES: u64 = 60_000;

@@ -64,17 +64,17 @@ fn invalid(field: impl Into<String>, reason: impl Into<String>) -> MachineError 
     }
 }
 
-/// The built-in machine files, embedded at compile time; the first is the default. They live
-/// in the crate (`crates/kinematics/machines/`, which the workspace's `machines/` links to) so
-/// that the packaged crate holds them too: one copy, built from a clean checkout or crates.io.
+/// The built-in machine files, embedded at compile time; the first is the default. They are the
+/// workspace's `machines/` folder, the one copy users read and edit (a symlink into the crate was
+/// tried and did not survive every checkout).
 const BUILTIN: &[(&str, &str)] = &[
-    ("mill3", include_str!("../machines/mill3.toml")),
-    ("yzca", include_str!("../machines/yzca.toml")),
-    ("table-ac", include_str!("../machines/table-ac.toml")),
-    ("table-bc", include_str!("../machines/table-bc.toml")),
+    ("mill3", include_str!("../../../machines/mill3.toml")),
+    ("yzca", include_str!("../../../machines/yzca.toml")),
+    ("table-ac", include_str!("../../../machines/table-ac.toml")),
+    ("table-bc", include_str!("../../../machines/table-bc.toml")),
     (
         "linear-delta",
-        include_str!("../machines/linear-delta.toml"),
+        include_str!("../../../machines/linear-delta.toml"),
     ),
 ];
 
