@@ -1,4 +1,10 @@
 //! tezgah-executor: the real-time loop, operating modes and drives.
 //!
-//! Takes timed samples from tezgah-motion and hands one set-point per period to a drive. It
-//! grows with the executor issue; for now it holds nothing.
+//! Takes timed samples from tezgah-motion and hands one [`SetPoint`] per period to a
+//! [`Drive`]. It grows with the executor issue.
+
+pub mod drive;
+pub mod setpoint;
+
+pub use drive::{Drive, DriveFault, DriveStatus};
+pub use setpoint::SetPoint;
