@@ -35,5 +35,7 @@ pub mod yzca;
 
 pub use error::{AtLine, KinematicsError};
 pub use kinematics::{Jacobian, Kinematics, Tolerances};
-pub use machine::{builtin_names, Machine, MachineError, Model, TcpSwitch};
+pub use machine::{
+    builtin_names, HomeSettings, Machine, MachineError, Model, ServoSettings, TcpSwitch,
+};
 pub use pose::{JointKind, JointLimit, Joints, Tool, ToolPose};
