@@ -32,3 +32,11 @@ pub trait Drive {
     /// Apply one period's set-point and return the status after it.
     fn apply(&mut self, setpoint: &SetPoint) -> DriveStatus;
 }
+
+pub mod ideal;
+pub mod metrics;
+pub mod servo;
+
+pub use ideal::IdealDrive;
+pub use metrics::{ContourError, ContourStats, JointTracking};
+pub use servo::{ServoAxis, ServoDrive, ServoError, ServoParams};
