@@ -4,6 +4,7 @@
 //! [`Drive`]. It grows with the executor issue.
 
 pub mod drive;
+pub mod manual;
 pub mod setpoint;
 
 pub use drive::{Drive, DriveFault, DriveStatus};

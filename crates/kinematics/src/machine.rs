@@ -644,7 +644,11 @@ fn build_servo(
             ),
         ));
     }
-    let loop_period_s = opt_pos("loop_period_s", r.loop_period_s, DEFAULT_SERVO_LOOP_PERIOD_S)?;
+    let loop_period_s = opt_pos(
+        "loop_period_s",
+        r.loop_period_s,
+        DEFAULT_SERVO_LOOP_PERIOD_S,
+    )?;
     // The velocity loop gain is 4·Kp with Kp = 2π·f/1.287 (see the executor's drive::servo);
     // its forward-Euler step is well damped only while Kv·h stays small.
     let kv = 4.0 * 2.0 * PI * bandwidth_hz / SERVO_BANDWIDTH_PER_KP;
@@ -711,8 +715,7 @@ fn build_home(
     };
     let switch = inside(
         "switch",
-        r.switch
-            .unwrap_or(if max.is_finite() { max } else { 0.0 }),
+        r.switch.unwrap_or(if max.is_finite() { max } else { 0.0 }),
     )?;
     let search_velocity = match r.search_velocity {
         Some(v) if v.is_finite() && v != 0.0 && v.abs() <= max_velocity => v,
@@ -729,7 +732,10 @@ fn build_home(
         Some(_) => {
             return Err(invalid(
                 f("home.latch_velocity"),
-                format!("must be > 0 and at most |search_velocity| ({})", search_velocity.abs()),
+                format!(
+                    "must be > 0 and at most |search_velocity| ({})",
+                    search_velocity.abs()
+                ),
             ))
         }
         None => 0.1 * search_velocity.abs(),
@@ -748,7 +754,10 @@ fn build_home(
 /// that breaks the rule). By default Z goes first (reference 000 §1.3: away from the work before
 /// anything moves sideways), then the others one after another in file order.
 fn home_order(joints: &mut [Joint]) -> Result<(), MachineError> {
-    let given = joints.iter().filter(|j| j.home.sequence != u32::MAX).count();
+    let given = joints
+        .iter()
+        .filter(|j| j.home.sequence != u32::MAX)
+        .count();
     if given == joints.len() {
         return Ok(());
     }

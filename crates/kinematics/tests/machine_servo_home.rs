@@ -62,7 +62,11 @@ fn builtin_mill3_homes_z_first() {
         let m = Machine::builtin(name).unwrap();
         let mut seq: Vec<u32> = m.joints.iter().map(|j| j.home.sequence).collect();
         seq.sort_unstable();
-        assert_eq!(seq, (0..m.joints.len() as u32).collect::<Vec<_>>(), "{name}");
+        assert_eq!(
+            seq,
+            (0..m.joints.len() as u32).collect::<Vec<_>>(),
+            "{name}"
+        );
     }
 }
 
@@ -95,7 +99,11 @@ fn bad_servo_and_home_fields_are_named() {
             "cannot give",
         ),
         (
-            ["[joint.servo]\nloop_period_s = 0.002\nbandwidth_hz = 5.0", "", ""],
+            [
+                "[joint.servo]\nloop_period_s = 0.002\nbandwidth_hz = 5.0",
+                "",
+                "",
+            ],
             "joint[0].servo.loop_period_s",
             "motion.period_s",
         ),
@@ -110,7 +118,11 @@ fn bad_servo_and_home_fields_are_named() {
             "non-zero",
         ),
         (
-            ["[joint.home]\nsearch_velocity = -5.0\nlatch_velocity = 6.0", "", ""],
+            [
+                "[joint.home]\nsearch_velocity = -5.0\nlatch_velocity = 6.0",
+                "",
+                "",
+            ],
             "joint[0].home.latch_velocity",
             "at most",
         ),

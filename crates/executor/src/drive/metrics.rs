@@ -233,7 +233,11 @@ mod tests {
         }
         let st = c.finish();
         let sag = r * (1.0 - (dtheta / 2.0).cos());
-        assert!(st.max <= delta + 1e-12 && st.max >= delta - sag - 1e-12, "{}", st.max);
+        assert!(
+            st.max <= delta + 1e-12 && st.max >= delta - sag - 1e-12,
+            "{}",
+            st.max
+        );
         assert!(st.rmse <= delta + 1e-12 && st.rmse >= delta - sag - 1e-12);
     }
 

@@ -1,0 +1,187 @@
+//! The velocity-mode jerk-limited ramp that JOG and the homing searches run on: from any state
+//! (x, v, a) to a target speed at zero acceleration, time-optimally under |a| ≤ A and |j| ≤ J
+//! (bang-bang jerk, Ruckig's velocity interface in one dimension). Closed forms only; the ramp
+//! is evaluated exactly at any time, so set-points lie on it and a change (override, stop, the
+//! soft-limit brake) can start between periods.
+//!
+//! With σ = ±1 the side the target lies on from the speed reached by bringing a to 0 at once,
+//! v_r = v₀ + a₀|a₀|/(2J), the acceleration goes from a₀ to a peak σ·a_p, holds, and returns
+//! to 0: the speed change (a_p² − a₀²)/(2J)·… gives, without a plateau,
+//!   σ(v_t − v₀) = (2a_p² − a₀²)/(2J)  ⇒  a_p = √((2Jσ(v_t − v₀) + a₀²)/2),
+//! and with a_p capped at A a plateau of (σ(v_t − v₀) − (2A² − a₀²)/(2J))/A. Phase times:
+//! t₁ = (a_p − σa₀)/J, t₂ = the plateau, t₃ = a_p/J.
+
+use tezgah_motion::profile::State;
+
+/// A ramp of three constant-jerk phases, then cruise at the target speed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VelocityRamp {
+    /// Phase start times (index 3: the end) and states there.
+    knots: [(f64, State); 4],
+}
+
+impl VelocityRamp {
+    /// From `start` (its jerk is ignored) to speed `target` with zero final acceleration, for
+    /// `max_acceleration` ≥ |start.a| and `max_jerk` > 0.
+    pub fn new(start: State, target: f64, max_acceleration: f64, max_jerk: f64) -> VelocityRamp {
+        let (a_lim, j) = (max_acceleration, max_jerk);
+        let (v0, a0) = (start.v, start.a.clamp(-a_lim, a_lim));
+        let v_rest = v0 + a0 * a0.abs() / (2.0 * j);
+        let sigma = if target >= v_rest { 1.0 } else { -1.0 };
+        let dv = sigma * (target - v0);
+        let free = ((2.0 * j * dv + a0 * a0) / 2.0).max(0.0).sqrt();
+        let (a_p, plateau) = if free > a_lim {
+            (
+                a_lim,
+                ((dv - (2.0 * a_lim * a_lim - a0 * a0) / (2.0 * j)) / a_lim).max(0.0),
+            )
+        } else {
+            (free, 0.0)
+        };
+        let durations = [((a_p - sigma * a0) / j).max(0.0), plateau, a_p / j];
+        let jerks = [sigma * j, 0.0, -sigma * j];
+        let mut knots = [(0.0, State::default()); 4];
+        let (mut t, mut x) = (
+            0.0,
+            State {
+                a: a0,
+                j: 0.0,
+                ..start
+            },
+        );
+        for k in 0..3 {
+            knots[k] = (t, State { j: jerks[k], ..x });
+            x = advance(x, jerks[k], durations[k]);
+            t += durations[k];
+        }
+        // The end is the target speed at rest in acceleration (rounding left aside).
+        knots[3] = (
+            t,
+            State {
+                v: target,
+                a: 0.0,
+                j: 0.0,
+                ..x
+            },
+        );
+        VelocityRamp { knots }
+    }
+
+    pub fn duration(&self) -> f64 {
+        self.knots[3].0
+    }
+
+    pub fn start(&self) -> State {
+        self.knots[0].1
+    }
+
+    /// The state at the end of the ramp.
+    pub fn end(&self) -> State {
+        self.knots[3].1
+    }
+
+    /// Displacement from start to end.
+    pub fn distance(&self) -> f64 {
+        self.knots[3].1.s - self.knots[0].1.s
+    }
+
+    /// The state at `t` after the start: exact on each phase; after the end it cruises at the
+    /// target speed; before the start (or NaN) it is the start state.
+    pub fn state_at(&self, t: f64) -> State {
+        if t >= self.duration() {
+            let (te, x) = self.knots[3];
+            return State {
+                s: x.s + x.v * (t - te),
+                ..x
+            };
+        }
+        if t.is_nan() || t <= 0.0 {
+            return self.knots[0].1;
+        }
+        let k = (0..3).rev().find(|&k| self.knots[k].0 <= t).unwrap_or(0);
+        let (t0, x) = self.knots[k];
+        advance(x, x.j, t - t0)
+    }
+}
+
+/// Displacement of the time-optimal stop from `state` (the braking distance, signed).
+pub fn stopping_displacement(state: State, max_acceleration: f64, max_jerk: f64) -> f64 {
+    VelocityRamp::new(state, 0.0, max_acceleration, max_jerk).distance()
+}
+
+/// Integrates a constant-jerk phase of length `dt`.
+fn advance(x: State, j: f64, dt: f64) -> State {
+    State {
+        s: x.s + dt * (x.v + dt * (0.5 * x.a + dt * j / 6.0)),
+        v: x.v + dt * (x.a + 0.5 * dt * j),
+        a: x.a + dt * j,
+        j,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use tezgah_motion::profile::{min_stopping_distance, speed_change_time, Limits};
+
+    fn at(v: f64, a: f64) -> State {
+        State {
+            s: 0.0,
+            v,
+            a,
+            j: 0.0,
+        }
+    }
+
+    #[test]
+    fn from_rest_matches_the_profile_solver() {
+        // At zero start acceleration the ramp is the motion crate's speed change (eqs. R1–R3).
+        let l = Limits::new(200.0, 2000.0, 50000.0).unwrap();
+        for (v0, v1) in [
+            (0.0, 50.0),
+            (0.0, 200.0),
+            (120.0, 0.0),
+            (30.0, 31.0),
+            (80.0, 20.0),
+        ] {
+            let r = VelocityRamp::new(at(v0, 0.0), v1, 2000.0, 50000.0);
+            let t = speed_change_time(v0, v1, &l).unwrap();
+            assert!((r.duration() - t).abs() < 1e-12, "{v0}→{v1}");
+            if v1 == 0.0 {
+                let d = min_stopping_distance(v0, &l).unwrap();
+                assert!((r.distance() - d).abs() < 1e-12 * d.max(1.0));
+            }
+            assert!((r.end().v - v1).abs() < 1e-9);
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn reaches_the_target_within_limits(
+            v0 in -100.0..100.0f64, a0 in -1.0..1.0f64, target in -100.0..100.0f64,
+        ) {
+            let (a_lim, j) = (1000.0, 20000.0);
+            let a0 = a0 * a_lim;
+            let r = VelocityRamp::new(at(v0, a0), target, a_lim, j);
+            // the last phase integrates to the target speed at zero acceleration
+            let (te, x) = r.knots[2];
+            let end = advance(x, x.j, r.duration() - te);
+            prop_assert!((end.v - target).abs() < 1e-9 * (1.0 + target.abs() + v0.abs()));
+            prop_assert!(end.a.abs() < 1e-9 * a_lim);
+            for (_, k) in r.knots {
+                prop_assert!(k.a.abs() <= a_lim * (1.0 + 1e-12));
+                prop_assert!(k.j.abs() <= j);
+            }
+        }
+
+        #[test]
+        fn state_is_continuous(v0 in 0.0..100.0f64, a0 in -1.0..1.0f64, target in 0.0..100.0f64) {
+            let r = VelocityRamp::new(at(v0, 1000.0 * a0), target, 1000.0, 20000.0);
+            for &(t, k) in &r.knots[1..] {
+                let left = r.state_at(t - 1e-9);
+                prop_assert!((left.v - k.v).abs() < 1e-4 && (left.a - k.a).abs() < 1e-4);
+            }
+        }
+    }
+}
