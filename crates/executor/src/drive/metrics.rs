@@ -91,6 +91,8 @@ pub struct ContourError {
     ring: Vec<(Vector3<f64>, Vector3<f64>)>,
     pushed: u64,
     evaluated: u64,
+    /// Tips measured before the last [`ContourError::restart_stats`].
+    excluded: u64,
     sum_sq: f64,
     max: f64,
 }
@@ -107,6 +109,7 @@ impl ContourError {
             ring: vec![(Vector3::zeros(), Vector3::zeros()); 2 * h + 1],
             pushed: 0,
             evaluated: 0,
+            excluded: 0,
             sum_sq: 0.0,
             max: 0.0,
         }
@@ -133,15 +136,25 @@ impl ContourError {
 
     /// Statistics of the tips measured so far.
     pub fn stats(&self) -> ContourStats {
+        let n = self.evaluated - self.excluded;
         ContourStats {
-            samples: self.evaluated,
-            rmse: if self.evaluated == 0 {
+            samples: n,
+            rmse: if n == 0 {
                 0.0
             } else {
-                (self.sum_sq / self.evaluated as f64).sqrt()
+                (self.sum_sq / n as f64).sqrt()
             },
             max: self.max,
         }
+    }
+
+    /// Leaves out of the statistics every tip pushed so far (a warm-up), keeping them as the
+    /// path the later tips are measured against.
+    pub fn restart_stats(&mut self) {
+        // tips pushed but not yet measured (the last H) belong to the warm-up too
+        self.excluded = self.pushed;
+        self.sum_sq = 0.0;
+        self.max = 0.0;
     }
 
     fn evaluate_next(&mut self) {
@@ -156,9 +169,11 @@ impl ContourError {
         for i in first..last {
             best = best.min(segment_distance_sq(&p, &at(i), &at(i + 1)));
         }
-        self.sum_sq += best;
-        self.max = self.max.max(best.sqrt());
         self.evaluated += 1;
+        if self.evaluated > self.excluded {
+            self.sum_sq += best;
+            self.max = self.max.max(best.sqrt());
+        }
     }
 }
 

@@ -6,7 +6,8 @@
 //!
 //! With σ = ±1 the side the target lies on from the speed reached by bringing a to 0 at once,
 //! v_r = v₀ + a₀|a₀|/(2J), the acceleration goes from a₀ to a peak σ·a_p, holds, and returns
-//! to 0: the speed change (a_p² − a₀²)/(2J)·… gives, without a plateau,
+//! to 0. A jerk phase taking the acceleration from α to β at jerk ±J changes the speed by
+//! (β² − α²)/(±2J), so (in the frame where σ = +1) without a plateau
 //!   σ(v_t − v₀) = (2a_p² − a₀²)/(2J)  ⇒  a_p = √((2Jσ(v_t − v₀) + a₀²)/2),
 //! and with a_p capped at A a plateau of (σ(v_t − v₀) − (2A² − a₀²)/(2J))/A. Phase times:
 //! t₁ = (a_p − σa₀)/J, t₂ = the plateau, t₃ = a_p/J.
