@@ -479,13 +479,18 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
             .transpose()?,
         blend_max_angle_deg: angle("path.blend_max_angle_deg", raw.path.blend_max_angle_deg)?,
     };
+    let sequences: Vec<Option<u32>> = raw
+        .joint
+        .iter()
+        .map(|j| j.home.as_ref().and_then(|h| h.sequence))
+        .collect();
     let mut joints = raw
         .joint
         .into_iter()
         .enumerate()
         .map(|(i, j)| build_joint(i, j))
         .collect::<Result<Vec<_>, _>>()?;
-    home_order(&mut joints)?;
+    home_order(&mut joints, &sequences)?;
     for (i, j) in joints.iter().enumerate() {
         if j.servo.loop_period_s > motion.period_s {
             return Err(invalid(
@@ -746,40 +751,39 @@ fn build_home(
         search_velocity,
         latch_velocity,
         position,
-        sequence: r.sequence.unwrap_or(u32::MAX),
+        // filled in by `home_order`, which sees every joint
+        sequence: r.sequence.unwrap_or(0),
     })
 }
 
-/// Fills in the homing order: given for every joint or for none (an error names the first joint
-/// that breaks the rule). By default Z goes first (reference 000 §1.3: away from the work before
-/// anything moves sideways), then the others one after another in file order.
-fn home_order(joints: &mut [Joint]) -> Result<(), MachineError> {
-    let given = joints
-        .iter()
-        .filter(|j| j.home.sequence != u32::MAX)
-        .count();
-    if given == joints.len() {
-        return Ok(());
-    }
-    if given > 0 {
-        let i = joints
-            .iter()
-            .position(|j| j.home.sequence == u32::MAX)
-            .unwrap_or(0);
-        return Err(invalid(
-            format!("joint[{i}].home.sequence"),
-            "missing: give a sequence for every joint or for none",
-        ));
-    }
+/// Fills in the homing order. By default Z goes first (reference 000 §1.3: away from the work
+/// before anything moves sideways), then the others one after another in file order; joints
+/// without a `sequence` when others have one follow them one after another in file order.
+fn home_order(joints: &mut [Joint], given: &[Option<u32>]) -> Result<(), MachineError> {
     let z = joints.iter().position(|j| j.name.eq_ignore_ascii_case("z"));
-    let mut next = u32::from(z.is_some());
-    for (i, j) in joints.iter_mut().enumerate() {
-        if Some(i) == z {
-            j.home.sequence = 0;
-        } else {
-            j.home.sequence = next;
-            next += 1;
-        }
+    // With no sequence given, Z is first; joints without one follow the given ones (or Z).
+    let mut next = match given.iter().flatten().max() {
+        Some(m) => m.checked_add(1).ok_or_else(|| {
+            invalid(
+                format!(
+                    "joint[{}].home.sequence",
+                    given.iter().position(|g| *g == Some(*m)).unwrap_or(0)
+                ),
+                "too large",
+            )
+        })?,
+        None => u32::from(z.is_some()),
+    };
+    let none_given = given.iter().all(Option::is_none);
+    for (i, (j, g)) in joints.iter_mut().zip(given).enumerate() {
+        j.home.sequence = match g {
+            Some(s) => *s,
+            None if none_given && Some(i) == z => 0,
+            None => {
+                next = next.saturating_add(1);
+                next - 1
+            }
+        };
     }
     Ok(())
 }

@@ -132,9 +132,9 @@ fn bad_servo_and_home_fields_are_named() {
             "outside",
         ),
         (
-            ["[joint.home]\nsequence = 0", "", ""],
-            "joint[1].home.sequence",
-            "every joint or for none",
+            ["[joint.home]\nsequence = 4294967295", "", ""],
+            "joint[0].home.sequence",
+            "too large",
         ),
     ];
     for (extra, field, reason) in cases {
@@ -147,6 +147,13 @@ fn bad_servo_and_home_fields_are_named() {
         Machine::from_toml_str(&mill(["[joint.servo]\nbandwith_hz = 3.0", "", ""])),
         Err(MachineError::Toml { .. })
     ));
+}
+
+#[test]
+fn joints_without_a_sequence_follow_the_given_ones() {
+    let m = Machine::from_toml_str(&mill(["[joint.home]\nsequence = 3", "", ""])).unwrap();
+    let seq: Vec<u32> = m.joints.iter().map(|j| j.home.sequence).collect();
+    assert_eq!(seq, [3, 4, 5]);
 }
 
 #[test]

@@ -19,7 +19,7 @@ use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::profile::{solve, Limits, Profile, State};
 
 use super::ramp::VelocityRamp;
-use super::{JointAxis, ManualError};
+use super::{check_start, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
 
 /// The home switches as the controller reads them, once per period.
@@ -229,12 +229,7 @@ impl Home {
     /// Homes every joint of `machine` from `start` (power-on frame, at rest; the set-point at
     /// `index`). Allocates here, never per period.
     pub fn new(machine: &Machine, start: &Joints, index: u64) -> Result<Home, ManualError> {
-        if start.len() != machine.joints.len() {
-            return Err(ManualError::JointCount {
-                given: start.len(),
-                expected: machine.joints.len(),
-            });
-        }
+        check_start(machine, start)?;
         let mut joints = Vec::with_capacity(machine.joints.len());
         for (i, j) in machine.joints.iter().enumerate() {
             let axis = JointAxis::from_machine(machine, i)?;
@@ -507,5 +502,40 @@ mod tests {
             50000f64.to_radians(),
         )
         .unwrap();
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+        #[test]
+        fn random_power_on_frames_home_exactly(
+            start in proptest::array::uniform3(-90.0..90.0f64),
+            offset in proptest::array::uniform3(-20.0..20.0f64),
+        ) {
+            let m = Machine::builtin("mill3").unwrap();
+            let (start, offset) = (Joints::new(start), Joints::new(offset));
+            let (home, sps, r) = run(&m, &start, &offset);
+            proptest::prop_assert!(r.is_ok(), "{:?}", r);
+            let found = home.offsets().unwrap();
+            let last = sps.last().unwrap();
+            for (i, (latch, v, a, j)) in [
+                (2.0, 200.0, 2000.0, 50000.0),
+                (2.0, 200.0, 2000.0, 50000.0),
+                (1.0, 100.0, 1000.0, 25000.0),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let late = found[i] - offset[i];
+                proptest::prop_assert!((0.0..=latch * 1e-3 + 1e-9).contains(&late), "{i}: {late}");
+                // home position 0 in machine coordinates
+                proptest::prop_assert_eq!(last.position[i], found[i]);
+                let c = check_limits(&positions(&start, &sps, i), 1e-3, v, a, j);
+                proptest::prop_assert!(c.is_ok(), "{i}: {:?}", c);
+            }
+            // Z moved and came to rest before X or Y moved
+            let z_end = last_move(&sps, 2);
+            proptest::prop_assert!(z_end < first_move(&sps, &start, 0));
+            proptest::prop_assert!(z_end < first_move(&sps, &start, 1));
+        }
     }
 }

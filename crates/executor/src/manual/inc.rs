@@ -8,7 +8,7 @@ use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::profile::{solve, Limits, Profile};
 
 use super::jog::Direction;
-use super::{JointAxis, ManualError};
+use super::{check_start, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
 
 /// Smallest INC step, file units (mm or degrees).
@@ -74,12 +74,7 @@ impl Inc {
         index: u64,
     ) -> Result<Inc, ManualError> {
         let axis = JointAxis::from_machine(machine, joint)?;
-        if start.len() != machine.joints.len() {
-            return Err(ManualError::JointCount {
-                given: start.len(),
-                expected: machine.joints.len(),
-            });
-        }
+        check_start(machine, start)?;
         let v = axis.speed(speed)?;
         let dir = direction.sign();
         let distance = step.value() / axis.to_file;

@@ -9,7 +9,7 @@ use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::profile::State;
 
 use super::ramp::{stopping_displacement, VelocityRamp};
-use super::{override_factor, JointAxis, ManualError};
+use super::{check_start, override_factor, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
 
 /// Which way a manual move goes along its joint.
@@ -65,12 +65,7 @@ impl Jog {
         index: u64,
     ) -> Result<Jog, ManualError> {
         let axis = JointAxis::from_machine(machine, joint)?;
-        if start.len() != machine.joints.len() {
-            return Err(ManualError::JointCount {
-                given: start.len(),
-                expected: machine.joints.len(),
-            });
-        }
+        check_start(machine, start)?;
         let speed = axis.speed(speed)?;
         let dir = direction.sign();
         let limit = if dir > 0.0 { axis.max } else { axis.min };
@@ -355,6 +350,17 @@ mod tests {
         assert!(matches!(
             Jog::new(&m, 0, &Joints::zeros(2), Direction::Plus, 5.0, 0),
             Err(ManualError::JointCount { .. })
+        ));
+        assert!(matches!(
+            Jog::new(
+                &m,
+                0,
+                &Joints::new([0.0, f64::NAN, 0.0]),
+                Direction::Plus,
+                5.0,
+                0
+            ),
+            Err(ManualError::NotFinite { joint: 1, .. })
         ));
     }
 

@@ -30,6 +30,8 @@ pub enum ManualError {
     NoSuchJoint { joint: usize, count: usize },
     #[error("start position has {given} joints, the machine {expected}")]
     JointCount { given: usize, expected: usize },
+    #[error("start position of joint {joint} is {value}")]
+    NotFinite { joint: usize, value: f64 },
     #[error("joint `{name}`: speed {value} must be > 0 and finite")]
     Speed { name: String, value: f64 },
     #[error("override {percent} % is outside 0–{max} %", max = MAX_OVERRIDE_PERCENT)]
@@ -114,6 +116,23 @@ impl JointAxis {
             target: target * self.to_file,
             limit: limit * self.to_file,
         }
+    }
+}
+
+/// A start position with one finite value per joint of `machine`.
+fn check_start(machine: &Machine, start: &tezgah_kinematics::Joints) -> Result<(), ManualError> {
+    if start.len() != machine.joints.len() {
+        return Err(ManualError::JointCount {
+            given: start.len(),
+            expected: machine.joints.len(),
+        });
+    }
+    match start.as_slice().iter().position(|v| !v.is_finite()) {
+        Some(joint) => Err(ManualError::NotFinite {
+            joint,
+            value: start[joint],
+        }),
+        None => Ok(()),
     }
 }
 
