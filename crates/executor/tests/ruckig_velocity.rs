@@ -5,7 +5,8 @@
 //! 20 000 seeded random cases (start speed and acceleration, target speed, limits) go to one
 //! Python process (tests/oracle/ruckig_velocity.py) run with `$TEZGAH_PYTHON`; skipped, with a
 //! message, when that is unset or cannot `import ruckig` (`.ci/install-ruckig` prints a python
-//! that can). Per case: the same duration (1e-9 relative, 1e-12 s absolute) and the same state
+//! that can). Ruckig refuses a few start states with |a0| exactly A; those (at most 1e-3 of the
+//! cases) are listed and skipped. Per case: the same duration (1e-9 relative, 1e-12 s absolute) and the same state
 //! at 7 times along the way (p within 1e-9·(|v|max·T + 1), v within 1e-9·(|v|max + A·T), a within
 //! 1e-9·A) — the optimum is unique, so this checks the closed forms and `state_at`.
 
@@ -87,6 +88,7 @@ fn velocity_ramp_matches_ruckig() {
     }
     let out = BufReader::new(child.stdout.take().unwrap());
     let mut checked = 0;
+    let mut ruckig_failed = Vec::new();
     let mut failures = Vec::new();
     for (c, line) in cases.iter().zip(out.lines()) {
         let line = line.unwrap();
@@ -94,7 +96,10 @@ fn velocity_ramp_matches_ruckig() {
             .split_whitespace()
             .map(|x| x.parse().unwrap())
             .collect();
-        assert!(!f[0].is_nan(), "Ruckig failed on {c:?}");
+        if f[0].is_nan() {
+            ruckig_failed.push(*c);
+            continue;
+        }
         let [v0, a0, vt, a, j] = *c;
         let ramp = VelocityRamp::new(
             State {
@@ -128,6 +133,12 @@ fn velocity_ramp_matches_ruckig() {
         checked += 1;
     }
     assert!(child.wait().unwrap().success());
-    assert_eq!(checked, CASES);
+    // Ruckig refuses a few start states exactly on |a0| = A; they must stay rare.
+    println!(
+        "Ruckig failed on {} cases: {ruckig_failed:?}",
+        ruckig_failed.len()
+    );
+    assert!(ruckig_failed.len() * 1000 <= CASES, "{ruckig_failed:?}");
+    assert_eq!(checked + ruckig_failed.len(), CASES);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
