@@ -395,6 +395,11 @@ mod tests {
         let (home, sps, r) = run(&m, &start, &offset);
         r.unwrap();
         assert!(home.is_done());
+        eprintln!(
+            "mill3 homing from (40, -20, 30): {} periods, offsets found {:?}",
+            sps.len(),
+            home.offsets().unwrap()
+        );
         // order: z moves and finishes before x starts, x before y
         let (z0, z1) = (first_move(&sps, &start, 2), last_move(&sps, 2));
         let (x0, x1) = (first_move(&sps, &start, 0), last_move(&sps, 0));
