@@ -513,6 +513,7 @@ mod tests {
             v_only < 1.05 * accel_lag && v_only > 0.7 * accel_lag,
             "{v_only} vs {accel_lag}"
         );
+        eprintln!("S-curve 40 mm, V 100: max |e| P-only {p_only:.4} mm, velocity FF {v_only:.3e} mm, full FF {full:.3e} mm");
         assert!(full < 1e-4 * p_only, "full {full} vs p-only {p_only}");
     }
 

@@ -224,4 +224,32 @@ mod tests {
         assert!(e.to_string().contains("soft limit 200"), "{e}");
         assert!(Inc::new(&m, 0, &near, Direction::Plus, IncStep::X10, 50.0, 0).is_ok());
     }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+        #[test]
+        fn random_steps_end_exactly_within_limits(
+            x0 in -99.0..99.0f64,
+            step in MIN_STEP..MAX_STEP,
+            plus in proptest::bool::ANY,
+            speed in 0.01..300.0f64,
+        ) {
+            let m = Machine::builtin("mill3").unwrap();
+            let start = Joints::new([0.0, 0.0, x0]);
+            let dir = if plus { Direction::Plus } else { Direction::Minus };
+            let inc = Inc::new(&m, 2, &start, dir, IncStep::new(step).unwrap(), speed, 7).unwrap();
+            let sps: Vec<SetPoint> = inc.collect();
+            let last = sps.last().unwrap();
+            proptest::prop_assert_eq!(last.position[2], x0 + dir.sign() * step);
+            // z: V = min(speed, 100), A 1000, J 25000
+            let r = check_limits(
+                &positions(&start, &sps, 2),
+                1e-3,
+                speed.min(100.0),
+                1000.0,
+                25000.0,
+            );
+            proptest::prop_assert!(r.is_ok(), "{:?}", r);
+        }
+    }
 }
