@@ -38,6 +38,9 @@ pub enum ServoError {
     /// A parameter is out of range (the machine reader checks the same for files).
     #[error("servo joint {joint}: {reason}")]
     Invalid { joint: usize, reason: String },
+    /// The set-point period is not a positive number of seconds.
+    #[error("servo drive: period {0} s must be > 0")]
+    Period(f64),
     /// The start position has another joint count than the parameters.
     #[error("servo drive: {given} start joints for {expected} axes")]
     JointCount { given: usize, expected: usize },
@@ -260,10 +263,7 @@ impl ServoDrive {
             axes[i] = ServoAxis::new(*p, start[i]);
         }
         if !(period_s.is_finite() && period_s > 0.0) {
-            return Err(ServoError::Invalid {
-                joint: 0,
-                reason: "period must be > 0".into(),
-            });
+            return Err(ServoError::Period(period_s));
         }
         // The finest loop period among the axes sets the common step count.
         let finest = params
@@ -564,6 +564,40 @@ mod tests {
         let again = d.apply(&SetPoint::at_rest(999, 0, Joints::new([5.0, 5.0])));
         assert_eq!(again.position, held);
         assert!(again.fault.is_some());
+    }
+
+    #[test]
+    fn rejects_bad_parameters() {
+        let ok = params(20.0, 1.0, 1.0, 0.0);
+        let q = Joints::new([0.0]);
+        assert_eq!(
+            ServoDrive::new(&[ok], 0.0, &q).unwrap_err(),
+            ServoError::Period(0.0)
+        );
+        for bad in [
+            ServoParams { kp: f64::NAN, ..ok },
+            ServoParams {
+                friction_rate: -1.0,
+                ..ok
+            },
+            ServoParams {
+                max_accel: 0.0,
+                ..ok
+            },
+            ServoParams {
+                following_error_limit: 0.0,
+                ..ok
+            },
+        ] {
+            assert!(matches!(
+                ServoDrive::new(&[ok, bad], 1e-3, &Joints::new([0.0, 0.0])),
+                Err(ServoError::Invalid { joint: 1, .. })
+            ));
+        }
+        assert!(matches!(
+            ServoDrive::new(&[ok], 1e-3, &Joints::new([0.0, 0.0])),
+            Err(ServoError::JointCount { .. })
+        ));
     }
 
     #[test]

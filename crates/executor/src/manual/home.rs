@@ -85,6 +85,16 @@ pub enum HomePhase {
     Done,
 }
 
+/// The last piece of a joint's homing: rest to rest from `start` to `target`.
+#[derive(Debug, Clone, Copy)]
+struct FinalMove {
+    start: f64,
+    /// ±1: the direction of the move (the profile runs forward).
+    sign: f64,
+    target: f64,
+    profile: Profile,
+}
+
 #[derive(Debug, Clone)]
 struct JointHoming {
     axis: JointAxis,
@@ -100,7 +110,7 @@ struct JointHoming {
     /// The current piece: a velocity ramp from t0, or the final profile from t0.
     t0: f64,
     ramp: VelocityRamp,
-    last: Option<(f64, f64, f64, Profile)>, // (start, sign, target, profile)
+    last: Option<FinalMove>,
     search_from: f64,
     max_travel: f64,
     offset: Option<f64>,
@@ -109,21 +119,19 @@ struct JointHoming {
 impl JointHoming {
     fn state(&self, t: f64) -> State {
         match &self.last {
-            Some((x0, sign, target, p))
-                if matches!(self.phase, HomePhase::Final | HomePhase::Done) =>
-            {
-                if t - self.t0 >= p.duration() {
+            Some(m) if matches!(self.phase, HomePhase::Final | HomePhase::Done) => {
+                if t - self.t0 >= m.profile.duration() {
                     State {
-                        s: *target,
+                        s: m.target,
                         ..State::default()
                     }
                 } else {
-                    let st = p.state_at(t - self.t0);
+                    let st = m.profile.state_at(t - self.t0);
                     State {
-                        s: x0 + sign * st.s,
-                        v: sign * st.v,
-                        a: sign * st.a,
-                        j: sign * st.j,
+                        s: m.start + m.sign * st.s,
+                        v: m.sign * st.v,
+                        a: m.sign * st.a,
+                        j: m.sign * st.j,
                     }
                 }
             }
@@ -140,7 +148,7 @@ impl JointHoming {
 
     fn piece_end(&self) -> f64 {
         match (&self.last, self.phase) {
-            (Some((_, _, _, p)), HomePhase::Final) => self.t0 + p.duration(),
+            (Some(m), HomePhase::Final) => self.t0 + m.profile.duration(),
             _ => self.t0 + self.ramp.duration(),
         }
     }
@@ -204,7 +212,12 @@ impl JointHoming {
         )
         .map_err(|e| motion(format!("{e:?}")))?;
         let p = solve(d.abs(), 0.0, 0.0, &limits).map_err(|e| motion(e.to_string()))?;
-        self.last = Some((x0, d.signum(), target, p));
+        self.last = Some(FinalMove {
+            start: x0,
+            sign: d.signum(),
+            target,
+            profile: p,
+        });
         self.t0 = t;
         self.phase = HomePhase::Final;
         Ok(())

@@ -210,6 +210,16 @@ mod tests {
     }
 
     #[test]
+    fn rotary_steps_are_degrees() {
+        let m = Machine::builtin("yzca").unwrap();
+        let start = Joints::new([0.0, 0.0, 0.0, 0.3]);
+        let inc = Inc::new(&m, 3, &start, Direction::Minus, IncStep::X1000, 20.0, 0).unwrap();
+        let last = inc.last().unwrap();
+        assert!((last.position[3] - (0.3 - 0.1f64.to_radians())).abs() < 1e-15);
+        assert_eq!(&last.position.as_slice()[..3], &[0.0; 3]);
+    }
+
+    #[test]
     fn refuses_bad_steps_and_limits() {
         let m = Machine::builtin("mill3").unwrap();
         for v in [0.0, 0.00009, 0.11, f64::NAN, -0.01] {
