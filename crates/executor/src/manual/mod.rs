@@ -6,6 +6,26 @@
 //! Reference 000 §1.3: JOG and HND run in velocity control, INC/HOME/REF in position control;
 //! JOG defaults to 50 mm/s (linear) and 20 °/s (rotary); INC steps are 0.0001–0.1 mm; HOME
 //! moves Z first.
+//!
+//! ```
+//! use tezgah_executor::drive::{Drive, JointTracking, ServoDrive};
+//! use tezgah_executor::manual::{jog::Direction, Jog};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let m = tezgah_kinematics::Machine::builtin("mill3")?;
+//! let start = m.home();
+//! let mut drive = ServoDrive::from_machine(&m, &start)?;
+//! let mut jog = Jog::new(&m, 0, &start, Direction::Plus, 50.0, 0)?; // X+ at 50 mm/s
+//! jog.set_override(25.0)?;
+//! let mut errors = JointTracking::new(3);
+//! for sp in jog.by_ref().take(500) {
+//!     errors.record(&drive.apply(&sp));
+//! }
+//! jog.stop(); // comes to rest in the jerk-limited minimum distance
+//! let rest = jog.last().expect("a final set-point at rest");
+//! assert_eq!(rest.velocity[0], 0.0);
+//! # Ok(())
+//! # }
+//! ```
 
 pub mod home;
 pub mod inc;
