@@ -12,7 +12,11 @@
 
 use tezgah_geom::{Axis, Pose, ToolControl, Vec3};
 use tezgah_kinematics::tcp::ProgramPose;
-use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
+use tezgah_kinematics::{
+    Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool, ToolPose,
+};
+
+use crate::path::orient::{AxisPath, ToolAxisMap};
 
 use super::PlanError;
 
@@ -132,6 +136,11 @@ impl PlanMachine {
         if !seg.rotary_only() || !self.orients() {
             return None;
         }
+        // The axis on a great circle: its turn is the circle's angle.
+        if let Some(AxisPath::Rotate(g)) = seg.axis {
+            let degrees = g.angle().to_degrees();
+            return (degrees > 1e-9).then_some(degrees);
+        }
         let tool = Tool::with_length(tool_length);
         let tip = seg.curve.point(seg.curve.domain().0);
         let [r0, r1] = seg.rotary;
@@ -241,6 +250,41 @@ impl PlanMachine {
         self.model.tcp_inverse(&p.tip, &p.angles, &tool, previous)
     }
 
+    /// Joints and program angles (A B C, degrees) of `seg` at curve parameter `u` (tip `tip`)
+    /// and fraction `f` of its length (or of its rotary travel), nearest `previous`: where the
+    /// segment carries a tool axis ([`Segment::axis`], under TCP), the inverse kinematics of
+    /// tip + axis, with the angles read back from the joints; otherwise A B C linear in `f`.
+    /// The one place the planner and the interpolator turn a point of a segment into joints.
+    pub fn segment_joints(
+        &self,
+        seg: &Segment,
+        u: f64,
+        f: f64,
+        tip: &Vec3,
+        previous: &Joints,
+    ) -> Result<(Joints, [f64; 3]), KinematicsError> {
+        let [r0, r1] = seg.rotary;
+        let mut rotary = if f >= 1.0 {
+            r1
+        } else {
+            [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
+        };
+        match (seg.axis, seg.control) {
+            (Some(path), ToolControl::CentrePoint { tool_length }) if self.orients() => {
+                let pose = ToolPose::new(*tip, path.at(u, f));
+                let q = self
+                    .model
+                    .inverse(&pose, &Tool::with_length(tool_length), previous)?;
+                let angles = self.model.tcp_angles(&q);
+                for (v, a) in angles.as_slice().iter().zip(&self.axes) {
+                    rotary[a.index() - 3] = v.to_degrees();
+                }
+                Ok((q, rotary))
+            }
+            _ => Ok((self.joints(seg.control, tip, &rotary, previous)?, rotary)),
+        }
+    }
+
     /// The program point (tip mm, A B C degrees) of joints `q` with TCP off: where a take-up
     /// move in joint mode starts and ends. Program axes without a joint read 0.
     pub fn joint_mode_point(&self, q: &Joints) -> Result<(Vec3, [f64; 3]), KinematicsError> {
@@ -257,5 +301,25 @@ impl PlanMachine {
             }
         }
         Ok((tip, rotary))
+    }
+}
+
+/// The model's tool axis for program angles, under TCP on a machine whose rotaries orient the
+/// tool: the smoothing builder's view of the machine.
+impl ToolAxisMap for PlanMachine {
+    fn axis(&self, control: ToolControl, tip: &Vec3, rotary: &[f64; 3]) -> Option<Vec3> {
+        let ToolControl::CentrePoint { tool_length } = control else {
+            return None;
+        };
+        if !self.orients() {
+            return None;
+        }
+        // The rotary joints are the angles themselves (no branch to choose), so the axis
+        // depends on the angles alone, bit for bit.
+        let q = self
+            .joints(control, tip, rotary, &Joints::zeros(self.joint_count()))
+            .ok()?;
+        let pose = self.model.forward(&q, &Tool::with_length(tool_length)).ok()?;
+        Some(pose.axis.into_inner())
     }
 }
