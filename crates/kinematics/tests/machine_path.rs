@@ -58,8 +58,14 @@ fn bad_values_name_their_field() {
         ),
         ("[path]\nshort_segment_mm = -1.0", "path.short_segment_mm"),
         ("[path]\nshort_segment_mm = nan", "path.short_segment_mm"),
-        ("[path]\naxis_tolerance_deg = 0.0", "path.axis_tolerance_deg"),
-        ("[path]\naxis_tolerance_deg = 200.0", "path.axis_tolerance_deg"),
+        (
+            "[path]\naxis_tolerance_deg = 0.0",
+            "path.axis_tolerance_deg",
+        ),
+        (
+            "[path]\naxis_tolerance_deg = 200.0",
+            "path.axis_tolerance_deg",
+        ),
     ] {
         match Machine::from_toml_str(&with_path(table)) {
             Err(MachineError::Invalid { field: f, .. }) => assert_eq!(f, field, "{table}"),

@@ -12,6 +12,13 @@ use tezgah_geom::{Curve, Quintic, State, ToolControl, Vec3};
 /// and so the rotation, is undefined (reference 004 §2.3 "V = −U: reject").
 pub const MAX_TURN: f64 = std::f64::consts::PI - 1e-6;
 
+/// A programmed point: tip (mm, workpiece frame) and A B C (degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProgramPoint {
+    pub tip: Vec3,
+    pub rotary: [f64; 3],
+}
+
 /// Gives the tool axis for the programmed rotary angles: the machine's model seen by the path
 /// stage, which knows no kinematics itself.
 pub trait ToolAxisMap: Debug + Send + Sync {
@@ -20,6 +27,20 @@ pub trait ToolAxisMap: Debug + Send + Sync {
     /// tool (TCP off, a machine whose rotaries do not tilt the tool) or the pose is out of
     /// reach (the planner then reports it with its line).
     fn axis(&self, control: ToolControl, tip: &Vec3, rotary: &[f64; 3]) -> Option<Vec3>;
+
+    /// Whether the joints that follow `path` continuously (nearest solution at each step)
+    /// from the programmed angles at `from` end on the programmed angles at `to` — the same
+    /// tilt branch and the same turns — without a jump on the way. Not so where the program
+    /// asks for what the axis alone cannot say: C turning with the tool along the C axis (the
+    /// pole), leaving the pole toward another C, whole turns, the long way round, a change of
+    /// tilt branch; the move then keeps its angles linear.
+    fn follows(
+        &self,
+        control: ToolControl,
+        from: &ProgramPoint,
+        to: &ProgramPoint,
+        path: &GreatCircle,
+    ) -> bool;
 }
 
 /// Rodrigues' rotation of `v` about the unit axis `k` by `theta` (reference 004 Eq 2):
@@ -69,7 +90,11 @@ impl GreatCircle {
         if angle > MAX_TURN {
             return Err(AxisError::Reversal(angle.to_degrees()));
         }
-        let k = if sin > 0.0 { cross / sin } else { Vec3::zeros() };
+        let k = if sin > 0.0 {
+            cross / sin
+        } else {
+            Vec3::zeros()
+        };
         Ok(GreatCircle {
             from,
             to,
@@ -272,14 +297,20 @@ mod tests {
         assert!((g.normal() - Vec3::y()).norm() < 1e-15);
         assert!((g.angle().to_degrees() - 30.0).abs() < 1e-12);
         let mid = g.at(0.5);
-        assert!((mid - Vec3::new(0.258819, 0.0, 0.965926)).norm() < 1e-6, "{mid}");
+        assert!(
+            (mid - Vec3::new(0.258819, 0.0, 0.965926)).norm() < 1e-6,
+            "{mid}"
+        );
         assert_eq!(g.at(1.0), u);
         // Just before the end the formula itself lands on U (not only the exact end value).
         assert!((g.at(1.0 - 1e-15) - u).norm() < 1e-14);
         // The paper's Eq 1 without normalising k: (0.25, 0, 0.866025), neither U nor unit.
         let raw = v.cross(&u);
         let wrong = rotate(&v, &raw, 30f64.to_radians());
-        assert!((wrong - Vec3::new(0.25, 0.0, 0.866025)).norm() < 1e-6, "{wrong}");
+        assert!(
+            (wrong - Vec3::new(0.25, 0.0, 0.866025)).norm() < 1e-6,
+            "{wrong}"
+        );
         assert!((wrong.norm() - 1.0).abs() > 0.05);
     }
 

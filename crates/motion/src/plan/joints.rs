@@ -16,7 +16,7 @@ use tezgah_kinematics::{
     Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool, ToolPose,
 };
 
-use crate::path::orient::{AxisPath, ToolAxisMap};
+use crate::path::orient::{AxisPath, GreatCircle, ProgramPoint, ToolAxisMap};
 
 use super::PlanError;
 
@@ -319,7 +319,68 @@ impl ToolAxisMap for PlanMachine {
         let q = self
             .joints(control, tip, rotary, &Joints::zeros(self.joint_count()))
             .ok()?;
-        let pose = self.model.forward(&q, &Tool::with_length(tool_length)).ok()?;
+        let pose = self
+            .model
+            .forward(&q, &Tool::with_length(tool_length))
+            .ok()?;
         Some(pose.axis.into_inner())
     }
+
+    fn follows(
+        &self,
+        control: ToolControl,
+        from: &ProgramPoint,
+        to: &ProgramPoint,
+        path: &GreatCircle,
+    ) -> bool {
+        let ToolControl::CentrePoint { tool_length } = control else {
+            return false;
+        };
+        let tool = Tool::with_length(tool_length);
+        let zeros = Joints::zeros(self.joint_count());
+        let (Ok(start), Ok(end)) = (
+            self.joints(control, &from.tip, &from.rotary, &zeros),
+            self.joints(control, &to.tip, &to.rotary, &zeros),
+        ) else {
+            return false;
+        };
+        // Steps of at most FOLLOW_STEP of the axis's turn: the nearest solution then tracks
+        // the branch the interpolator's 1 ms samples follow.
+        let steps = ((path.angle() / FOLLOW_STEP).ceil() as usize).max(8);
+        let at = |f: f64, previous: &Joints| {
+            let tip = from.tip + (to.tip - from.tip) * f;
+            self.model
+                .inverse(&ToolPose::new(tip, path.at(f)), &tool, previous)
+                .ok()
+        };
+        let mut q = start;
+        for k in 1..=steps {
+            let (f0, f1) = ((k - 1) as f64 / steps as f64, k as f64 / steps as f64);
+            let Some(next) = at(f1, &q) else {
+                return false;
+            };
+            // A joint that jumps (leaving the pole, where C is free, toward another C) does
+            // not halve its change when the step is halved, as a smooth joint does.
+            let (i, big) = (0..q.len())
+                .map(|i| (i, (next[i] - q[i]).abs()))
+                .fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
+            if big > 1e-9 {
+                let Some(mid) = at(0.5 * (f0 + f1), &q) else {
+                    return false;
+                };
+                if (mid[i] - q[i]).abs().max((next[i] - mid[i]).abs()) > 0.9 * big {
+                    return false;
+                }
+            }
+            q = next;
+        }
+        // The walk ends on the programmed tip and axis exactly, so on the programmed joints
+        // up to rounding when it kept their branch and turns.
+        (0..self.joint_count()).all(|i| (q[i] - end[i]).abs() <= FOLLOW_MATCH)
+    }
 }
+
+/// Largest turn of the tool axis (rad) between two steps of [`PlanMachine::follows`]'s walk.
+const FOLLOW_STEP: f64 = 0.01;
+/// How close (mm, rad) the walk's joints must end to the programmed ones.
+const FOLLOW_MATCH: f64 = 1e-9;

@@ -71,7 +71,11 @@ pub(crate) fn deviation(a: &Piece, b: &Piece, p: &Placed, axis: &AxisBlend) -> f
             let tip = p.curve.point(u);
             let (da, ua) = nearest(a, &tip, &ca);
             let (db, ub) = nearest(b, &tip, &cb);
-            let programmed = if da <= db { a.axis_at(ua) } else { b.axis_at(ub) };
+            let programmed = if da <= db {
+                a.axis_at(ua)
+            } else {
+                b.axis_at(ub)
+            };
             programmed.map_or(0.0, |o| angle_between(&axis.at(u), &o))
         },
         0.0,

@@ -24,13 +24,6 @@ pub enum PathError {
     /// A tolerance (options or `G64 P`) that is not finite and positive.
     #[error("line {line}: path tolerance {value} mm is not a positive finite number")]
     Tolerance { line: u32, value: f64 },
-    /// A move whose tool axis cannot be carried (it reverses: the rotation is undefined).
-    #[error("line {line}: {source}")]
-    Axis {
-        line: u32,
-        #[source]
-        source: crate::path::orient::AxisError,
-    },
     /// An option of [`super::SmoothOptions`] out of its range.
     #[error("smoothing option {name} = {value} is out of range")]
     Option { name: &'static str, value: f64 },

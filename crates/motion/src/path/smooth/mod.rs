@@ -30,7 +30,7 @@ use tezgah_geom::{
 pub use blend::{Blend, End};
 pub use error::PathError;
 
-use crate::path::orient::{AxisBlend, AxisPath, GreatCircle, ToolAxisMap};
+use crate::path::orient::{AxisBlend, AxisPath, GreatCircle, ProgramPoint, ToolAxisMap};
 use crate::path::{Junction, PathItem, Segment, SegmentFeed};
 use blend::{NoBlend, Placed};
 use piece::{Geo, Mode, Piece};
@@ -349,17 +349,27 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         };
         let axis = match (&self.opts.orientation, m.control) {
             (Some(map), control @ ToolControl::CentrePoint { .. }) => {
-                let from = map.0.axis(control, &Vec3::from(m.pos.xyz()), &rotary[0]);
-                let to = if rotary[0] == rotary[1] {
-                    from
-                } else {
-                    map.0.axis(control, &Vec3::from(end.xyz()), &rotary[1])
+                let from = ProgramPoint {
+                    tip: Vec3::from(m.pos.xyz()),
+                    rotary: rotary[0],
                 };
-                match (from, to) {
-                    (Some(v), Some(u)) => Some(
-                        GreatCircle::new(v, u).map_err(|source| PathError::Axis { line, source })?,
-                    ),
-                    // Out of reach: the planner reports it with its line.
+                let to = ProgramPoint {
+                    tip: Vec3::from(end.xyz()),
+                    rotary: rotary[1],
+                };
+                let v = map.0.axis(control, &from.tip, &from.rotary);
+                let u = if rotary[0] == rotary[1] {
+                    v
+                } else {
+                    map.0.axis(control, &to.tip, &to.rotary)
+                };
+                // Out of reach: the planner reports it with its line. A reversal (no common
+                // normal), or a move the axis alone cannot describe (see
+                // `ToolAxisMap::follows`), keeps its angles linear.
+                match (v, u) {
+                    (Some(v), Some(u)) => GreatCircle::new(v, u).ok().filter(|g| {
+                        rotary[0] == rotary[1] || map.0.follows(control, &from, &to, g)
+                    }),
                     _ => None,
                 }
             }
@@ -503,8 +513,8 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         };
         // 5-axis: the tool axis (or, without one, the rotary axes running linearly) must stay
         // within the angular tolerance across the blend: shorten the legs until it does.
-        let mut placed = blend::place(&a, b, share, max_angle)
-            .map(|p| (self.orientation(&a, b, &p), p));
+        let mut placed =
+            blend::place(&a, b, share, max_angle).map(|p| (self.orientation(&a, b, &p), p));
         if let Ok((None, _)) = &placed {
             placed = Err(NoBlend::Corner);
             let mut s = share;
@@ -575,6 +585,11 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
     #[allow(clippy::type_complexity)]
     fn orientation(&self, a: &Piece, b: &Piece, p: &Placed) -> Option<(Option<AxisBlend>, f64)> {
         let tolerance = self.opts.angular_tolerance;
+        // A move with linear angles next to one carrying its axis: the two meet only at the
+        // programmed point (a blend would start the axis from where each left it).
+        if a.axis.is_some() != b.axis.is_some() {
+            return None;
+        }
         if a.axis.is_some() && b.axis.is_some() {
             let blend = axis::blend(a, b, p)?;
             let deviation = axis::deviation(a, b, p, &blend);
