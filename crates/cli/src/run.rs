@@ -18,17 +18,20 @@ use crate::plot::Trace;
 /// The built-in demo program (a rounded pocket outline with a helical entry).
 /// The smoothing options: the builder's defaults, then what the machine file's `[path]` table
 /// sets.
+/// The machine itself gives the tool axis of the program angles (5-axis under TCP).
 fn smooth_options(
     path: &tezgah_kinematics::machine::PathSettings,
     tolerance: f64,
     start: Pose,
-    control: tezgah_geom::ToolControl,
+    machine: &PlanMachine,
 ) -> SmoothOptions {
     let d = SmoothOptions::default();
     SmoothOptions {
         tolerance,
         start,
-        control,
+        control: machine.initial,
+        orientation: Some(smooth::Orientation(std::sync::Arc::new(machine.clone()))),
+        angular_tolerance: path.axis_tolerance_deg.unwrap_or(d.angular_tolerance),
         blend_max_angle: path
             .blend_max_angle_deg
             .map_or(d.blend_max_angle, f64::to_radians),
@@ -157,7 +160,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     // G61 keeps corners, G61.1 stops at every block end.
     let items = smooth::build(
         moves.iter().cloned(),
-        &smooth_options(&machine.path, tolerance, start, pm.initial),
+        &smooth_options(&machine.path, tolerance, start, &pm),
     )
     .map_err(|e| miette!("{e}"))?;
     let segments = items

@@ -136,6 +136,7 @@ struct RawPath {
     compress_corner_angle_deg: Option<f64>,
     short_segment_mm: Option<f64>,
     blend_max_angle_deg: Option<f64>,
+    axis_tolerance_deg: Option<f64>,
 }
 
 #[derive(Deserialize)]
@@ -202,6 +203,9 @@ pub struct PathSettings {
     pub short_segment_mm: Option<f64>,
     /// Largest turn that is blended, degrees (sharper corners are passed at rest).
     pub blend_max_angle_deg: Option<f64>,
+    /// Angular tolerance, degrees: under tool-centre-point control the largest angle between
+    /// the tool axis and the programmed one (corner blends of the axis keep within it).
+    pub axis_tolerance_deg: Option<f64>,
 }
 
 /// One `[[joint]]`, in machine-file units (mm or degrees).
@@ -478,6 +482,7 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
             .map(|v| positive("path.short_segment_mm", v))
             .transpose()?,
         blend_max_angle_deg: angle("path.blend_max_angle_deg", raw.path.blend_max_angle_deg)?,
+        axis_tolerance_deg: angle("path.axis_tolerance_deg", raw.path.axis_tolerance_deg)?,
     };
     let sequences: Vec<Option<u32>> = raw
         .joint

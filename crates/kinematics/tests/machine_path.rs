@@ -21,8 +21,19 @@ fn mill3_shows_every_path_field() {
             compress_corner_angle_deg: Some(30.0),
             short_segment_mm: Some(1.0),
             blend_max_angle_deg: Some(175.0),
+            axis_tolerance_deg: None,
         }
     );
+}
+
+#[test]
+fn five_axis_machines_show_the_axis_tolerance() {
+    for name in ["table-ac", "table-bc", "yzca"] {
+        let m = Machine::builtin(name).unwrap();
+        assert_eq!(m.path.axis_tolerance_deg, Some(0.1), "{name}");
+    }
+    let m = Machine::from_toml_str(&with_path("[path]\naxis_tolerance_deg = 0.02")).unwrap();
+    assert_eq!(m.path.axis_tolerance_deg, Some(0.02));
 }
 
 #[test]
@@ -47,6 +58,14 @@ fn bad_values_name_their_field() {
         ),
         ("[path]\nshort_segment_mm = -1.0", "path.short_segment_mm"),
         ("[path]\nshort_segment_mm = nan", "path.short_segment_mm"),
+        (
+            "[path]\naxis_tolerance_deg = 0.0",
+            "path.axis_tolerance_deg",
+        ),
+        (
+            "[path]\naxis_tolerance_deg = 200.0",
+            "path.axis_tolerance_deg",
+        ),
     ] {
         match Machine::from_toml_str(&with_path(table)) {
             Err(MachineError::Invalid { field: f, .. }) => assert_eq!(f, field, "{table}"),

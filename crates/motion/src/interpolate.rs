@@ -143,26 +143,21 @@ impl Interpolator {
         };
         let s = s.clamp(0.0, len);
         let f = if len > 0.0 { s / len } else { 1.0 };
-        let tip = if s >= len {
+        let (_, b) = seg.curve.domain();
+        let (tip, u) = if s >= len {
             // Block ends exactly: the curve returns its end point bit for bit.
-            let (_, b) = seg.curve.domain();
-            seg.curve.point(b)
+            (seg.curve.point(b), b)
         } else {
-            seg.curve.point(param.u(seg, s))
-        };
-        let [r0, r1] = seg.rotary;
-        let rotary = if f >= 1.0 {
-            r1
-        } else {
-            [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
+            let u = param.u(seg, s);
+            (seg.curve.point(u), u)
         };
         let err = |source| InterpolateError::Kinematics {
             line: seg.line,
             source,
         };
-        let q = self
+        let (q, rotary) = self
             .machine
-            .joints(seg.control, &tip, &rotary, &self.joints)
+            .segment_joints(seg, u, f, &tip, &self.joints)
             .map_err(err)?;
         self.joints = q;
         Ok((tip, rotary, q))

@@ -114,5 +114,6 @@ fn joint_line(
         tolerance: next.tolerance,
         control: ToolControl::Joints,
         tool_axis_travel: None,
+        axis: None,
     })
 }

@@ -43,6 +43,7 @@ fn segment(curve: Bezier, feed: f64) -> Segment {
         tolerance: 0.01,
         control: Default::default(),
         tool_axis_travel: None,
+        axis: None,
     }
 }
 

@@ -224,6 +224,7 @@ impl Direct {
             tolerance: self.tolerance(),
             control: self.control,
             tool_axis_travel: None,
+            axis: None,
         };
         if seg.rotary_only() && seg.rotary_travel() <= 0.0 {
             // Nothing moves: a repeated point.

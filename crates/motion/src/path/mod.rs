@@ -5,6 +5,7 @@
 //! program allows. The feed planner reads only this module's types, never G-code.
 
 pub mod direct;
+pub mod orient;
 pub mod segment;
 
 pub use segment::{Junction, PathItem, Segment, SegmentFeed};

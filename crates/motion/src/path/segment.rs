@@ -7,6 +7,8 @@
 
 use tezgah_geom::{Curve, ToolControl, Vec3};
 
+use crate::path::orient::AxisPath;
+
 /// How fast a segment is to be run, before the machine's limits lower it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SegmentFeed {
@@ -77,6 +79,11 @@ pub struct Segment {
     /// minute of that rotation). Set by the planner, which knows the machine; `None` times a
     /// rotary-only segment by its largest axis travel.
     pub tool_axis_travel: Option<f64>,
+    /// Under tool-centre-point control on a machine whose rotaries orient the tool, the tool
+    /// axis along the segment (workpiece frame): the joints then follow tip + axis, and the
+    /// rotary angles are read back from them. `None` runs `rotary` linearly (TCP off, or a
+    /// machine whose rotaries do not orient the tool).
+    pub axis: Option<AxisPath>,
 }
 
 impl Segment {
@@ -114,6 +121,7 @@ impl std::fmt::Debug for Segment {
             .field("end", &self.end)
             .field("tolerance", &self.tolerance)
             .field("control", &self.control)
+            .field("axis", &self.axis)
             .finish_non_exhaustive()
     }
 }

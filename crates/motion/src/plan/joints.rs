@@ -12,7 +12,11 @@
 
 use tezgah_geom::{Axis, Pose, ToolControl, Vec3};
 use tezgah_kinematics::tcp::ProgramPose;
-use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool};
+use tezgah_kinematics::{
+    Joints, Kinematics, KinematicsError, Machine, Model, TcpSwitch, Tool, ToolPose,
+};
+
+use crate::path::orient::{AxisPath, GreatCircle, ProgramPoint, ToolAxisMap};
 
 use super::PlanError;
 
@@ -132,6 +136,11 @@ impl PlanMachine {
         if !seg.rotary_only() || !self.orients() {
             return None;
         }
+        // The axis on a great circle: its turn is the circle's angle.
+        if let Some(AxisPath::Rotate(g)) = seg.axis {
+            let degrees = g.angle().to_degrees();
+            return (degrees > 1e-9).then_some(degrees);
+        }
         let tool = Tool::with_length(tool_length);
         let tip = seg.curve.point(seg.curve.domain().0);
         let [r0, r1] = seg.rotary;
@@ -241,6 +250,41 @@ impl PlanMachine {
         self.model.tcp_inverse(&p.tip, &p.angles, &tool, previous)
     }
 
+    /// Joints and program angles (A B C, degrees) of `seg` at curve parameter `u` (tip `tip`)
+    /// and fraction `f` of its length (or of its rotary travel), nearest `previous`: where the
+    /// segment carries a tool axis ([`Segment::axis`], under TCP), the inverse kinematics of
+    /// tip + axis, with the angles read back from the joints; otherwise A B C linear in `f`.
+    /// The one place the planner and the interpolator turn a point of a segment into joints.
+    pub fn segment_joints(
+        &self,
+        seg: &Segment,
+        u: f64,
+        f: f64,
+        tip: &Vec3,
+        previous: &Joints,
+    ) -> Result<(Joints, [f64; 3]), KinematicsError> {
+        let [r0, r1] = seg.rotary;
+        let mut rotary = if f >= 1.0 {
+            r1
+        } else {
+            [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
+        };
+        match (seg.axis, seg.control) {
+            (Some(path), ToolControl::CentrePoint { tool_length }) if self.orients() => {
+                let pose = ToolPose::new(*tip, path.at(u, f));
+                let q = self
+                    .model
+                    .inverse(&pose, &Tool::with_length(tool_length), previous)?;
+                let angles = self.model.tcp_angles(&q);
+                for (v, a) in angles.as_slice().iter().zip(&self.axes) {
+                    rotary[a.index() - 3] = v.to_degrees();
+                }
+                Ok((q, rotary))
+            }
+            _ => Ok((self.joints(seg.control, tip, &rotary, previous)?, rotary)),
+        }
+    }
+
     /// The program point (tip mm, A B C degrees) of joints `q` with TCP off: where a take-up
     /// move in joint mode starts and ends. Program axes without a joint read 0.
     pub fn joint_mode_point(&self, q: &Joints) -> Result<(Vec3, [f64; 3]), KinematicsError> {
@@ -259,3 +303,84 @@ impl PlanMachine {
         Ok((tip, rotary))
     }
 }
+
+/// The model's tool axis for program angles, under TCP on a machine whose rotaries orient the
+/// tool: the smoothing builder's view of the machine.
+impl ToolAxisMap for PlanMachine {
+    fn axis(&self, control: ToolControl, tip: &Vec3, rotary: &[f64; 3]) -> Option<Vec3> {
+        let ToolControl::CentrePoint { tool_length } = control else {
+            return None;
+        };
+        if !self.orients() {
+            return None;
+        }
+        // The rotary joints are the angles themselves (no branch to choose), so the axis
+        // depends on the angles alone, bit for bit.
+        let q = self
+            .joints(control, tip, rotary, &Joints::zeros(self.joint_count()))
+            .ok()?;
+        let pose = self
+            .model
+            .forward(&q, &Tool::with_length(tool_length))
+            .ok()?;
+        Some(pose.axis.into_inner())
+    }
+
+    fn follows(
+        &self,
+        control: ToolControl,
+        from: &ProgramPoint,
+        to: &ProgramPoint,
+        path: &GreatCircle,
+    ) -> bool {
+        let ToolControl::CentrePoint { tool_length } = control else {
+            return false;
+        };
+        let tool = Tool::with_length(tool_length);
+        let zeros = Joints::zeros(self.joint_count());
+        let (Ok(start), Ok(end)) = (
+            self.joints(control, &from.tip, &from.rotary, &zeros),
+            self.joints(control, &to.tip, &to.rotary, &zeros),
+        ) else {
+            return false;
+        };
+        // Steps of at most FOLLOW_STEP of the axis's turn: the nearest solution then tracks
+        // the branch the interpolator's 1 ms samples follow.
+        let steps = ((path.angle() / FOLLOW_STEP).ceil() as usize).max(8);
+        let at = |f: f64, previous: &Joints| {
+            let tip = from.tip + (to.tip - from.tip) * f;
+            self.model
+                .inverse(&ToolPose::new(tip, path.at(f)), &tool, previous)
+                .ok()
+        };
+        let mut q = start;
+        for k in 1..=steps {
+            let (f0, f1) = ((k - 1) as f64 / steps as f64, k as f64 / steps as f64);
+            let Some(next) = at(f1, &q) else {
+                return false;
+            };
+            // A joint that jumps (leaving the pole, where C is free, toward another C) does
+            // not halve its change when the step is halved, as a smooth joint does.
+            let (i, big) = (0..q.len())
+                .map(|i| (i, (next[i] - q[i]).abs()))
+                .fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
+            if big > 1e-9 {
+                let Some(mid) = at(0.5 * (f0 + f1), &q) else {
+                    return false;
+                };
+                if (mid[i] - q[i]).abs().max((next[i] - mid[i]).abs()) > 0.9 * big {
+                    return false;
+                }
+            }
+            q = next;
+        }
+        // The walk ends on the programmed tip and axis exactly, so on the programmed joints
+        // up to rounding when it kept their branch and turns.
+        (0..self.joint_count()).all(|i| (q[i] - end[i]).abs() <= FOLLOW_MATCH)
+    }
+}
+
+/// Largest turn of the tool axis (rad) between two steps of [`PlanMachine::follows`]'s walk.
+const FOLLOW_STEP: f64 = 0.01;
+/// How close (mm, rad) the walk's joints must end to the programmed ones.
+const FOLLOW_MATCH: f64 = 1e-9;

@@ -316,7 +316,6 @@ fn numeric_joints(
     let by_curvature = (length * g.kappa_max / 0.05).ceil() as usize;
     let steps = by_length.max(by_curvature).min(MAX_STEPS);
     let h = length / steps as f64;
-    let [r0, r1] = seg.rotary;
     let map = if g.rotary_only || constant_speed(&*seg.curve) {
         None
     } else {
@@ -324,22 +323,28 @@ fn numeric_joints(
         ArcLengthMap::new(&*seg.curve, 1e-12 * seg.length.clamp(1e-3, 1.0)).ok()
     };
     let at = |f: f64| {
-        let tip = if g.rotary_only {
-            seg.curve.point(ua)
+        let u = if g.rotary_only {
+            ua
         } else if let Some(m) = &map {
-            seg.curve.point(m.u_at(&*seg.curve, f * m.length()))
+            m.u_at(&*seg.curve, f * m.length())
         } else {
-            seg.curve.point(ua + (ub - ua) * f)
+            ua + (ub - ua) * f
         };
-        (tip, [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f))
+        (seg.curve.point(u), u)
     };
     let mut q: Vec<[f64; MAX_JOINTS]> = Vec::with_capacity(steps + 1);
-    let mut prev = Joints::zeros(n);
+    // The branch the interpolator follows: the one of the programmed angles at the start
+    // (where a tool axis is carried, its inverse has two tilt branches; the guess picks the
+    // one the path arrives on).
+    let (tip0, _) = at(0.0);
+    let mut prev = machine
+        .joints(seg.control, &tip0, &seg.rotary[0], &Joints::zeros(n))
+        .unwrap_or_else(|_| Joints::zeros(n));
     for k in 0..=steps {
         let f = k as f64 / steps as f64;
-        let (tip, rot) = at(f);
+        let (tip, u) = at(f);
         // Unreachable points are the interpolator's error to report, with the line.
-        let Ok(qk) = machine.joints(seg.control, &tip, &rot, &prev) else {
+        let Ok((qk, _)) = machine.segment_joints(seg, u, f, &tip, &prev) else {
             return Ok(());
         };
         prev = qk;
@@ -360,8 +365,9 @@ fn numeric_joints(
         if big > 1e-9 {
             let mut before = Joints::zeros(n);
             before.as_mut_slice().copy_from_slice(&q[k][..n]);
-            let (tip, rot) = at((k as f64 + 0.5) / steps as f64);
-            if let Ok(mid) = machine.joints(seg.control, &tip, &rot, &before) {
+            let fm = (k as f64 + 0.5) / steps as f64;
+            let (tip, u) = at(fm);
+            if let Ok((mid, _)) = machine.segment_joints(seg, u, fm, &tip, &before) {
                 let half = (mid[i] - x(k)).abs().max((x(k + 1) - mid[i]).abs());
                 if half > 0.9 * big {
                     return Err(PlanError::JointJump {

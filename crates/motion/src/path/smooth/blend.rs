@@ -168,6 +168,8 @@ pub(crate) struct Placed {
     pub ub: f64,
     /// Corner deviation achieved (distance from the programmed corner to the blend), mm.
     pub deviation: f64,
+    /// The blend's parametric speed `|C′|` at both ends (`λ = 2ℓ`).
+    pub speed: f64,
 }
 
 /// Distance from `q` to the piece's geometry over `[u0, u1]`; `cuts` are the piece's knots
@@ -187,7 +189,7 @@ fn distance_to(p: &Piece, q: &Vec3, cuts: &[f64]) -> f64 {
 }
 
 /// `[u0, the piece's knots strictly inside, u1]` (just the ends for lines and arcs).
-fn cuts(p: &Piece, u0: f64, u1: f64) -> Vec<f64> {
+pub(crate) fn cuts(p: &Piece, u0: f64, u1: f64) -> Vec<f64> {
     let mut c = vec![u0];
     if let Geo::Spline(n) = &p.geo {
         let k = n.knots();
@@ -233,7 +235,11 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     let room_b = b.full_length * LEG_SHARE;
     let room_a = room_a.min(a.s_at(a.u1) - a.s_at(a.u0));
     let room_b = room_b.min(b.s_at(b.u1) - b.s_at(b.u0));
-    let mut leg = (8.0 * share / (3.0 * half)).min(room_a).min(room_b);
+    // A hair below the tolerance-exact leg: at exactly 8ε/(3 sin(φ/2)) the closed-form
+    // deviation rounds to either side of ε, and a rounding up halved the leg.
+    let mut leg = (8.0 * share / (3.0 * half) * (1.0 - 1e-12))
+        .min(room_a)
+        .min(room_b);
     if !(leg > 0.0 && leg.is_finite()) {
         return Err(NoBlend::Corner);
     }
@@ -298,6 +304,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
                 ua,
                 ub,
                 deviation,
+                speed: lam,
             });
         }
         leg *= 0.5;

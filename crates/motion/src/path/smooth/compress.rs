@@ -162,5 +162,7 @@ fn fit_run(run: &[Piece], share: f64) -> Fit {
         return Fit::Failed;
     }
     piece.moves = run.len();
+    // The rotary axes stand still along a run, so does the tool axis.
+    piece.axis = first.axis;
     Fit::Spline(Box::new(piece))
 }

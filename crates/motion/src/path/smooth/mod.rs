@@ -14,12 +14,14 @@
 //! against the spline, so by the triangle inequality the path stays within
 //! `(compression_share + blend_share)·ε` of the program, and the samples within `ε`.
 
+mod axis;
 pub mod blend;
 mod compress;
 mod error;
 mod piece;
 
 use std::collections::VecDeque;
+use std::sync::Arc as Shared;
 
 use tezgah_geom::{
     Arc, FeedMode, Line, Move, MoveKind, PathMode, Pose, StopKind, ToolControl, Vec3,
@@ -28,8 +30,9 @@ use tezgah_geom::{
 pub use blend::{Blend, End};
 pub use error::PathError;
 
+use crate::path::orient::{AxisBlend, AxisPath, GreatCircle, ProgramPoint, ToolAxisMap};
 use crate::path::{Junction, PathItem, Segment, SegmentFeed};
-use blend::NoBlend;
+use blend::{NoBlend, Placed};
 use piece::{Geo, Mode, Piece};
 
 /// The share of the tolerance left to the feed planner's chord error (and interpolation):
@@ -59,9 +62,16 @@ pub struct SmoothOptions {
     pub compression_share: f64,
     /// Share of the tolerance for corner blends. Default 0.4.
     pub blend_share: f64,
-    /// Largest deviation (degrees) of a rotary axis across a blend from its programmed value
-    /// at the corner (5-axis). Default 0.1°.
+    /// The angular tolerance (degrees; the machine file's `[path] axis_tolerance_deg`): under
+    /// TCP with an [`Self::orientation`], the largest angle between the tool axis and the
+    /// programmed one, of which a blend may take `1 − CHORD_SHARE`; otherwise the largest
+    /// deviation of a rotary axis across a blend from its programmed value at the corner.
+    /// Default 0.1°.
     pub angular_tolerance: f64,
+    /// The machine's tool axis for the program angles (5-axis under TCP): with it, each move
+    /// carries its tool axis on a great circle and blends carry it by the two-curve method
+    /// ([`crate::path::orient`]); without it (and with TCP off) A B C run linearly.
+    pub orientation: Option<Orientation>,
     /// Where the tool stands before the first move (work frame, mm and degrees).
     pub start: Pose,
     /// Moves read and processed at a time (bounded memory). Default 512.
@@ -85,6 +95,7 @@ impl Default for SmoothOptions {
             start: Pose::ZERO,
             window: 512,
             control: ToolControl::Joints,
+            orientation: None,
         }
     }
 }
@@ -126,6 +137,16 @@ impl SmoothOptions {
             });
         }
         Ok(())
+    }
+}
+
+/// The machine's program-angle → tool-axis map, shared by the options (compared by identity).
+#[derive(Debug, Clone)]
+pub struct Orientation(pub Shared<dyn ToolAxisMap>);
+
+impl PartialEq for Orientation {
+    fn eq(&self, other: &Self) -> bool {
+        Shared::ptr_eq(&self.0, &other.0)
     }
 }
 
@@ -202,6 +223,8 @@ pub struct Stats {
     pub spline_cuts: usize,
     /// Largest corner deviation of a blend, mm (closed form for line–line, measured otherwise).
     pub max_blend_deviation: f64,
+    /// Largest angle between a blend's tool axis and the programmed axis, degrees (5-axis).
+    pub max_axis_deviation: f64,
 }
 
 impl<I: Iterator<Item = Move>> Smoother<I> {
@@ -324,8 +347,37 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     .ok_or(PathError::FeedPerRevolution { line })?
             }
         };
+        let axis = match (&self.opts.orientation, m.control) {
+            (Some(map), control @ ToolControl::CentrePoint { .. }) => {
+                let from = ProgramPoint {
+                    tip: Vec3::from(m.pos.xyz()),
+                    rotary: rotary[0],
+                };
+                let to = ProgramPoint {
+                    tip: Vec3::from(end.xyz()),
+                    rotary: rotary[1],
+                };
+                let v = map.0.axis(control, &from.tip, &from.rotary);
+                let u = if rotary[0] == rotary[1] {
+                    v
+                } else {
+                    map.0.axis(control, &to.tip, &to.rotary)
+                };
+                // Out of reach: the planner reports it with its line. A reversal (no common
+                // normal), or a move the axis alone cannot describe (see
+                // `ToolAxisMap::follows`), keeps its angles linear.
+                match (v, u) {
+                    (Some(v), Some(u)) => GreatCircle::new(v, u).ok().filter(|g| {
+                        rotary[0] == rotary[1] || map.0.follows(control, &from, &to, g)
+                    }),
+                    _ => None,
+                }
+            }
+            _ => None,
+        };
         m.pos = end;
-        let piece = Piece::new(geo, rotary, line, feed, m.tolerance, m.mode);
+        let mut piece = Piece::new(geo, rotary, line, feed, m.tolerance, m.mode);
+        piece.axis = axis;
         if !piece.moves_tip() && rotary[0] == rotary[1] {
             // Goes nowhere: nothing to run.
             return Ok(None);
@@ -459,32 +511,37 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
             // Only the tangent test: every real turn stays a corner.
             0.0
         };
-        let mut placed = blend::place(&a, b, share, max_angle);
-        // 5-axis: the rotary axes run linearly across the blend; keep their deviation from the
-        // programmed value at the corner within the angular tolerance by shortening the legs.
-        if let Ok(p) = &placed {
-            if !self.rotary_ok(&a, b, p.ua, p.ub) {
-                placed = Err(NoBlend::Corner);
-                let mut s = share;
-                for _ in 0..20 {
-                    s *= 0.5;
-                    match blend::place(&a, b, s, max_angle) {
-                        Ok(q) if self.rotary_ok(&a, b, q.ua, q.ub) => {
-                            placed = Ok(q);
+        // 5-axis: the tool axis (or, without one, the rotary axes running linearly) must stay
+        // within the angular tolerance across the blend: shorten the legs until it does.
+        let mut placed =
+            blend::place(&a, b, share, max_angle).map(|p| (self.orientation(&a, b, &p), p));
+        if let Ok((None, _)) = &placed {
+            placed = Err(NoBlend::Corner);
+            let mut s = share;
+            for _ in 0..20 {
+                s *= 0.5;
+                match blend::place(&a, b, s, max_angle) {
+                    Ok(q) => {
+                        if let Some(o) = self.orientation(&a, b, &q) {
+                            placed = Ok((Some(o), q));
                             break;
                         }
-                        Ok(_) => {}
-                        Err(e) => {
-                            placed = Err(e);
-                            break;
-                        }
+                    }
+                    Err(e) => {
+                        placed = Err(e);
+                        break;
                     }
                 }
             }
         }
         match placed {
-            Ok(p) => {
+            Ok((fit, p)) => {
                 let rotary = [a.rotary_at(p.ua), b.rotary_at(p.ub)];
+                let axis = fit.and_then(|(blend, deviation)| {
+                    self.stats.max_axis_deviation =
+                        self.stats.max_axis_deviation.max(deviation.to_degrees());
+                    blend.map(AxisPath::Blend)
+                });
                 let feed = blend_feed(&a, b, p.ua, p.ub);
                 let seg = Segment {
                     curve: Box::new(p.curve),
@@ -496,6 +553,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     tolerance: a.tolerance.min(b.tolerance),
                     control: self.control,
                     tool_axis_travel: None,
+                    axis,
                 };
                 a.u1 = p.ua;
                 b.u0 = p.ub;
@@ -505,7 +563,9 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 self.push_segment(seg);
             }
             Err(NoBlend::Tangent { same_curvature }) => {
-                let end = if same_curvature {
+                // The tip runs on smoothly; the axis (or the rotary axes) may change its rate
+                // here, which the planner must see as a tangent junction.
+                let end = if same_curvature && orientation_continues(&a, b) {
                     Junction::Smooth
                 } else {
                     Junction::Tangent
@@ -519,10 +579,49 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         }
     }
 
-    fn rotary_ok(&self, a: &Piece, b: &Piece, ua: f64, ub: f64) -> bool {
+    /// The orientation side of a placed blend, `None` if it leaves the angular tolerance: the
+    /// two-curve axis blend and its deviation (rad) where both pieces carry a tool axis,
+    /// otherwise no axis blend and the rotary axes' deviation at mid-blend (degrees → rad).
+    #[allow(clippy::type_complexity)]
+    fn orientation(&self, a: &Piece, b: &Piece, p: &Placed) -> Option<(Option<AxisBlend>, f64)> {
+        let tolerance = self.opts.angular_tolerance;
+        // A move with linear angles next to one carrying its axis: the two meet only at the
+        // programmed point (a blend would start the axis from where each left it).
+        if a.axis.is_some() != b.axis.is_some() {
+            return None;
+        }
+        if a.axis.is_some() && b.axis.is_some() {
+            let blend = axis::blend(a, b, p)?;
+            let deviation = axis::deviation(a, b, p, &blend);
+            return (deviation <= (1.0 - CHORD_SHARE) * tolerance.to_radians())
+                .then_some((Some(blend), deviation));
+        }
         let corner = a.rotary[1];
-        let (ra, rb) = (a.rotary_at(ua), b.rotary_at(ub));
-        (0..3).all(|i| (corner[i] - 0.5 * (ra[i] + rb[i])).abs() <= self.opts.angular_tolerance)
+        let (ra, rb) = (a.rotary_at(p.ua), b.rotary_at(p.ub));
+        let deviation = (0..3)
+            .map(|i| (corner[i] - 0.5 * (ra[i] + rb[i])).abs())
+            .fold(0.0, f64::max);
+        (deviation <= tolerance).then_some((None, 0.0))
+    }
+}
+
+/// Whether the orientation's rate of change by arc length (and, for the tool axis, its second
+/// derivative) is the same on both sides of a tangent junction, to 1e-9 relative.
+fn orientation_continues(a: &Piece, b: &Piece) -> bool {
+    let same = |x: Vec3, y: Vec3| (x - y).norm() <= 1e-9 * x.norm().max(y.norm()).max(1e-12);
+    match (a.axis, b.axis) {
+        (Some(ga), Some(gb)) => {
+            let ([a1, a2], [b1, b2]) = (ga.derivatives(1.0), gb.derivatives(0.0));
+            let (la, lb) = (a.full_length, b.full_length);
+            same(a1 / la, b1 / lb) && same(a2 / (la * la), b2 / (lb * lb))
+        }
+        _ => {
+            let rate = |p: &Piece| {
+                let [r0, r1] = p.rotary;
+                Vec3::new(r1[0] - r0[0], r1[1] - r0[1], r1[2] - r0[2]) / p.full_length
+            };
+            same(rate(a), rate(b))
+        }
     }
 }
 

@@ -6,6 +6,7 @@ use std::sync::Arc as Shared;
 
 use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, Trimmed, Vec3};
 
+use crate::path::orient::{AxisPath, GreatCircle};
 use crate::path::{Junction, Segment, SegmentFeed};
 
 /// Arc-length tolerance for the pieces that need a map (splines, arcs of changing radius): far
@@ -113,6 +114,9 @@ pub(crate) struct Piece {
     pub mode: Mode,
     /// Number of programmed moves this piece stands for (1, or the run length of a spline).
     pub moves: usize,
+    /// The tool axis along the untrimmed piece, in step with its arc length (5-axis under
+    /// TCP; `None` where the rotary axes run linearly).
+    pub axis: Option<GreatCircle>,
 }
 
 impl Piece {
@@ -153,7 +157,27 @@ impl Piece {
             tolerance,
             mode,
             moves: 1,
+            axis: None,
         }
+    }
+
+    /// Fraction of the untrimmed length at parameter `u` (what the axis path runs on).
+    pub fn fraction(&self, u: f64) -> f64 {
+        let (a, b) = self.geo.domain();
+        if u <= a {
+            0.0
+        } else if u >= b {
+            1.0
+        } else if self.full_length > 0.0 {
+            self.s_at(u) / self.full_length
+        } else {
+            0.0
+        }
+    }
+
+    /// The tool axis at parameter `u`, if the piece carries one.
+    pub fn axis_at(&self, u: f64) -> Option<tezgah_geom::Vec3> {
+        self.axis.map(|g| g.at(self.fraction(u)))
     }
 
     /// Arc length from the curve's start to `u`.
@@ -276,6 +300,13 @@ impl Piece {
         } else {
             [self.rotary_at(self.u0), self.rotary_at(self.u1)]
         };
+        let axis = self.axis.map(|g| {
+            AxisPath::Rotate(if whole {
+                g
+            } else {
+                g.part(self.fraction(self.u0), self.fraction(self.u1))
+            })
+        });
         let feed = match self.feed {
             SegmentFeed::InverseTime(t) if self.full_length > 0.0 => {
                 SegmentFeed::InverseTime(t * length / self.full_length)
@@ -302,6 +333,7 @@ impl Piece {
             // The builder stamps the control in force when it emits the segment.
             control: tezgah_geom::ToolControl::Joints,
             tool_axis_travel: None,
+            axis,
         }
     }
 }

@@ -1,0 +1,379 @@
+//! The tool axis along the smoothed path under tool-centre-point control (5-axis, reference
+//! 004 §2.3–2.4): reference 004's derived values for the two-curve blend, and properties on
+//! thousands of random 5-axis polylines on the table-ac trunnion — the axis is a unit vector
+//! everywhere, continuous at every joint (bit for bit), with continuous first and second
+//! derivatives by arc length at every smooth joint (measured, 1e-9), within the blend's share
+//! of the angular tolerance of the programmed axis (measured independently), exact at the
+//! programmed ends, never NaN.
+
+mod path_support;
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use path_support::*;
+use proptest::prelude::*;
+use tezgah_geom::{Curve, Move, MoveKind, PathMode, Pose, Quintic, State, ToolControl, Vec3};
+use tezgah_kinematics::Machine;
+use tezgah_motion::path::orient::{
+    angle_between, AxisBlend, AxisEnd, AxisPath, GreatCircle, ToolAxisMap,
+};
+use tezgah_motion::path::smooth::{build, Orientation, SmoothOptions, CHORD_SHARE};
+use tezgah_motion::path::{Junction, PathItem};
+use tezgah_motion::plan::PlanMachine;
+
+const TCP: ToolControl = ToolControl::CentrePoint { tool_length: 35.0 };
+
+/// Table-ac's tool axis in closed form (DESIGN.md): `(sin A sin C, sin A cos C, cos A)`.
+fn table_ac_axis(a_deg: f64, c_deg: f64) -> Vec3 {
+    let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
+    Vec3::new(a.sin() * c.sin(), a.sin() * c.cos(), a.cos())
+}
+
+fn machine() -> PlanMachine {
+    PlanMachine::from_machine(&Machine::builtin("table-ac").unwrap()).unwrap()
+}
+
+fn options(pm: &PlanMachine, tolerance: f64, angular: f64) -> SmoothOptions {
+    SmoothOptions {
+        tolerance,
+        angular_tolerance: angular,
+        control: TCP,
+        orientation: Some(Orientation(Arc::new(pm.clone()))),
+        ..SmoothOptions::default()
+    }
+}
+
+fn g1ac(line: u32, p: Vec3, a: f64, c: f64) -> Move {
+    Move {
+        line,
+        kind: MoveKind::Feed {
+            end: Pose::new(p.x, p.y, p.z, a, 0.0, c),
+        },
+    }
+}
+
+#[test]
+fn the_machine_gives_the_closed_form_axis() {
+    let pm = machine();
+    for (a, c) in [(0.0, 0.0), (30.0, 45.0), (-20.0, 300.0), (90.0, -170.0)] {
+        let o = pm
+            .axis(TCP, &Vec3::new(10.0, -5.0, 3.0), &[a, 0.0, c])
+            .unwrap();
+        assert!((o - table_ac_axis(a, c)).norm() < 1e-15, "{a} {c}: {o}");
+    }
+    // TCP off: the angles are joints, there is no axis to carry.
+    assert_eq!(
+        pm.axis(ToolControl::Joints, &Vec3::zeros(), &[30.0, 0.0, 0.0]),
+        None
+    );
+}
+
+/// Reference 004 §2.4 Steps 5–7 and §5.4 in physical time: the 90° line–line corner with
+/// ℓ = 1 mm at v = 10 mm/s (T = 0.2 s), the axis turning on both legs. The upper curve is the
+/// quintic of Step 6 through Step 5's rigid-body end data for a point h along the axis; Eq 7
+/// gives the axis. The library's blend must give the same axis for every h.
+#[test]
+fn two_curve_blend_matches_reference_004_steps_5_to_7() {
+    let (v, t_blend) = (10.0, 0.2);
+    // Legs: the tool tilts about the path normal on each (θ̇ = 0.2 rad/s and −0.3 rad/s).
+    let o0 = table_ac_axis(20.0, 0.0);
+    let oc = table_ac_axis(20.0 + 0.2f64.to_degrees() / v, 0.0);
+    let k0 = Vec3::x();
+    let k1 = Vec3::new(0.6, 0.0, 0.8);
+    let (w0, w1) = (0.2, -0.3);
+    let o1 = GreatCircle::new(oc, tezgah_motion::path::orient::rotate(&oc, &k1, w1 / v))
+        .unwrap()
+        .at(1.0);
+    // Lower curve: §5.4's x(τ) = −1 + 10τ − 250τ³ + 625τ⁴, y(τ) = 250τ³ − 625τ⁴.
+    let p = |tau: f64| {
+        Vec3::new(
+            -1.0 + 10.0 * tau - 250.0 * tau.powi(3) + 625.0 * tau.powi(4),
+            250.0 * tau.powi(3) - 625.0 * tau.powi(4),
+            0.0,
+        )
+    };
+    // Step 5: Q̇ = Ṗ + h ω×O, Q̈ = P̈ + h(α×O + ω×(ω×O)), α = 0 at the blend's ends.
+    let end_state = |pt: Vec3, pv: Vec3, o: Vec3, omega: Vec3, h: f64| State {
+        p: pt + o * h,
+        v: pv + omega.cross(&o) * h,
+        a: omega.cross(&omega.cross(&o)) * h,
+    };
+    for h in [1.0, 35.0, 250.0] {
+        let q = Quintic::hermite(
+            end_state(p(0.0), Vec3::x() * v, o0, k0 * w0, h),
+            end_state(p(t_blend), Vec3::y() * v, o1, k1 * w1, h),
+            t_blend,
+        )
+        .unwrap();
+        // The library's blend in u = τ/T: O′ = T·ω×O, O″ = T²·ω×(ω×O).
+        let end = |o: Vec3, omega: Vec3| AxisEnd {
+            axis: o,
+            d1: omega.cross(&o) * t_blend,
+            d2: omega.cross(&omega.cross(&o)) * (t_blend * t_blend),
+        };
+        let blend = AxisBlend::new(end(o0, k0 * w0), end(o1, k1 * w1)).unwrap();
+        for i in 0..=20 {
+            let tau = t_blend * i as f64 / 20.0;
+            let eq7 = (q.point(tau) - p(tau)).normalize();
+            let ours = blend.at(tau / t_blend);
+            assert!(
+                angle_between(&eq7, &ours) < 1e-12 * h.max(1.0) * 1e2,
+                "h {h} τ {tau}: {eq7} {ours}"
+            );
+            // And the library's own upper curve is that quintic.
+            let upper = blend.upper(&p(tau), h, tau / t_blend);
+            assert!((upper - q.point(tau)).norm() < 1e-11 * h, "h {h} τ {tau}");
+        }
+        assert_eq!(blend.at(0.0), o0);
+        assert_eq!(blend.at(1.0), o1);
+    }
+}
+
+/// One step of a random 5-axis polyline: turn the heading by `turn` in XY, go `len` mm,
+/// climb `dz`, turn A by `da`° and C by `dc`°.
+#[derive(Debug, Clone)]
+struct Step {
+    turn: f64,
+    len: f64,
+    dz: f64,
+    da: f64,
+    dc: f64,
+}
+
+fn step() -> impl Strategy<Value = Step> {
+    (
+        -2.9f64..2.9,
+        0.3f64..15.0,
+        -1.0f64..1.0,
+        -8.0f64..8.0,
+        prop_oneof![-40.0f64..-0.5, 0.5f64..40.0],
+    )
+        .prop_map(|(turn, len, dz, da, dc)| Step {
+            turn,
+            len,
+            dz,
+            da,
+            dc,
+        })
+}
+
+struct Program {
+    moves: Vec<Move>,
+    /// Programmed points with their A and C (start first).
+    points: Vec<(Vec3, f64, f64)>,
+}
+
+fn program(steps: &[Step], tolerance: f64) -> Program {
+    let start = (Vec3::new(5.0, -3.0, 2.0), 25.0, 10.0);
+    let mut moves = vec![
+        feed(1, 1200.0),
+        mode(
+            2,
+            PathMode::Continuous {
+                tolerance: Some(tolerance),
+            },
+        ),
+        Move {
+            line: 3,
+            kind: MoveKind::Rapid {
+                end: Pose::new(start.0.x, start.0.y, start.0.z, start.1, 0.0, start.2),
+            },
+        },
+    ];
+    // The rapid starts from the origin (A 0, C 0).
+    let mut points = vec![(Vec3::zeros(), 0.0, 0.0), start];
+    let (mut pos, mut a, mut c) = start;
+    let mut heading = Vec3::x();
+    for (i, s) in steps.iter().enumerate() {
+        let (sn, cs) = s.turn.sin_cos();
+        heading = Vec3::new(
+            cs * heading.x - sn * heading.y,
+            sn * heading.x + cs * heading.y,
+            0.0,
+        );
+        pos += heading * s.len + Vec3::new(0.0, 0.0, s.dz);
+        a = (a + s.da).clamp(5.0, 80.0);
+        c += s.dc;
+        moves.push(g1ac(i as u32 + 4, pos, a, c));
+        points.push((pos, a, c));
+    }
+    Program { moves, points }
+}
+
+/// The programmed axis at the point of move `m` (from `points[m − 1]` to `points[m]`; the
+/// move of source line L is m = L − 2) nearest `q`: the great circle between the closed-form axes of its ends, at the fraction of
+/// its length (reference 004 Eq 3). Returns (distance, axis).
+fn programmed(points: &[(Vec3, f64, f64)], m: usize, q: &Vec3) -> (f64, Vec3) {
+    let (p0, a0, c0) = points[m - 1];
+    let (p1, a1, c1) = points[m];
+    let d = p1 - p0;
+    let t = ((q - p0).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+    let g = GreatCircle::new(table_ac_axis(a0, c0), table_ac_axis(a1, c1)).unwrap();
+    ((p0 + d * t - q).norm(), g.at(t))
+}
+
+fn check(prog: &Program, items: &[PathItem], pm: &PlanMachine, angular: f64) -> Result<(), String> {
+    let segs = segments(items);
+    let budget = (1.0 - CHORD_SHARE) * angular.to_radians();
+    for (i, s) in segs.iter().enumerate() {
+        let path = s.axis.ok_or(format!("segment {i}: no axis under TCP"))?;
+        let (u0, u1) = s.curve.domain();
+        for k in 0..=16 {
+            let f = k as f64 / 16.0;
+            let u = u0 + (u1 - u0) * f;
+            let o = path.at(u, f);
+            if !(o.iter().all(|x| x.is_finite()) && (o.norm() - 1.0).abs() < 1e-12) {
+                return Err(format!("segment {i}: axis {o} at {f}"));
+            }
+        }
+        // A blend (its line is the incoming move's) within the blend's share of the angular
+        // tolerance of the programmed axis at the nearest point of its two moves.
+        if let AxisPath::Blend(b) = path {
+            let m = (s.line - 2) as usize;
+            for k in 0..=200 {
+                let u = k as f64 / 200.0;
+                let tip = s.curve.point(u);
+                let (da, oa) = programmed(&prog.points, m, &tip);
+                let (db, ob) = programmed(&prog.points, m + 1, &tip);
+                let reference = if da <= db { oa } else { ob };
+                let dev = angle_between(&b.at(u), &reference);
+                if dev > budget + 1e-12 {
+                    return Err(format!(
+                        "segment {i} (line {}): axis {:.3e}° off at u = {u}, budget {:.3e}°",
+                        s.line,
+                        dev.to_degrees(),
+                        budget.to_degrees()
+                    ));
+                }
+            }
+        }
+    }
+    for (i, w) in segs.windows(2).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        let (pa, pb) = (a.axis.unwrap(), b.axis.unwrap());
+        let (ea, sb) = (pa.ends()[1], pb.ends()[0]);
+        if ea != sb {
+            return Err(format!("joint {i}: axis {ea} then {sb}"));
+        }
+        if a.end == Junction::Smooth {
+            let [_, a1, a2] = pa.arc_derivatives(&*a.curve, a.length, a.curve.domain().1, 1.0);
+            let [_, b1, b2] = pb.arc_derivatives(&*b.curve, b.length, b.curve.domain().0, 0.0);
+            // Within 1e-9 (per mm, per mm²), relative where the values exceed 1.
+            let scale1 = a1.norm().max(b1.norm()).max(1.0);
+            let scale2 = a2.norm().max(b2.norm()).max(1.0);
+            if (a1 - b1).norm() > 1e-9 * scale1 || (a2 - b2).norm() > 1e-9 * scale2 {
+                return Err(format!(
+                    "joint {i} (line {}): O' {a1} vs {b1}, O'' {a2} vs {b2}",
+                    a.line
+                ));
+            }
+        }
+    }
+    // Programmed ends exactly: the machine's axis of the last programmed angles.
+    let last = segs.last().ok_or("no segments")?;
+    let &(p, a, c) = prog.points.last().unwrap();
+    let want = pm.axis(TCP, &p, &[a, 0.0, c]).unwrap();
+    if last.axis.unwrap().ends()[1] != want {
+        return Err(format!(
+            "end axis {:?} vs {want}",
+            last.axis.unwrap().ends()
+        ));
+    }
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
+
+    #[test]
+    fn random_five_axis_polylines(
+        steps in proptest::collection::vec(step(), 1..12),
+        tol in prop_oneof![Just(0.01), Just(0.002), Just(0.1)],
+        angular in prop_oneof![Just(0.1), Just(0.01), Just(1.0)],
+    ) {
+        let pm = machine();
+        let prog = program(&steps, tol);
+        let items = build(prog.moves.clone(), &options(&pm, 0.01, angular)).unwrap();
+        if let Err(e) = check(&prog, &items, &pm, angular) {
+            return Err(TestCaseError::fail(e));
+        }
+    }
+}
+
+#[test]
+fn a_blend_is_shortened_to_keep_the_axis_within_tolerance() {
+    // A right-angle corner where the axis turns fast on both legs (20° per mm about different
+    // normals): with a loose angular tolerance the blend takes its whole tip share, with a
+    // tight one its legs shrink until the axis fits.
+    let pm = machine();
+    let moves = vec![
+        feed(1, 600.0),
+        g1ac(2, Vec3::new(1.0, 0.0, 0.0), 20.0, 0.0),
+        g1ac(3, Vec3::new(1.0, 1.0, 0.0), 20.0, 20.0),
+    ];
+    let leg = |angular: f64| {
+        let items = build(moves.clone(), &options(&pm, 0.05, angular)).unwrap();
+        let segs = segments(&items);
+        assert_eq!(segs.len(), 3, "line, blend, line");
+        assert!(matches!(segs[1].axis, Some(AxisPath::Blend(_))));
+        1.0 - segs[0].length
+    };
+    let loose = leg(5.0);
+    let tight = leg(0.05);
+    // Tip share only: ℓ = 8·0.4·0.05/(3 sin 45°).
+    let tip_leg = 8.0 * 0.4 * 0.05 / (3.0 * (PI / 4.0).sin());
+    assert!(
+        (loose - tip_leg).abs() < 1e-10 * tip_leg,
+        "{loose} {tip_leg}"
+    );
+    assert!(tight < 0.5 * loose && tight > 0.0, "{tight} {loose}");
+}
+
+/// Moves the tool axis alone cannot describe keep their angles linear: a reversal (C 180° at
+/// A 90°), a whole turn of C, C turning with the tool along the C axis, the long way round.
+/// The others carry the axis, and each move's joints end on the programmed ones.
+#[test]
+fn moves_the_axis_cannot_describe_keep_linear_angles() {
+    let pm = machine();
+    let cases: [(&[(f64, f64)], &[bool]); 6] = [
+        // Reversal at the second move.
+        (&[(90.0, 0.0), (90.0, 180.0)], &[true, false]),
+        // A whole turn.
+        (&[(30.0, 0.0), (30.0, 360.0)], &[true, false]),
+        // At the pole C is free: the axis stays while the program turns C (linear); tilting
+        // away from the pole then starts from the programmed C (carried); leaving the pole
+        // toward another C would make C jump (linear).
+        (
+            &[(0.0, 0.0), (0.0, 90.0), (30.0, 90.0)],
+            &[true, false, true],
+        ),
+        (
+            &[(0.0, 0.0), (30.0, 40.0), (40.0, 50.0)],
+            &[true, false, true],
+        ),
+        // The long way round: C 0 → 350 (the axis would go −10°).
+        (&[(30.0, 0.0), (30.0, 350.0)], &[true, false]),
+        // The short way: carried.
+        (&[(30.0, 0.0), (30.0, 40.0)], &[true, true]),
+    ];
+    for (angles, carried) in cases {
+        let mut moves = vec![feed(1, 600.0)];
+        let mut x = 0.0;
+        for (i, &(a, c)) in angles.iter().enumerate() {
+            x += 5.0;
+            moves.push(g1ac(i as u32 + 2, Vec3::new(x, 0.0, 0.0), a, c));
+        }
+        let items = build(moves, &options(&pm, 0.01, 0.1)).unwrap();
+        let segs = segments(&items);
+        for (i, &want) in carried.iter().enumerate() {
+            let line = i as u32 + 2;
+            // Every segment of the move (trimmed pieces and, between carried moves, blends).
+            let got = segs
+                .iter()
+                .filter(|s| s.line == line && !matches!(s.axis, Some(AxisPath::Blend(_))))
+                .all(|s| s.axis.is_some() == want);
+            assert!(got, "{angles:?}: move {i} carried {want}: {segs:#?}");
+        }
+    }
+}
