@@ -97,6 +97,16 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Error text wraps at the terminal's width on a terminal, and not at all into a pipe or a
+    // log, where a message broken across lines defeats `grep`.
+    let _ = miette::set_hook(Box::new(|_| {
+        use std::io::IsTerminal;
+        Box::new(
+            miette::MietteHandlerOpts::new()
+                .wrap_lines(std::io::stderr().is_terminal())
+                .build(),
+        )
+    }));
     let result = match cli.command {
         Command::Canon { program, inputs } => canon(&program, &inputs),
         Command::Check { program, inputs } => check(&program, &inputs),
