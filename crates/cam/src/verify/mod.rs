@@ -1,0 +1,444 @@
+//! Independent verification of a tool path: a dexel simulation of the cut. Sits after the
+//! post-processor (it sweeps the cutter along the program as the machine moves it) or after a
+//! strategy (along the tool path itself), and measures the largest scallop and the deepest
+//! gouge on the surface, with their error bounds.
+//!
+//! Dexels stand on the surface along its outward normal at the nodes of a grid in (u, v) over
+//! the machined region (the box of the cutter-contact parameters), spaced at most `cell` mm
+//! apart on the surface. Each holds the material height above its foot; every cutter pose
+//! lowers it to where the dexel enters the cutter ([`solid`]). Afterwards a positive height is
+//! a scallop, a negative one a gouge.
+//!
+//! Error bounds (both one-sided, DESIGN.md asks that they be stated):
+//! * sweep: the cutter is placed at discrete poses no point of it moving more than `δ`
+//!   between two; the material left between two placements of a convex body whose surface
+//!   curves with radius ≥ ρ is at most `δ²/(8ρ)` deep (the sagitta), ρ the corner radius (the
+//!   tool radius for a flat end). Heights are over-estimated by at most that.
+//! * grid: the highest scallop is sampled at a node at most `c/√2` from it (c the largest
+//!   node spacing); the scallop's flank rises with slope at most `tan φ`, `cos φ = 1 − h/ρ`
+//!   (the cutter's profile meeting the surface at the height h), so the sampled maximum is
+//!   below the true one by at most `tan φ · c/√2`. The same bound covers a gouge's depth.
+
+pub mod solid;
+
+use tezgah_geom::{NurbsSurface, Vec3};
+
+pub use solid::{CutterPose, CutterSolid};
+
+use crate::toolpath::ToolPath;
+
+/// How finely to simulate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VerifyOptions {
+    /// Largest spacing of dexels on the surface, mm (at most a twentieth of the step-over).
+    pub cell_mm: f64,
+    /// Largest motion of any cutter point between two simulated poses, mm.
+    pub sweep_spacing_mm: f64,
+}
+
+/// What the simulation measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verification {
+    /// Dexels simulated.
+    pub dexels: usize,
+    /// Largest node spacing achieved on the surface, mm.
+    pub cell_mm: f64,
+    /// Cutter poses swept.
+    pub poses: usize,
+    /// Dexels of the region that no pose reached.
+    pub uncut: usize,
+    /// Highest material left above the surface (along the normal), mm; 0 if none.
+    pub max_scallop_mm: f64,
+    /// Where: (u, v) and the surface point.
+    pub max_scallop_at: Option<((f64, f64), Vec3)>,
+    /// Deepest cut below the surface, mm; 0 if none.
+    pub gouge_depth_mm: f64,
+    pub gouge_at: Option<((f64, f64), Vec3)>,
+    /// Grid error bound, mm (the true maxima exceed the measured ones by at most this).
+    pub grid_bound_mm: f64,
+    /// Sweep error bound, mm (measured heights exceed the true ones by at most this).
+    pub sweep_bound_mm: f64,
+}
+
+/// Why the simulation could not run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum VerifyError {
+    #[error("{what} must be a finite number > 0, got {value}")]
+    Option { what: &'static str, value: f64 },
+    #[error("the tool path has no cutter locations")]
+    Empty,
+    #[error("the grid would need {0} dexels (more than {MAX_DEXELS}); use a coarser cell")]
+    TooFine(usize),
+}
+
+/// Memory guard: 8 M dexels are ~0.5 GB of grid data.
+pub const MAX_DEXELS: usize = 8_000_000;
+
+/// Surface samples per direction when estimating the largest parametric speed.
+const SPEED_SAMPLES: usize = 33;
+
+struct Dexel {
+    foot: Vec3,
+    normal: Vec3,
+    uv: (f64, f64),
+    height: f64,
+}
+
+/// Poses along a tool path's passes as straight tip motion and great-circle axis motion
+/// between cutter locations (links left out), no cutter point moving more than `spacing`.
+pub fn path_poses(path: &ToolPath, spacing: f64) -> Vec<CutterPose> {
+    let reach = path
+        .cutter
+        .shape
+        .radius()
+        .hypot(path.cutter.shape.corner_radius());
+    let mut out = Vec::new();
+    for pass in &path.passes {
+        let Some(first) = pass.points.first() else {
+            continue;
+        };
+        out.push(CutterPose {
+            tip: first.tip,
+            axis: first.axis.normalize(),
+        });
+        for w in pass.points.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            let (ua, ub) = (a.axis.normalize(), b.axis.normalize());
+            let angle = ua.angle(&ub);
+            let span = (b.tip - a.tip).norm() + reach * angle;
+            let n = ((span / spacing).ceil() as usize).clamp(1, 1_000_000);
+            for k in 1..=n {
+                let t = k as f64 / n as f64;
+                let axis = if angle > 1e-12 {
+                    let k_rot = ua.cross(&ub).normalize();
+                    let th = t * angle;
+                    ua * th.cos() + k_rot.cross(&ua) * th.sin()
+                } else {
+                    ua
+                };
+                out.push(CutterPose {
+                    tip: a.tip + (b.tip - a.tip) * t,
+                    axis,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// The step-over of a path: over neighbouring passes, the median distance from a pass's
+/// contact points to the next pass's contact polyline; the smallest such median. `None`
+/// with fewer than two passes.
+pub fn step_over(path: &ToolPath) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    for w in path.passes.windows(2) {
+        let next: Vec<Vec3> = w[1].points.iter().map(|c| c.contact).collect();
+        if next.is_empty() || w[0].points.is_empty() {
+            continue;
+        }
+        let stride = (w[0].points.len() / 50).max(1);
+        let mut d: Vec<f64> = w[0]
+            .points
+            .iter()
+            .step_by(stride)
+            .map(|c| polyline_distance(&c.contact, &next))
+            .collect();
+        d.sort_by(f64::total_cmp);
+        let median = d[d.len() / 2];
+        if median > 0.0 {
+            best = Some(best.map_or(median, |b| b.min(median)));
+        }
+    }
+    best
+}
+
+fn polyline_distance(p: &Vec3, line: &[Vec3]) -> f64 {
+    if line.len() == 1 {
+        return (p - line[0]).norm();
+    }
+    line.windows(2)
+        .map(|s| {
+            let d = s[1] - s[0];
+            let l2 = d.norm_squared();
+            let t = if l2 > 0.0 {
+                ((p - s[0]).dot(&d) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p - (s[0] + d * t)).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn positive(what: &'static str, value: f64) -> Result<f64, VerifyError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(VerifyError::Option { what, value })
+    }
+}
+
+/// Simulates `poses` of the path's cutter over `surface` and measures scallop and gouge on the
+/// region the path's contact points span.
+pub fn simulate(
+    surface: &NurbsSurface,
+    path: &ToolPath,
+    poses: &[CutterPose],
+    options: &VerifyOptions,
+) -> Result<Verification, VerifyError> {
+    let cell = positive("the cell size", options.cell_mm)?;
+    let spacing = positive("the sweep spacing", options.sweep_spacing_mm)?;
+    let cls: Vec<_> = path.passes.iter().flat_map(|p| &p.points).collect();
+    let first = cls.first().ok_or(VerifyError::Empty)?;
+    // The machined region in (u, v).
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for c in &cls {
+        u0 = u0.min(c.uv.0);
+        u1 = u1.max(c.uv.0);
+        v0 = v0.min(c.uv.1);
+        v1 = v1.max(c.uv.1);
+    }
+    let (du0, du1) = surface.domain_u();
+    let (dv0, dv1) = surface.domain_v();
+    let (u0, u1, v0, v1) = (u0.max(du0), u1.min(du1), v0.max(dv0), v1.min(dv1));
+    // Largest parametric speeds over the region, sampled, with a margin for what falls
+    // between samples.
+    let (mut su, mut sv) = (0.0_f64, 0.0_f64);
+    for i in 0..SPEED_SAMPLES {
+        for j in 0..SPEED_SAMPLES {
+            let u = u0 + (u1 - u0) * i as f64 / (SPEED_SAMPLES - 1) as f64;
+            let v = v0 + (v1 - v0) * j as f64 / (SPEED_SAMPLES - 1) as f64;
+            let d = surface.derivs(u, v);
+            su = su.max(d.su.norm());
+            sv = sv.max(d.sv.norm());
+        }
+    }
+    let (su, sv) = (su * 1.05, sv * 1.05);
+    let nu = ((su * (u1 - u0) / cell).ceil() as usize).max(1) + 1;
+    let nv = ((sv * (v1 - v0) / cell).ceil() as usize).max(1) + 1;
+    let count = nu.saturating_mul(nv);
+    if count > MAX_DEXELS {
+        return Err(VerifyError::TooFine(count));
+    }
+    let achieved = (su * (u1 - u0) / (nu - 1) as f64).max(sv * (v1 - v0) / (nv - 1) as f64);
+    // Orient the normals out of the material as the path's first contact says.
+    let flip = surface
+        .normal(first.uv.0, first.uv.1)
+        .is_some_and(|n| n.dot(&first.normal) < 0.0);
+    let r = path.cutter.shape.radius();
+    // Dexels reach the cutter radius above and below the surface: higher material counts as
+    // uncut, deeper gouges are reported as that deep.
+    let up = r;
+    let depth = r;
+    let mut dexels: Vec<Dexel> = Vec::with_capacity(count);
+    for i in 0..nu {
+        let u = if nu > 1 {
+            u0 + (u1 - u0) * i as f64 / (nu - 1) as f64
+        } else {
+            u0
+        };
+        for j in 0..nv {
+            let v = if nv > 1 {
+                v0 + (v1 - v0) * j as f64 / (nv - 1) as f64
+            } else {
+                v0
+            };
+            let Some(n) = surface.normal(u, v) else {
+                continue;
+            };
+            let n = if flip {
+                -n.into_inner()
+            } else {
+                n.into_inner()
+            };
+            dexels.push(Dexel {
+                foot: surface.point(u, v),
+                normal: n,
+                uv: (u, v),
+                height: up,
+            });
+        }
+    }
+    let solid = CutterSolid::of(&path.cutter);
+    let grid = Buckets::new(&dexels, r.max(4.0 * cell));
+    let reach_out = up.max(depth);
+    for pose in poses {
+        let axis = pose.axis;
+        // The solid lies within R of its axis segment from the corner's centre to the top.
+        let (s0, s1) = (
+            pose.tip + axis * solid.corner,
+            pose.tip + axis * solid.core_top,
+        );
+        let grow = r + reach_out;
+        let lo = s0.inf(&s1).add_scalar(-grow);
+        let hi = s0.sup(&s1).add_scalar(grow);
+        grid.visit(&lo, &hi, |k| {
+            let d = &mut dexels[k];
+            let (a, b) = (d.foot - d.normal * depth, d.foot + d.normal * d.height);
+            if segment_distance(&a, &b, &s0, &s1) > r {
+                return;
+            }
+            if let Some(t) = solid.entry(pose, &d.foot, &d.normal, -depth, d.height) {
+                if t < d.height {
+                    d.height = t;
+                }
+            }
+        });
+    }
+    let mut out = Verification {
+        dexels: dexels.len(),
+        cell_mm: achieved,
+        poses: poses.len(),
+        uncut: 0,
+        max_scallop_mm: 0.0,
+        max_scallop_at: None,
+        gouge_depth_mm: 0.0,
+        gouge_at: None,
+        grid_bound_mm: 0.0,
+        sweep_bound_mm: 0.0,
+    };
+    for d in &dexels {
+        if d.height >= up {
+            out.uncut += 1;
+        } else if d.height > out.max_scallop_mm {
+            out.max_scallop_mm = d.height;
+            out.max_scallop_at = Some((d.uv, d.foot));
+        } else if -d.height > out.gouge_depth_mm {
+            out.gouge_depth_mm = -d.height;
+            out.gouge_at = Some((d.uv, d.foot));
+        }
+    }
+    let rho = if solid.corner > 0.0 { solid.corner } else { r };
+    out.sweep_bound_mm = spacing * spacing / (8.0 * rho);
+    let worst = out.max_scallop_mm.max(out.gouge_depth_mm);
+    let mut e = 0.0;
+    for _ in 0..3 {
+        let c = 1.0 - (worst + e) / rho;
+        let slope = if c > 0.0 {
+            (1.0 - c * c).sqrt() / c
+        } else {
+            f64::INFINITY
+        };
+        e = (slope * achieved / std::f64::consts::SQRT_2).min(rho);
+    }
+    out.grid_bound_mm = e;
+    Ok(out)
+}
+
+/// Distance between the segments p0–p1 and q0–q1 (Ericson, *Real-Time Collision Detection*,
+/// §5.1.9: the closest points by clamped parameters).
+fn segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f64 {
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
+    let (s, t) = if a <= f64::EPSILON && e <= f64::EPSILON {
+        (0.0, 0.0)
+    } else if a <= f64::EPSILON {
+        (0.0, (f / e).clamp(0.0, 1.0))
+    } else {
+        let c = d1.dot(&r);
+        if e <= f64::EPSILON {
+            ((-c / a).clamp(0.0, 1.0), 0.0)
+        } else {
+            let b = d1.dot(&d2);
+            let denom = a * e - b * b;
+            let mut s = if denom > 0.0 {
+                ((b * f - c * e) / denom).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let mut t = (b * s + f) / e;
+            if t < 0.0 {
+                t = 0.0;
+                s = (-c / a).clamp(0.0, 1.0);
+            } else if t > 1.0 {
+                t = 1.0;
+                s = ((b - c) / a).clamp(0.0, 1.0);
+            }
+            (s, t)
+        }
+    };
+    ((p0 + d1 * s) - (q0 + d2 * t)).norm()
+}
+
+/// A uniform grid of buckets over the dexel feet, for the poses' neighbourhood queries.
+struct Buckets {
+    origin: Vec3,
+    size: f64,
+    dims: [usize; 3],
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl Buckets {
+    fn new(dexels: &[Dexel], size: f64) -> Self {
+        let mut lo = Vec3::repeat(f64::INFINITY);
+        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+        for d in dexels {
+            lo = lo.inf(&d.foot);
+            hi = hi.sup(&d.foot);
+        }
+        if dexels.is_empty() {
+            lo = Vec3::zeros();
+            hi = Vec3::zeros();
+        }
+        let dims = [0, 1, 2].map(|i| (((hi[i] - lo[i]) / size).floor() as usize + 1).min(4096));
+        let cells = dims[0] * dims[1] * dims[2];
+        let index = |p: &Vec3| -> usize {
+            let c = [0, 1, 2]
+                .map(|i| (((p[i] - lo[i]) / size).floor().max(0.0) as usize).min(dims[i] - 1));
+            (c[0] * dims[1] + c[1]) * dims[2] + c[2]
+        };
+        let mut count = vec![0u32; cells + 1];
+        for d in dexels {
+            count[index(&d.foot) + 1] += 1;
+        }
+        for i in 0..cells {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut items = vec![0u32; dexels.len()];
+        for (k, d) in dexels.iter().enumerate() {
+            let b = index(&d.foot);
+            items[fill[b] as usize] = k as u32;
+            fill[b] += 1;
+        }
+        Buckets {
+            origin: lo,
+            size,
+            dims,
+            start: count,
+            items,
+        }
+    }
+
+    fn visit(&self, lo: &Vec3, hi: &Vec3, mut f: impl FnMut(usize)) {
+        let range = |i: usize| -> Option<(usize, usize)> {
+            let a = ((lo[i] - self.origin[i]) / self.size).floor();
+            let b = ((hi[i] - self.origin[i]) / self.size).floor();
+            if b < 0.0 || a > (self.dims[i] - 1) as f64 {
+                return None;
+            }
+            Some((a.max(0.0) as usize, (b as usize).min(self.dims[i] - 1)))
+        };
+        let (Some(x), Some(y), Some(z)) = (range(0), range(1), range(2)) else {
+            return;
+        };
+        for i in x.0..=x.1 {
+            for j in y.0..=y.1 {
+                let row = (i * self.dims[1] + j) * self.dims[2];
+                let (s, e) = (
+                    self.start[row + z.0] as usize,
+                    self.start[row + z.1 + 1] as usize,
+                );
+                for &k in &self.items[s..e] {
+                    f(k as usize);
+                }
+            }
+        }
+    }
+}
