@@ -150,13 +150,53 @@ impl MachineMotion<'_> {
         };
         out.push(first);
         for next in iter {
+            // Leaving the pole for a point of another C: C is free at the pole, so the table
+            // turns there first, the tool standing still on the part (the turn is then halved
+            // like any move; without it, every half would still hold the whole turn).
+            let a = *out.last().expect("out starts non-empty");
+            if self.orienter.at_pole(&a.axis) && (next.angles.c - a.angles.c).abs() > 1e-12 {
+                let angles = self.orienter.keeping_c(&a.axis, next.angles.c);
+                let joints = self
+                    .joints(&a.tip, angles, &a.joints)
+                    .map_err(|e| PostError::Kinematics {
+                        at: next.source,
+                        error: e,
+                    })?;
+                let turn = PostedPoint {
+                    angles,
+                    joints,
+                    motion: next.motion,
+                    source: next.source,
+                    inserted: true,
+                    ..a
+                };
+                inserted += 1;
+                self.halve_into(&mut out, turn, tolerance, max_halvings, &mut worst, &mut inserted)?;
+            }
+            self.halve_into(&mut out, next, tolerance, max_halvings, &mut worst, &mut inserted)?;
+        }
+        Ok((out, worst, inserted))
+    }
+
+    /// Appends `next` to `out`, halving the segment from `out`'s last point until every piece
+    /// is within `tolerance`.
+    fn halve_into(
+        &self,
+        out: &mut Vec<PostedPoint>,
+        next: PostedPoint,
+        tolerance: f64,
+        max_halvings: u32,
+        worst: &mut f64,
+        inserted: &mut usize,
+    ) -> Result<(), PostError> {
+        {
             // Depth-first halving: a stack of pending ends with their depth.
             let mut stack = vec![(next, 0u32)];
             while let Some((b, depth)) = stack.pop() {
                 let a = *out.last().expect("out starts non-empty");
                 let d = self.deviation(&a, &b)?;
                 if d <= tolerance {
-                    worst = worst.max(d);
+                    *worst = worst.max(d);
                     out.push(b);
                     continue;
                 }
@@ -168,11 +208,11 @@ impl MachineMotion<'_> {
                     });
                 }
                 let m = self.midpoint(&a, &b)?;
-                inserted += 1;
+                *inserted += 1;
                 stack.push((b, depth + 1));
                 stack.push((m, depth + 1));
             }
         }
-        Ok((out, worst, inserted))
+        Ok(())
     }
 }

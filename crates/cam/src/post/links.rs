@@ -31,6 +31,8 @@ pub struct Station {
     pub motion: Motion,
     /// The (pass, point) of the tool path this station is, if it is one.
     pub source: Option<(usize, usize)>,
+    /// The (pass, point) this station is, approaches or leaves: where errors are reported.
+    pub place: Option<(usize, usize)>,
 }
 
 /// Smallest upward component of a tool axis that can still be retracted to the safe plane.
@@ -76,6 +78,7 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
                 axis: Vec3::z(),
                 motion: Motion::Rapid,
                 source: None,
+                place: None,
             });
         }
         out.push(Station {
@@ -83,6 +86,7 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
             axis: first.axis,
             motion: Motion::Rapid,
             source: None,
+            place: Some((p, 0)),
         });
         let mut last = first;
         out.push(Station {
@@ -90,6 +94,7 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
             axis: first.axis,
             motion: Motion::Plunge,
             source: Some((p, 0)),
+            place: Some((p, 0)),
         });
         for (i, cl) in pass.points.iter().enumerate().skip(1) {
             if (cl.tip - last.tip).norm() <= 1e-9 && (cl.axis - last.axis).norm() <= 1e-12 {
@@ -100,15 +105,18 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
                 axis: cl.axis,
                 motion: Motion::Cut,
                 source: Some((p, i)),
+                place: Some((p, i)),
             });
             last = cl;
         }
-        let up = lifted(last.tip, last.axis, safe, (p, pass.points.len() - 1))?;
+        let at = (p, pass.points.len() - 1);
+        let up = lifted(last.tip, last.axis, safe, at)?;
         out.push(Station {
             tip: up,
             axis: last.axis,
             motion: Motion::Rapid,
             source: None,
+            place: Some(at),
         });
     }
     if let Some(end) = out.last().copied() {
@@ -117,6 +125,7 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
             axis: Vec3::z(),
             motion: Motion::Rapid,
             source: None,
+            place: None,
         });
     }
     Ok(out)

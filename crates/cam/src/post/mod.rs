@@ -252,7 +252,7 @@ pub fn post(
     let angles = orienter
         .choose(&axes, home)
         .map_err(|e| PostError::Kinematics {
-            at: stations[e.index].source,
+            at: stations[e.index].place,
             error: e.error,
         })?;
     let mut points = Vec::with_capacity(stations.len());
@@ -261,7 +261,7 @@ pub fn post(
         let joints = motion
             .joints(&s.tip, *a, &previous)
             .map_err(|e| PostError::Kinematics {
-                at: s.source,
+                at: s.place,
                 error: e,
             })?;
         previous = joints;

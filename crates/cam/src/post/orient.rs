@@ -194,8 +194,10 @@ impl Orienter {
             tilt: 0.5 * (from.tilt + to.tilt),
             c: 0.5 * (from.c + to.c),
         };
+        // At the pole C is free: halfway between the neighbours' (already unwrapped) C, so
+        // that halving a turn of C made there converges.
         let cands: Vec<TableAngles> = if self.at_pole(k) {
-            vec![self.keeping_c(k, from.c)]
+            vec![self.keeping_c(k, mid.c)]
         } else {
             self.solutions(k).to_vec()
         };

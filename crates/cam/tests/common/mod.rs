@@ -74,11 +74,30 @@ pub fn ball_at(surface: &NurbsSurface, r: f64, u: f64, v: f64, lead: f64) -> Cut
 /// Zig-zag passes along v at `passes` evenly spaced u values over [0, 1], `steps` segments
 /// per pass.
 pub fn zigzag(surface: &NurbsSurface, r: f64, passes: usize, steps: usize, lead: f64) -> ToolPath {
+    zigzag_along(surface, r, passes, steps, lead, false)
+}
+
+/// As [`zigzag`], the passes along u (at evenly spaced v) when `along_u`.
+pub fn zigzag_along(
+    surface: &NurbsSurface,
+    r: f64,
+    passes: usize,
+    steps: usize,
+    lead: f64,
+    along_u: bool,
+) -> ToolPath {
     let mut out = Vec::new();
     for i in 0..passes {
-        let u = i as f64 / (passes - 1) as f64;
+        let a = i as f64 / (passes - 1) as f64;
         let mut points: Vec<CutterLocation> = (0..=steps)
-            .map(|j| ball_at(surface, r, u, j as f64 / steps as f64, lead))
+            .map(|j| {
+                let b = j as f64 / steps as f64;
+                if along_u {
+                    ball_at(surface, r, b, a, lead)
+                } else {
+                    ball_at(surface, r, a, b, lead)
+                }
+            })
             .collect();
         if i % 2 == 1 {
             points.reverse();
