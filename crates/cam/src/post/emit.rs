@@ -58,6 +58,11 @@ fn words(p: &PostedPoint, motion: &MachineMotion<'_>, letters: [char; 2]) -> Str
     )
 }
 
+/// A comment line; parentheses inside would nest (an error in LinuxCNC's dialect).
+fn comment(out: &mut String, text: &str) {
+    let _ = writeln!(out, "({})", text.replace(['(', ')'], " "));
+}
+
 /// The whole program.
 pub fn program(
     points: &[PostedPoint],
@@ -69,22 +74,24 @@ pub fn program(
     let mut out = String::new();
     let tool = options.tool_number;
     let form = match motion.form {
-        OutputForm::CentrePoint => "tool-centre-point (G43.4): X Y Z = tip on the part",
-        OutputForm::Joints => "joints (G43): X Y Z = tip in machine coordinates",
+        OutputForm::CentrePoint => "tool-centre-point output, G43.4: X Y Z = tip on the part",
+        OutputForm::Joints => "joint output, G43: X Y Z = tip in machine coordinates",
     };
-    let _ = writeln!(
-        out,
-        "(tezgah cam{}{})",
-        if options.title.is_empty() { "" } else { ": " },
-        options.title.replace(['(', ')'], "")
-    );
-    let _ = writeln!(out, "({form}, {}{} table angles)", letters[0], letters[1]);
-    let _ = writeln!(
-        out,
-        "(feed {} mm/min, linearisation tolerance {} mm, safe plane Z{} on the part)",
-        number(options.feed_mm_per_min),
-        options.tolerance_mm,
-        number(safe)
+    let title = if options.title.is_empty() {
+        "tezgah cam".to_owned()
+    } else {
+        format!("tezgah cam: {}", options.title)
+    };
+    comment(&mut out, &title);
+    comment(&mut out, &format!("{form}, {}{} table angles", letters[0], letters[1]));
+    comment(
+        &mut out,
+        &format!(
+            "feed {} mm/min, linearisation tolerance {} mm, safe plane Z{} on the part",
+            number(options.feed_mm_per_min),
+            options.tolerance_mm,
+            number(safe)
+        ),
     );
     let _ = writeln!(out, "G21 G17 G90 G40 G94 G64");
     let _ = writeln!(out, "T{tool} M6");
