@@ -42,7 +42,10 @@ fn machine_pose(
     let tool = Tool::with_length(TOOL_LENGTH);
     match form {
         OutputForm::Joints => {
-            let p = machine.kinematics.forward(&a.joints.lerp(&b.joints, t), &tool).unwrap();
+            let p = machine
+                .kinematics
+                .forward(&a.joints.lerp(&b.joints, t), &tool)
+                .unwrap();
             (p.tip, p.axis.into_inner())
         }
         OutputForm::CentrePoint => {
@@ -68,7 +71,10 @@ fn check_posted(machine: &Machine, path: &ToolPath, posted: &Posted, form: Outpu
         assert!(reach * pose.axis.angle(&p.axis) <= 0.5 * tolerance + 1e-12);
     }
     // Every cutter location of the path is an output point, in order.
-    let mut it = posted.points.iter().filter(|p| !p.inserted && p.source.is_some());
+    let mut it = posted
+        .points
+        .iter()
+        .filter(|p| !p.inserted && p.source.is_some());
     for (i, pass) in path.passes.iter().enumerate() {
         for (j, cl) in pass.points.iter().enumerate() {
             let p = it.next().unwrap();
@@ -116,7 +122,10 @@ fn tcp_output_on_table_ac_reproduces_the_path() {
             .windows(2)
             .map(|w| (w[1].angles.c - w[0].angles.c).abs())
             .sum();
-        assert!(c_travel <= std::f64::consts::FRAC_PI_2 + 1e-9, "C travels {c_travel}");
+        assert!(
+            c_travel <= std::f64::consts::FRAC_PI_2 + 1e-9,
+            "C travels {c_travel}"
+        );
         assert!(posted.points.iter().any(|p| p.angles.tilt < -0.1));
         assert!(posted.points.iter().any(|p| p.angles.tilt > 0.1));
         // Lengths: the cutting length is the path's.
@@ -155,7 +164,13 @@ fn joint_output_inserts_points_and_maps_back_through_the_gcode() {
                 .unwrap()
         };
         let q = machine
-            .from_file_units(&[word('X'), word('Y'), word('Z') + TOOL_LENGTH, word('A'), word('C')])
+            .from_file_units(&[
+                word('X'),
+                word('Y'),
+                word('Z') + TOOL_LENGTH,
+                word('A'),
+                word('C'),
+            ])
             .unwrap();
         let tip = machine.kinematics.forward(&q, &tool).unwrap().tip;
         assert!((tip - p.tip).norm() < 2e-4, "{line}: {tip} vs {}", p.tip);
@@ -188,19 +203,31 @@ fn unreachable_and_unsupported_are_errors() {
     let path = cylinder_path(false);
     let o = options(OutputForm::CentrePoint, FeedOutput::PerMinute);
     match post(&path, &narrow, &o) {
-        Err(PostError::Kinematics { at: Some((0, 0)), error }) => {
+        Err(PostError::Kinematics {
+            at: Some((0, 0)),
+            error,
+        }) => {
             assert!(error.to_string().contains('a'), "{error}")
         }
         other => panic!("{other:?}"),
     }
     let mill = Machine::builtin("mill3").unwrap();
     assert!(matches!(mill.kinematics, Model::Cartesian(_)));
-    assert!(matches!(post(&path, &mill, &o), Err(PostError::Machine("cartesian"))));
+    assert!(matches!(
+        post(&path, &mill, &o),
+        Err(PostError::Machine("cartesian"))
+    ));
     let mut bad = path.clone();
     bad.passes[1].points[3].axis = nalgebra::Vector3::zeros();
-    assert!(matches!(post(&bad, &Machine::builtin("table-ac").unwrap(), &o), Err(PostError::BadLocation { pass: 1, point: 3 })));
+    assert!(matches!(
+        post(&bad, &Machine::builtin("table-ac").unwrap(), &o),
+        Err(PostError::BadLocation { pass: 1, point: 3 })
+    ));
     for (feed, tol) in [(0.0, 0.01), (1000.0, f64::NAN)] {
         let o = PostOptions::new(feed, tol);
-        assert!(matches!(post(&path, &Machine::builtin("table-ac").unwrap(), &o), Err(PostError::Option { .. })));
+        assert!(matches!(
+            post(&path, &Machine::builtin("table-ac").unwrap(), &o),
+            Err(PostError::Option { .. })
+        ));
     }
 }

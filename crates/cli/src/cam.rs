@@ -142,9 +142,12 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
     let json = report_json(&args, &machine, &path, &done, scallop);
     if let Some(p) = &args.report {
-        std::fs::write(p, serde_json::to_string_pretty(&json).into_diagnostic()? + "\n")
-            .into_diagnostic()
-            .wrap_err_with(|| format!("cannot write {}", p.display()))?;
+        std::fs::write(
+            p,
+            serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
+        )
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", p.display()))?;
     }
     summary(&args, &done, scallop, tolerance);
     Ok(if done.verified(scallop, tolerance) {
@@ -183,7 +186,9 @@ impl Finished {
     /// within its stated bound).
     pub fn verified(&self, scallop: f64, tolerance: f64) -> bool {
         let v = &self.verification;
-        v.gouge_depth_mm <= tolerance && v.max_scallop_mm - v.sweep_bound_mm <= scallop && v.uncut == 0
+        v.gouge_depth_mm <= tolerance
+            && v.max_scallop_mm - v.sweep_bound_mm <= scallop
+            && v.uncut == 0
     }
 }
 
@@ -313,8 +318,14 @@ mod tests {
             Vec3::new(w, 0.0, 0.0),
             Vec3::new(w, h, 0.0),
         ];
-        let s = NurbsSurface::bspline(1, 1, &pts, vec![0.0, 0.0, 1.0, 1.0], vec![0.0, 0.0, 1.0, 1.0])
-            .unwrap();
+        let s = NurbsSurface::bspline(
+            1,
+            1,
+            &pts,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 1.0, 1.0],
+        )
+        .unwrap();
         let r = 1.5;
         let lead = 10f64.to_radians();
         let n = (w / step).round() as usize;
@@ -358,10 +369,16 @@ mod tests {
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.
         let h = 1.5 - (2.25_f64 - 0.25).sqrt();
-        assert!(v.max_scallop_mm <= h + v.sweep_bound_mm && v.max_scallop_mm >= h - v.grid_bound_mm, "{v:?}");
+        assert!(
+            v.max_scallop_mm <= h + v.sweep_bound_mm && v.max_scallop_mm >= h - v.grid_bound_mm,
+            "{v:?}"
+        );
         assert!(v.gouge_depth_mm < 1e-6, "{v:?}");
         assert!(done.verified(h + 0.01, 0.01));
-        assert!(!done.verified(0.5 * h, 0.01), "a scallop above the target fails");
+        assert!(
+            !done.verified(0.5 * h, 0.01),
+            "a scallop above the target fails"
+        );
         assert!((done.posted.stats.cutting_length_mm - path.cutting_length()).abs() < 1e-9);
     }
 }

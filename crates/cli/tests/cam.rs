@@ -39,8 +39,15 @@ fn cylinder_job() -> ToolPath {
             ws.push(if k == 1 { half.cos() } else { 1.0 });
         }
     }
-    let s = NurbsSurface::new(2, 1, &pts, &ws, vec![0., 0., 0., 1., 1., 1.], vec![0., 0., 1., 1.])
-        .unwrap();
+    let s = NurbsSurface::new(
+        2,
+        1,
+        &pts,
+        &ws,
+        vec![0., 0., 0., 1., 1., 1.],
+        vec![0., 0., 1., 1.],
+    )
+    .unwrap();
     let passes = (0..5)
         .map(|i| {
             let v = i as f64 / 4.0;
@@ -74,7 +81,12 @@ fn cylinder_job() -> ToolPath {
 fn check_and_run(program: &str, name: &str) -> serde_json::Value {
     let ngc = tmp(&format!("{name}.ngc"));
     std::fs::write(&ngc, program).unwrap();
-    let out = tezgah().arg("check").arg(&ngc).args(["--tool-table", TOOLS]).output().unwrap();
+    let out = tezgah()
+        .arg("check")
+        .arg(&ngc)
+        .args(["--tool-table", TOOLS])
+        .output()
+        .unwrap();
     assert!(
         out.status.success(),
         "check: {}{}\n{program}",
@@ -104,10 +116,17 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
             ("peak_jerk", "max_jerk"),
         ] {
             let (p, l) = (j[peak].as_f64().unwrap(), j[limit].as_f64().unwrap());
-            assert!(p <= 1.005 * l, "{name} {}: {peak} {p} > {limit} {l}", j["name"]);
+            assert!(
+                p <= 1.005 * l,
+                "{name} {}: {peak} {p} > {limit} {l}",
+                j["name"]
+            );
         }
     }
-    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01, "{report}");
+    assert!(
+        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{report}"
+    );
     report
 }
 
@@ -133,7 +152,11 @@ fn posted_programs_pass_check_and_run_on_table_ac() {
         let a = &report["joints"][3];
         assert!(a["peak_velocity"].as_f64().unwrap() > 1.0, "{name}: {a}");
         let duration = report["duration_s"].as_f64().unwrap();
-        assert!(duration >= posted.stats.feed_time_s * 0.999, "{name}: {duration} < {:?}", posted.stats);
+        assert!(
+            duration >= posted.stats.feed_time_s * 0.999,
+            "{name}: {duration} < {:?}",
+            posted.stats
+        );
     }
 }
 
@@ -153,10 +176,22 @@ fn cam_refuses_bad_options_without_a_panic() {
             .unwrap();
         assert!(!out.status.success());
         let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!err.contains("panicked") && (err.contains("tool") || err.contains("strategy")), "{err}");
+        assert!(
+            !err.contains("panicked") && (err.contains("tool") || err.contains("strategy")),
+            "{err}"
+        );
     }
     let out = tezgah()
-        .args(["cam", "s.stp", "--tool", "ball:3", "--strategy", "zigzag", "--scallop", "-1"])
+        .args([
+            "cam",
+            "s.stp",
+            "--tool",
+            "ball:3",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "-1",
+        ])
         .args(["--tolerance", "0.01", "-o"])
         .arg(&out_ngc)
         .output()

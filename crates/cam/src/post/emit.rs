@@ -83,7 +83,10 @@ pub fn program(
         format!("tezgah cam: {}", options.title)
     };
     comment(&mut out, &title);
-    comment(&mut out, &format!("{form}, {}{} table angles", letters[0], letters[1]));
+    comment(
+        &mut out,
+        &format!("{form}, {}{} table angles", letters[0], letters[1]),
+    );
     comment(
         &mut out,
         &format!(

@@ -156,12 +156,12 @@ impl MachineMotion<'_> {
             let a = *out.last().expect("out starts non-empty");
             if self.orienter.at_pole(&a.axis) && (next.angles.c - a.angles.c).abs() > 1e-12 {
                 let angles = self.orienter.keeping_c(&a.axis, next.angles.c);
-                let joints = self
-                    .joints(&a.tip, angles, &a.joints)
-                    .map_err(|e| PostError::Kinematics {
-                        at: next.source,
-                        error: e,
-                    })?;
+                let joints =
+                    self.joints(&a.tip, angles, &a.joints)
+                        .map_err(|e| PostError::Kinematics {
+                            at: next.source,
+                            error: e,
+                        })?;
                 let turn = PostedPoint {
                     angles,
                     joints,
@@ -171,9 +171,23 @@ impl MachineMotion<'_> {
                     ..a
                 };
                 inserted += 1;
-                self.halve_into(&mut out, turn, tolerance, max_halvings, &mut worst, &mut inserted)?;
+                self.halve_into(
+                    &mut out,
+                    turn,
+                    tolerance,
+                    max_halvings,
+                    &mut worst,
+                    &mut inserted,
+                )?;
             }
-            self.halve_into(&mut out, next, tolerance, max_halvings, &mut worst, &mut inserted)?;
+            self.halve_into(
+                &mut out,
+                next,
+                tolerance,
+                max_halvings,
+                &mut worst,
+                &mut inserted,
+            )?;
         }
         Ok((out, worst, inserted))
     }

@@ -322,4 +322,95 @@ mod tests {
         assert_eq!(err.index, 1);
         assert!(err.error.to_string().contains('a'), "{}", err.error);
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+        use tezgah_kinematics::trunnion::Trunnion;
+        use tezgah_kinematics::{Joints, Kinematics, Tolerances, Tool, ToolPose};
+
+        /// A smooth random walk of tool axes within 80° of the C axis.
+        fn walk(start: (f64, f64), steps: &[(f64, f64)]) -> Vec<Vec3> {
+            let (mut t, mut c) = start;
+            steps
+                .iter()
+                .map(|(dt, dc)| {
+                    t = (t + dt).clamp(-1.4, 1.4);
+                    c += dc;
+                    table_ac::axis(t, c)
+                })
+                .collect()
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(200))]
+
+            /// Every chosen pair reproduces its axis, stays in the tilt limits, C moves
+            /// continuously, and the whole-path choice never travels more than the per-point
+            /// nearest choice of the kinematics crate.
+            #[test]
+            fn chosen_angles_reproduce_axes_and_beat_greedy(
+                start in (-1.0f64..1.0, -3.0f64..3.0),
+                steps in proptest::collection::vec((-0.08f64..0.08, -0.3f64..0.3), 2..60),
+                lo in -100.0f64..0.0,
+            ) {
+                let o = ac(lo, 120.0);
+                let axes = walk(start, &steps);
+                let got = match o.choose(&axes, ZERO) {
+                    Ok(g) => g,
+                    // Only a tilt beyond the limits may refuse.
+                    Err(e) => {
+                        let k = axes[e.index];
+                        let need = k.x.hypot(k.y).atan2(k.z);
+                        prop_assert!(need > 120f64.to_radians() && need > -lo.to_radians());
+                        return Ok(());
+                    }
+                };
+                let mut last = ZERO;
+                for (a, k) in got.iter().zip(&axes) {
+                    prop_assert!((o.axis(*a) - k).norm() < 1e-6);
+                    prop_assert!(o.tilt_limit.contains(a.tilt));
+                    prop_assert!((a.c - last.c).abs() <= PI + 1e-9);
+                    last = *a;
+                }
+                let travel = |v: &[(f64, f64)]| -> f64 {
+                    let mut prev = (0.0, 0.0);
+                    let mut sum = 0.0;
+                    for &(t, c) in v {
+                        sum += (t - prev.0).abs() + (c - prev.1).abs();
+                        prev = (t, c);
+                    }
+                    sum
+                };
+                let limits = vec![
+                    JointLimit::unlimited("x", tezgah_kinematics::JointKind::Linear),
+                    JointLimit::unlimited("y", tezgah_kinematics::JointKind::Linear),
+                    JointLimit::unlimited("z", tezgah_kinematics::JointKind::Linear),
+                    o.tilt_limit.clone(),
+                    o.c_limit.clone(),
+                ];
+                let greedy_model = Trunnion::new(
+                    TiltAxis::X,
+                    nalgebra::Vector3::zeros(),
+                    nalgebra::Vector3::zeros(),
+                    limits,
+                    Tolerances::default(),
+                )
+                .unwrap();
+                let mut q = Joints::zeros(5);
+                let mut greedy = Vec::new();
+                for k in &axes {
+                    match greedy_model.inverse(&ToolPose::new(nalgebra::Vector3::zeros(), *k), &Tool::default(), &q) {
+                        Ok(next) => {
+                            q = next;
+                            greedy.push((q[3], q[4]));
+                        }
+                        Err(_) => return Ok(()),
+                    }
+                }
+                let ours: Vec<(f64, f64)> = got.iter().map(|a| (a.tilt, a.c)).collect();
+                prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+            }
+        }
+    }
 }
