@@ -54,7 +54,7 @@ fn ball_on_a_plane_leaves_the_closed_form_scallop() {
     assert!(v.gouge_depth_mm < 1e-9, "no gouge: {}", v.gouge_depth_mm);
     // The bounds are small against the scallop itself.
     assert!(
-        v.grid_bound_mm < 0.2 * h && v.sweep_bound_mm < 0.01 * h,
+        v.grid_bound_mm < 0.2 * h && v.sweep_bound_mm < 0.02 * h,
         "{v:?}"
     );
 }
@@ -88,6 +88,14 @@ fn ball_on_a_convex_cylinder() {
         .windows(2)
         .map(|w| (angle(&w[1]) - angle(&w[0])).abs())
         .fold(0.0, f64::max);
+    eprintln!(
+        "gaps {:?} at {:?}",
+        path.passes
+            .windows(2)
+            .map(|w| (angle(&w[1]) - angle(&w[0])).to_degrees())
+            .collect::<Vec<_>>(),
+        v.max_scallop_at
+    );
     let (c, s) = ((gap / 2.0).cos(), (gap / 2.0).sin());
     let h = (rho + r) * c - (r * r - (rho + r).powi(2) * s * s).sqrt() - rho;
     assert!(h > 0.01, "{h}");

@@ -11,13 +11,18 @@
 //!
 //! Error bounds (both one-sided, DESIGN.md asks that they be stated):
 //! * sweep: the cutter is placed at discrete poses no point of it moving more than `δ`
-//!   between two; the material left between two placements of a convex body whose surface
-//!   curves with radius ≥ ρ is at most `δ²/(8ρ)` deep (the sagitta), ρ the corner radius (the
-//!   tool radius for a flat end). Heights are over-estimated by at most that.
+//!   between two; the material left between two placements is at most the sagitta of the
+//!   cutter's section where the dexel meets it: at a scallop of height h that section of the
+//!   corner (radius ρ: the corner radius, the tool radius for a flat end) is a circle of radius
+//!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`.
 //! * grid: the highest scallop is sampled at a node at most `c/√2` from it (c the largest
 //!   node spacing); the scallop's flank rises with slope at most `tan φ`, `cos φ = 1 − h/ρ`
 //!   (the cutter's profile meeting the surface at the height h), so the sampled maximum is
 //!   below the true one by at most `tan φ · c/√2`. The same bound covers a gouge's depth.
+//!   Every node within that bound of the maximum then gets a lattice twice as fine around it;
+//!   when all fit under the cap the bound is halved (the true maximum lies within half a cell
+//!   of a sub-node), otherwise the highest are refined and the coarse bound stands.
+//!
 
 pub mod solid;
 
@@ -78,6 +83,8 @@ pub const MAX_DEXELS: usize = 8_000_000;
 const SPEED_SAMPLES: usize = 33;
 
 struct Dexel {
+    /// Grid node (i along u, j along v); sub-nodes of the refinement carry their parent's.
+    node: (usize, usize),
     foot: Vec3,
     normal: Vec3,
     uv: (f64, f64),
@@ -257,6 +264,7 @@ pub fn simulate(
                 n.into_inner()
             };
             dexels.push(Dexel {
+                node: (i, j),
                 foot: surface.point(u, v),
                 normal: n,
                 uv: (u, v),
@@ -264,32 +272,13 @@ pub fn simulate(
             });
         }
     }
-    let solid = CutterSolid::of(&path.cutter);
-    let grid = Buckets::new(&dexels, r.max(4.0 * cell));
-    let reach_out = up.max(depth);
-    for pose in poses {
-        let axis = pose.axis;
-        // The solid lies within R of its axis segment from the corner's centre to the top.
-        let (s0, s1) = (
-            pose.tip + axis * solid.corner,
-            pose.tip + axis * solid.core_top,
-        );
-        let grow = r + reach_out;
-        let lo = s0.inf(&s1).add_scalar(-grow);
-        let hi = s0.sup(&s1).add_scalar(grow);
-        grid.visit(&lo, &hi, |k| {
-            let d = &mut dexels[k];
-            let (a, b) = (d.foot - d.normal * depth, d.foot + d.normal * d.height);
-            if segment_distance(&a, &b, &s0, &s1) > r {
-                return;
-            }
-            if let Some(t) = solid.entry(pose, &d.foot, &d.normal, -depth, d.height) {
-                if t < d.height {
-                    d.height = t;
-                }
-            }
-        });
-    }
+    let sweeper = Sweeper {
+        solid: CutterSolid::of(&path.cutter),
+        radius: r,
+        depth,
+        bucket: r.max(4.0 * cell),
+    };
+    sweeper.run(&mut dexels, poses);
     let mut out = Verification {
         dexels: dexels.len(),
         cell_mm: achieved,
@@ -302,10 +291,111 @@ pub fn simulate(
         grid_bound_mm: 0.0,
         sweep_bound_mm: 0.0,
     };
-    for d in &dexels {
+    out.uncut = dexels.iter().filter(|d| d.height >= up).count();
+    measure(&dexels, up, &mut out);
+    let solid = sweeper.solid;
+    let rho = if solid.corner > 0.0 { solid.corner } else { r };
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    let coarse = grid_bound(&out, rho, achieved);
+
+    // Refinement: every node that may stand next to the true maximum (its height within the
+    // grid bound of the measured one, likewise for the gouge) gets a 9×9 sub-grid over its
+    // neighbouring cells. If they all fit under the cap, the true extremes lie within a
+    // quarter cell of a sub-node and the bound shrinks fourfold; otherwise the highest ones are
+    // refined and the coarse bound stands.
+    let mut scallops: Vec<usize> = (0..dexels.len())
+        .filter(|&k| dexels[k].height < up && dexels[k].height >= out.max_scallop_mm - coarse)
+        .collect();
+    let mut gouges: Vec<usize> = (0..dexels.len())
+        .filter(|&k| dexels[k].height < 0.0 && -dexels[k].height >= out.gouge_depth_mm - coarse)
+        .collect();
+    let complete = scallops.len() + gouges.len() <= REFINE_CAP;
+    scallops.sort_by(|&a, &b| dexels[b].height.total_cmp(&dexels[a].height));
+    gouges.sort_by(|&a, &b| dexels[a].height.total_cmp(&dexels[b].height));
+    scallops.truncate(REFINE_CAP / 2);
+    gouges.truncate(REFINE_CAP / 2);
+    // Sub-nodes on the lattice REFINE times finer than the grid, shared between neighbouring
+    // candidates (a ridge of candidates costs a strip, not a box each).
+    let f = REFINE as i64;
+    let mut lattice = std::collections::HashSet::new();
+    let mut fine: Vec<Dexel> = Vec::new();
+    for &k in scallops.iter().chain(&gouges) {
+        let (i, j) = dexels[k].node;
+        for di in -f..=f {
+            for dj in -f..=f {
+                let (fi, fj) = (f * i as i64 + di, f * j as i64 + dj);
+                if fi < 0 || fj < 0 || fi > f * (nu as i64 - 1) || fj > f * (nv as i64 - 1) {
+                    continue;
+                }
+                if !lattice.insert((fi, fj)) {
+                    continue;
+                }
+                let uu = if nu > 1 {
+                    u0 + (u1 - u0) * fi as f64 / (f * (nu as i64 - 1)) as f64
+                } else {
+                    u0
+                };
+                let vv = if nv > 1 {
+                    v0 + (v1 - v0) * fj as f64 / (f * (nv as i64 - 1)) as f64
+                } else {
+                    v0
+                };
+                let Some(n) = surface.normal(uu, vv) else {
+                    continue;
+                };
+                let n = if flip {
+                    -n.into_inner()
+                } else {
+                    n.into_inner()
+                };
+                fine.push(Dexel {
+                    node: (i, j),
+                    foot: surface.point(uu, vv),
+                    normal: n,
+                    uv: (uu, vv),
+                    height: up,
+                });
+            }
+        }
+    }
+    if !fine.is_empty() {
+        sweeper.run(&mut fine, poses);
+        measure(&fine, up, &mut out);
+    }
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    out.grid_bound_mm = if complete {
+        grid_bound(&out, rho, achieved / REFINE as f64)
+    } else {
+        grid_bound(&out, rho, achieved)
+    };
+    Ok(out)
+}
+
+/// Candidate nodes refined at most (each adds up to (2·REFINE + 1)² sub-dexels, fewer where
+/// neighbours share them).
+const REFINE_CAP: usize = 4096;
+
+/// The refinement lattice is this many times finer than the grid.
+const REFINE: usize = 2;
+
+/// `δ²/(8(ρ − h))`: the sagitta between two placements δ apart of the cutter's section at
+/// the height h of the highest scallop, a circle of radius at least ρ − h (ρ when h ≥ ρ would
+/// make it meaningless: then ρ itself, the whole corner, is the bound).
+fn sweep_bound(spacing: f64, rho: f64, h: f64) -> f64 {
+    if h < rho {
+        (spacing * spacing / (8.0 * (rho - h))).min(rho)
+    } else {
+        rho
+    }
+}
+
+/// Raises the result's scallop and gouge to what `dexels` show.
+fn measure(dexels: &[Dexel], up: f64, out: &mut Verification) {
+    for d in dexels {
         if d.height >= up {
-            out.uncut += 1;
-        } else if d.height > out.max_scallop_mm {
+            continue;
+        }
+        if d.height > out.max_scallop_mm {
             out.max_scallop_mm = d.height;
             out.max_scallop_at = Some((d.uv, d.foot));
         } else if -d.height > out.gouge_depth_mm {
@@ -313,8 +403,11 @@ pub fn simulate(
             out.gouge_at = Some((d.uv, d.foot));
         }
     }
-    let rho = if solid.corner > 0.0 { solid.corner } else { r };
-    out.sweep_bound_mm = spacing * spacing / (8.0 * rho);
+}
+
+/// `tan φ · c/√2` with `cos φ = 1 − (h + e)/ρ`, solved for e by a few fixed-point rounds
+/// (h the larger of scallop and gouge; the flank's slope grows with the height it reaches).
+fn grid_bound(out: &Verification, rho: f64, cell: f64) -> f64 {
     let worst = out.max_scallop_mm.max(out.gouge_depth_mm);
     let mut e = 0.0;
     for _ in 0..3 {
@@ -324,10 +417,49 @@ pub fn simulate(
         } else {
             f64::INFINITY
         };
-        e = (slope * achieved / std::f64::consts::SQRT_2).min(rho);
+        e = (slope * cell / std::f64::consts::SQRT_2).min(rho);
     }
-    out.grid_bound_mm = e;
-    Ok(out)
+    e
+}
+
+/// Lowers dexels to where they enter the cutter at each pose.
+struct Sweeper {
+    solid: CutterSolid,
+    radius: f64,
+    depth: f64,
+    bucket: f64,
+}
+
+impl Sweeper {
+    fn run(&self, dexels: &mut [Dexel], poses: &[CutterPose]) {
+        let grid = Buckets::new(dexels, self.bucket);
+        let (r, depth, solid) = (self.radius, self.depth, &self.solid);
+        // Dexels reach at most this far from their feet.
+        let reach_out = dexels.iter().map(|d| d.height).fold(depth, f64::max);
+        for pose in poses {
+            let axis = pose.axis;
+            // The solid lies within R of its axis segment from the corner's centre to the top.
+            let (s0, s1) = (
+                pose.tip + axis * solid.corner,
+                pose.tip + axis * solid.core_top,
+            );
+            let grow = r + reach_out;
+            let lo = s0.inf(&s1).add_scalar(-grow);
+            let hi = s0.sup(&s1).add_scalar(grow);
+            grid.visit(&lo, &hi, |k| {
+                let d = &mut dexels[k];
+                let (a, b) = (d.foot - d.normal * depth, d.foot + d.normal * d.height);
+                if segment_distance(&a, &b, &s0, &s1) > r {
+                    return;
+                }
+                if let Some(t) = solid.entry(pose, &d.foot, &d.normal, -depth, d.height) {
+                    if t < d.height {
+                        d.height = t;
+                    }
+                }
+            });
+        }
+    }
 }
 
 /// Distance between the segments p0–p1 and q0–q1 (Ericson, *Real-Time Collision Detection*,
