@@ -101,6 +101,12 @@ fn check_posted(machine: &Machine, path: &ToolPath, posted: &Posted, form: Outpu
             worst = worst.max(d + reach * axis.angle(&ideal));
         }
     }
+    eprintln!(
+        "{form:?}: {} points, {} inserted, post's worst {:.5} mm, dense worst {worst:.5} mm",
+        posted.points.len(),
+        posted.stats.inserted,
+        posted.stats.max_linearisation_mm
+    );
     assert!(worst <= tolerance * 1.02, "dense deviation {worst}");
     worst
 }
@@ -230,4 +236,51 @@ fn unreachable_and_unsupported_are_errors() {
             Err(PostError::Option { .. })
         ));
     }
+}
+
+#[test]
+fn tcp_output_inserts_points_where_c_turns() {
+    // A ring under a tool tilted 30° that turns with it (C steps of 30°): under TCP the table
+    // angles move linearly, so the axis runs on a small circle instead of the great circle
+    // between the two axes — 0.02 mm at the reach of a D = 3 ball, over the tolerance.
+    let machine = Machine::builtin("table-ac").unwrap();
+    let tilt = 30f64.to_radians();
+    let points = (0..=12)
+        .map(|k| {
+            let c = (k as f64 * 30.0).to_radians();
+            let axis = tezgah_kinematics::table_ac::axis(tilt, c);
+            let tip = nalgebra::Vector3::new(10.0 * c.cos(), 10.0 * c.sin(), 0.0);
+            tezgah_cam::CutterLocation {
+                tip,
+                axis,
+                contact: tip,
+                normal: axis,
+                uv: (0.0, c),
+            }
+        })
+        .collect();
+    let path = ToolPath {
+        cutter: tezgah_cam::Cutter::standard(tezgah_cam::CutterShape::Ball { radius: 1.5 }),
+        passes: vec![tezgah_cam::Pass { points }],
+    };
+    let posted = post(
+        &path,
+        &machine,
+        &options(OutputForm::CentrePoint, FeedOutput::PerMinute),
+    )
+    .unwrap();
+    assert!(posted.stats.inserted >= 12, "{:?}", posted.stats);
+    check_posted(&machine, &path, &posted, OutputForm::CentrePoint);
+    // C runs continuously through a whole turn.
+    let last = posted
+        .points
+        .iter()
+        .rev()
+        .find(|p| p.source.is_some())
+        .unwrap();
+    assert!(
+        (last.angles.c.to_degrees() - 360.0).abs() < 1e-9,
+        "{}",
+        last.angles.c.to_degrees()
+    );
 }
