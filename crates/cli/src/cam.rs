@@ -38,17 +38,31 @@ pub struct PlanRequest<'a> {
     pub strategy: &'a str,
     pub scallop_mm: f64,
     pub tolerance_mm: f64,
-    pub lead_rad: f64,
-    pub tilt_rad: f64,
+    pub lead_deg: f64,
+    pub tilt_deg: f64,
 }
 
 /// The surface of a STEP file and the tool path the strategy plans on it.
 ///
-/// TODO(lead, at merge): connect STEP import and the strategies here —
-/// `let surface = tezgah_cam::step::read(path)?;` then
-/// `let path = tezgah_cam::strategy::plan(&surface, cutter, request)?;` (their branches own
-/// those modules). Everything after this call (post, verification, files) is complete and
-/// tested end to end from tool paths built in the tests.
+/// TODO(lead, at merge): connect STEP import (branch `step`) and the strategies (branch
+/// `strategy`) here. With the APIs on those branches today this is:
+///
+/// ```text
+/// let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
+/// let face = model.faces.first().ok_or_else(|| miette!("{}: no face", path.display()))?;
+/// let kind = request.strategy.parse::<tezgah_cam::StrategyKind>().map_err(|e| miette!("{e}"))?;
+/// let mut settings = tezgah_cam::Settings::new(kind, request.scallop_mm, request.tolerance_mm);
+/// if let tezgah_cam::ToolAxis::Surface { lead_deg, tilt_deg, .. } = &mut settings.axis {
+///     (*lead_deg, *tilt_deg) = (request.lead_deg, request.tilt_deg);
+/// }
+/// settings.reverse_normal = !face.same_sense;
+/// let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
+/// // plan.refused lists gouging points the strategy could not correct: print them.
+/// Ok((face.surface.clone(), plan.path))
+/// ```
+///
+/// Everything after this call (post, verification, files) is complete and tested end to end
+/// from tool paths built in the tests.
 fn plan_surface(
     path: &Path,
     _cutter: Cutter,
@@ -109,8 +123,8 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         strategy: &args.strategy,
         scallop_mm: scallop,
         tolerance_mm: tolerance,
-        lead_rad: args.lead_deg.to_radians(),
-        tilt_rad: args.tilt_deg.to_radians(),
+        lead_deg: args.lead_deg,
+        tilt_deg: args.tilt_deg,
     };
     let (surface, path) = plan_surface(&args.surface, cutter, &request)?;
     let options = PostOptions {
