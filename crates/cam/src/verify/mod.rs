@@ -76,8 +76,8 @@ pub enum VerifyError {
     TooFine(usize),
 }
 
-/// Memory guard: 8 M dexels are ~0.5 GB of grid data.
-pub const MAX_DEXELS: usize = 8_000_000;
+/// Memory guard: 4 M dexels are ~0.35 GB of grid data.
+pub const MAX_DEXELS: usize = 4_000_000;
 
 /// Surface samples per direction when estimating the largest parametric speed.
 const SPEED_SAMPLES: usize = 33;
@@ -518,7 +518,19 @@ impl Buckets {
             lo = Vec3::zeros();
             hi = Vec3::zeros();
         }
-        let dims = [0, 1, 2].map(|i| (((hi[i] - lo[i]) / size).floor() as usize + 1).min(4096));
+        // The feet lie on a surface, so most of a 3-D grid is empty: buckets grow until the
+        // grid has at most a few cells per dexel (a part far larger than the tool would
+        // otherwise ask for billions of cells).
+        let limit = 4 * dexels.len() + 4096;
+        let mut size = size;
+        let mut dims = [1usize; 3];
+        for _ in 0..200 {
+            dims = [0, 1, 2].map(|i| ((hi[i] - lo[i]) / size).floor().clamp(0.0, 1e6) as usize + 1);
+            if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= limit {
+                break;
+            }
+            size *= 1.5;
+        }
         let cells = dims[0] * dims[1] * dims[2];
         let index = |p: &Vec3| -> usize {
             let c = [0, 1, 2]
@@ -572,5 +584,66 @@ impl Buckets {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dexel(foot: Vec3) -> Dexel {
+        Dexel {
+            node: (0, 0),
+            foot,
+            normal: Vec3::z(),
+            uv: (0.0, 0.0),
+            height: 1.0,
+        }
+    }
+
+    #[test]
+    fn buckets_stay_small_on_a_huge_sparse_part_and_find_their_dexels() {
+        // Two feet a kilometre apart with 1 mm buckets: 10¹⁸ cells if the grid did not grow.
+        let dexels = [dexel(Vec3::zeros()), dexel(Vec3::new(1e6, 1e6, 1e6))];
+        let b = Buckets::new(&dexels, 1.0);
+        assert!(b.start.len() <= 4 * 2 + 4096 + 1);
+        let mut seen = Vec::new();
+        b.visit(&Vec3::repeat(-1.0), &Vec3::repeat(1.0), |k| seen.push(k));
+        assert!(seen.contains(&0));
+        let mut all = Vec::new();
+        b.visit(&Vec3::repeat(-1.0), &Vec3::repeat(2e6), |k| all.push(k));
+        all.sort();
+        assert_eq!(all, vec![0, 1]);
+    }
+
+    #[test]
+    fn segment_distance_matches_closed_forms() {
+        let o = Vec3::zeros();
+        // Skew perpendicular lines 2 apart.
+        let d = segment_distance(
+            &o,
+            &Vec3::x(),
+            &Vec3::new(0.5, -1.0, 2.0),
+            &Vec3::new(0.5, 1.0, 2.0),
+        );
+        assert!((d - 2.0).abs() < 1e-12);
+        // Parallel, overlapping.
+        let d = segment_distance(
+            &o,
+            &Vec3::x(),
+            &Vec3::new(0.5, 3.0, 0.0),
+            &Vec3::new(2.0, 3.0, 0.0),
+        );
+        assert!((d - 3.0).abs() < 1e-12);
+        // End to end, and a point.
+        let d = segment_distance(
+            &o,
+            &Vec3::x(),
+            &Vec3::new(4.0, 4.0, 0.0),
+            &Vec3::new(5.0, 4.0, 0.0),
+        );
+        assert!((d - 5.0).abs() < 1e-12);
+        let p = Vec3::new(0.5, 0.0, 1.0);
+        assert!((segment_distance(&o, &Vec3::x(), &p, &p) - 1.0).abs() < 1e-12);
     }
 }
