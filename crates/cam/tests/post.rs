@@ -284,3 +284,47 @@ fn tcp_output_inserts_points_where_c_turns() {
         last.angles.c.to_degrees()
     );
 }
+
+#[test]
+fn the_posted_joint_program_cuts_without_gouging() {
+    // The program as the machine moves it — links, plunges, inserted points and all — swept
+    // through the dexel simulation: no gouge beyond the path's own chord sag plus the
+    // linearisation tolerance (the two add), and the scallop between passes 1.5 mm apart is
+    // the closed form's for a D = 3 ball on ρ = 20.
+    let machine = Machine::builtin("table-ac").unwrap();
+    let surface = common::cylinder(20.0, 25f64.to_radians(), 12.0);
+    let path = common::zigzag_along(&surface, 1.5, 9, 16, 0.0, true);
+    let o = options(OutputForm::Joints, FeedOutput::InverseTime);
+    let posted = post(&path, &machine, &o).unwrap();
+    let poses = posted.sweep(&machine, 0.1).unwrap();
+    let s = tezgah_cam::verify::step_over(&path).unwrap();
+    let v = tezgah_cam::verify::simulate(
+        &surface,
+        &path,
+        &poses,
+        &tezgah_cam::verify::VerifyOptions {
+            cell_mm: s / 10.0,
+            sweep_spacing_mm: 0.1,
+        },
+    )
+    .unwrap();
+    // The ball centres run on chords of the radius-21.5 circle: sag (ρ + R)(1 − cos(Δθ/2)).
+    let step = path.passes[0]
+        .points
+        .windows(2)
+        .map(|w| w[0].normal.angle(&w[1].normal))
+        .fold(0.0, f64::max);
+    let sag = 21.5 * (1.0 - (step / 2.0).cos());
+    assert!(v.gouge_depth_mm > 0.5 * sag, "the chords do cut in: {v:?}");
+    assert!(v.gouge_depth_mm <= sag + o.tolerance_mm, "sag {sag}: {v:?}");
+    // Passes along the circumference: the ridge runs around the cylinder between ball
+    // centres 1.5 mm apart along Y at radius ρ + R, so its height above the surface is the
+    // plane's R − √(R² − (s/2)²) measured along the normal.
+    let h = 1.5 - (2.25_f64 - 0.75_f64.powi(2)).sqrt();
+    assert!((s - 1.5).abs() < 1e-9, "{s}");
+    assert!(
+        v.max_scallop_mm <= h + v.sweep_bound_mm + 1e-9 && v.max_scallop_mm >= h - v.grid_bound_mm,
+        "{} vs {h}: {v:?}",
+        v.max_scallop_mm
+    );
+}

@@ -117,6 +117,16 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         ));
     }
     let machine = crate::run::load_machine(Some(args.machine.as_deref().unwrap_or("table-ac")))?;
+    if !matches!(
+        machine.kinematics,
+        tezgah_kinematics::Model::TableAc(_) | tezgah_kinematics::Model::TableBc(_)
+    ) {
+        return Err(miette!(
+            "--machine {}: the post-processor handles table-ac and table-bc machines, not {}",
+            machine.name,
+            machine.kinematics.type_name()
+        ));
+    }
     let length = tool_length(args.tool_table.as_deref(), args.tool_number)?;
     let cutter = Cutter::standard(shape);
     let request = PlanRequest {
@@ -227,9 +237,7 @@ pub fn finish(
         cell_mm: step_over / 20.0,
         sweep_spacing_mm: spacing,
     };
-    let poses = posted
-        .sweep(path, machine, options, spacing)
-        .into_diagnostic()?;
+    let poses = posted.sweep(machine, spacing).into_diagnostic()?;
     let verification =
         verify::simulate(surface, path, &poses, &verify_options).into_diagnostic()?;
     Ok(Finished {

@@ -168,6 +168,11 @@ pub struct Posted {
     pub stats: PostStats,
     /// The program's letters for the tilt and C (A C or B C).
     pub rotary_letters: [char; 2],
+    /// How the program was written, with the tool it was posted for (for [`Posted::sweep`]).
+    pub form: OutputForm,
+    pub tool: Tool,
+    /// The cutter's reach from its tip, mm ([`reach`]).
+    pub reach: f64,
 }
 
 /// The cutter's reach from its tip: `√(R² + r²)`, the farthest point of the cutting end.
@@ -291,6 +296,9 @@ pub fn post(
         program,
         stats,
         rotary_letters: letters,
+        form: options.form,
+        tool,
+        reach,
     })
 }
 
@@ -309,14 +317,8 @@ fn point(s: &Station, angles: TableAngles, joints: Joints) -> PostedPoint {
 impl Posted {
     /// The cutter's poses along the program as the machine moves it, no point of the cutting
     /// end moving more than `spacing` between consecutive poses: what the verifying
-    /// simulation sweeps. `motion` must be the one the program was posted with.
-    pub fn sweep(
-        &self,
-        path: &ToolPath,
-        machine: &Machine,
-        options: &PostOptions,
-        spacing: f64,
-    ) -> Result<Vec<CutterPose>, PostError> {
+    /// simulation sweeps. `machine` is the one the program was posted for.
+    pub fn sweep(&self, machine: &Machine, spacing: f64) -> Result<Vec<CutterPose>, PostError> {
         let spacing = positive("the sweep spacing", spacing)?;
         let model = match &machine.kinematics {
             Model::TableAc(t) | Model::TableBc(t) => t,
@@ -329,12 +331,12 @@ impl Posted {
             c_limit: limits[4].clone(),
             pole_sin: 0.0,
         };
-        let reach = reach(path);
+        let reach = self.reach;
         let motion = MachineMotion {
             model,
             orienter: &orienter,
-            tool: Tool::with_length(options.tool_length_mm),
-            form: options.form,
+            tool: self.tool,
+            form: self.form,
             reach,
         };
         let mut out = Vec::new();
