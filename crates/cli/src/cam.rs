@@ -129,10 +129,13 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     }
     let length = tool_length(args.tool_table.as_deref(), args.tool_number)?;
     let cutter = Cutter::standard(shape);
+    // One guarantee (DESIGN.md "Tolerance"): the strategy's chords and the post's
+    // linearisation each get half, so the machine's motion stays within the tolerance of the
+    // exact cutter-location path (the two add up where they meet, as on a convex surface).
     let request = PlanRequest {
         strategy: &args.strategy,
         scallop_mm: scallop,
-        tolerance_mm: tolerance,
+        tolerance_mm: 0.5 * tolerance,
         lead_deg: args.lead_deg,
         tilt_deg: args.tilt_deg,
     };
@@ -158,7 +161,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             args.strategy,
             scallop
         ),
-        ..PostOptions::new(feed, tolerance)
+        ..PostOptions::new(feed, 0.5 * tolerance)
     };
     let done = finish(&surface, &path, &machine, &options)?;
     std::fs::write(&args.output, &done.posted.program)
