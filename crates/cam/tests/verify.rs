@@ -88,14 +88,6 @@ fn ball_on_a_convex_cylinder() {
         .windows(2)
         .map(|w| (angle(&w[1]) - angle(&w[0])).abs())
         .fold(0.0, f64::max);
-    eprintln!(
-        "gaps {:?} at {:?}",
-        path.passes
-            .windows(2)
-            .map(|w| (angle(&w[1]) - angle(&w[0])).to_degrees())
-            .collect::<Vec<_>>(),
-        v.max_scallop_at
-    );
     let (c, s) = ((gap / 2.0).cos(), (gap / 2.0).sin());
     let h = (rho + r) * c - (r * r - (rho + r).powi(2) * s * s).sqrt() - rho;
     assert!(h > 0.01, "{h}");

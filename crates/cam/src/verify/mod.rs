@@ -17,8 +17,9 @@
 //!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`.
 //! * grid: the highest scallop is sampled at a node at most `c/√2` from it (c the largest
 //!   node spacing); the scallop's flank rises with slope at most `tan φ`, `cos φ = 1 − h/ρ`
-//!   (the cutter's profile meeting the surface at the height h), so the sampled maximum is
-//!   below the true one by at most `tan φ · c/√2`. The same bound covers a gouge's depth.
+//!   (the cutter's profile meeting the surface at the height h; on a convex surface ρ is
+//!   replaced by the effective `1/(1/ρ + κ)`, κ the largest convex curvature), so the sampled
+//!   maximum is below the true one by at most `tan φ · c/√2`. The same bound covers a gouge's depth.
 //!   Every node within that bound of the maximum then gets a lattice twice as fine around it;
 //!   when all fit under the cap the bound is halved (the true maximum lies within half a cell
 //!   of a sub-node), otherwise the highest are refined and the coarse bound stands.
@@ -237,6 +238,22 @@ pub fn simulate(
     let flip = surface
         .normal(first.uv.0, first.uv.1)
         .is_some_and(|n| n.dot(&first.normal) < 0.0);
+    // The surface's largest convex curvature (bending away from the outward normal): a scallop
+    // flank rises over it as over a plane under a cutter of the smaller effective radius
+    // 1/(1/ρ + κ), so the grid bound uses that.
+    let mut convex = 0.0_f64;
+    for i in 0..SPEED_SAMPLES {
+        for j in 0..SPEED_SAMPLES {
+            let u = u0 + (u1 - u0) * i as f64 / (SPEED_SAMPLES - 1) as f64;
+            let v = v0 + (v1 - v0) * j as f64 / (SPEED_SAMPLES - 1) as f64;
+            if let Some(k) = surface.principal_curvatures(u, v) {
+                // Curvatures are positive toward S_u × S_v; the most convex is the most
+                // negative toward the outward normal.
+                let outward_min = if flip { -k.k1 } else { k.k2 };
+                convex = convex.max(-outward_min);
+            }
+        }
+    }
     let r = path.cutter.shape.radius();
     // Dexels reach the cutter radius above and below the surface: higher material counts as
     // uncut, deeper gouges are reported as that deep.
@@ -296,7 +313,8 @@ pub fn simulate(
     let solid = sweeper.solid;
     let rho = if solid.corner > 0.0 { solid.corner } else { r };
     out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
-    let coarse = grid_bound(&out, rho, achieved);
+    let rho_flank = 1.0 / (1.0 / rho + convex);
+    let coarse = grid_bound(&out, rho_flank, achieved);
 
     // Refinement: every node that may stand next to the true maximum (its height within the
     // grid bound of the measured one, likewise for the gouge) gets a 9×9 sub-grid over its
@@ -364,9 +382,9 @@ pub fn simulate(
     }
     out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
     out.grid_bound_mm = if complete {
-        grid_bound(&out, rho, achieved / REFINE as f64)
+        grid_bound(&out, rho_flank, achieved / REFINE as f64)
     } else {
-        grid_bound(&out, rho, achieved)
+        grid_bound(&out, rho_flank, achieved)
     };
     Ok(out)
 }
