@@ -94,11 +94,14 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     let json = tmp(&format!("{name}.json"));
+    let csv = tmp(&format!("{name}.csv"));
     let out = tezgah()
         .arg("run")
         .arg(&ngc)
         .args(["--machine", "table-ac", "--tool-table", TOOLS, "--report"])
         .arg(&json)
+        .arg("--samples")
+        .arg(&csv)
         .output()
         .unwrap();
     assert!(
@@ -126,6 +129,47 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
     assert!(
         report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
         "{report}"
+    );
+    // The machine ends where the program's last block says, read the way the output form
+    // means it: under TCP the samples' tip is X Y Z; with joint output (TCP off, G43) the
+    // joints are X Y Z with the tool length (28.5 mm) added to Z, A and C.
+    let samples = std::fs::read_to_string(&csv).unwrap();
+    let last: Vec<f64> = samples
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    // The last motion block (modal G0 may leave the G word out).
+    let block = program
+        .lines()
+        .rfind(|l| !l.starts_with('(') && l.contains('X') && l.contains('C'))
+        .unwrap();
+    let word = |c: char| -> f64 {
+        block
+            .split(' ')
+            .find_map(|w| w.strip_prefix(c).filter(|v| !v.is_empty()))
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (x, y, z, a, c) = (word('X'), word('Y'), word('Z'), word('A'), word('C'));
+    // Columns: t, line, x, y, z, a, c, tip_x, tip_y, tip_z.
+    let (got, want) = if program.contains("G43.4") {
+        ([last[7], last[8], last[9]], [x, y, z])
+    } else {
+        ([last[2], last[3], last[4]], [x, y, z + 28.5])
+    };
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            (g - w).abs() < 1e-6,
+            "{name}: ends at {got:?}, program says {want:?}"
+        );
+    }
+    assert!(
+        (last[5] - a).abs() < 1e-6 && (last[6] - c).abs() < 1e-6,
+        "{name}: {last:?}"
     );
     report
 }

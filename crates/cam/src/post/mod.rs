@@ -239,7 +239,7 @@ pub fn post(
         c_limit: limits[4].clone(),
         // C is held inside the cone whose axis error costs at most half the tolerance at
         // the cutter's reach.
-        pole_sin: (0.5 * tolerance / reach).min(1.0).asin().sin(),
+        pole_sin: (0.5 * tolerance / reach).min(1.0),
     };
     let tool = Tool::with_length(options.tool_length_mm);
     let motion = MachineMotion {
