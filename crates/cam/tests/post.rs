@@ -328,3 +328,58 @@ fn the_posted_joint_program_cuts_without_gouging() {
         v.max_scallop_mm
     );
 }
+
+mod no_panic {
+    use super::*;
+    use proptest::prelude::*;
+    use tezgah_cam::{Cutter, CutterLocation, CutterShape, Pass};
+
+    fn location() -> impl Strategy<Value = CutterLocation> {
+        (
+            proptest::array::uniform3(-60.0f64..60.0),
+            proptest::array::uniform3(-1.0f64..1.0),
+        )
+            .prop_map(|(t, a)| {
+                let tip = nalgebra::Vector3::from(t);
+                let axis = nalgebra::Vector3::from(a);
+                CutterLocation {
+                    tip,
+                    axis,
+                    contact: tip,
+                    normal: axis,
+                    uv: (0.0, 0.0),
+                }
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Any path, feed and tolerance: a program whose every joint is within limits, or an
+        /// error — never a panic.
+        #[test]
+        fn any_path_posts_or_fails_cleanly(
+            passes in proptest::collection::vec(proptest::collection::vec(location(), 0..6), 0..4),
+            feed in prop_oneof![Just(0.0), Just(f64::NAN), 1.0f64..5000.0],
+            tolerance in prop_oneof![Just(-1.0), 1e-4f64..0.1],
+            joints in any::<bool>(),
+            bc in any::<bool>(),
+        ) {
+            let machine = Machine::builtin(if bc { "table-bc" } else { "table-ac" }).unwrap();
+            let path = ToolPath {
+                cutter: Cutter::standard(CutterShape::Ball { radius: 2.0 }),
+                passes: passes.into_iter().map(|points| Pass { points }).collect(),
+            };
+            let o = PostOptions {
+                form: if joints { OutputForm::Joints } else { OutputForm::CentrePoint },
+                ..PostOptions::new(feed, tolerance)
+            };
+            if let Ok(posted) = post(&path, &machine, &o) {
+                prop_assert!(posted.program.ends_with("M2\n"));
+                for p in &posted.points {
+                    prop_assert!(machine.kinematics.check_joints(&p.joints).is_ok());
+                }
+            }
+        }
+    }
+}

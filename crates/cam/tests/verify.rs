@@ -128,3 +128,33 @@ fn bad_options_are_errors() {
         );
     }
 }
+
+mod no_panic {
+    use proptest::prelude::*;
+    use tezgah_cam::verify::{simulate, CutterPose, VerifyOptions};
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// Any poses (NaN and wild ones included) and cell: a measurement or an error.
+        #[test]
+        fn any_poses_simulate_or_fail_cleanly(
+            poses in proptest::collection::vec(
+                (proptest::array::uniform3(prop_oneof![Just(f64::NAN), -20.0f64..20.0]),
+                 proptest::array::uniform3(-1.0f64..1.0)),
+                0..40),
+            cell in prop_oneof![Just(0.0), 0.05f64..2.0],
+        ) {
+            let surface = super::common::plane(10.0, 8.0);
+            let path = super::common::zigzag(&surface, 3.0, 3, 4, 0.0);
+            let poses: Vec<CutterPose> = poses
+                .into_iter()
+                .map(|(t, a)| CutterPose { tip: t.into(), axis: nalgebra::Vector3::from(a).normalize() })
+                .collect();
+            let options = VerifyOptions { cell_mm: cell, sweep_spacing_mm: 0.1 };
+            if let Ok(v) = simulate(&surface, &path, &poses, &options) {
+                prop_assert!(v.max_scallop_mm >= 0.0 && v.gouge_depth_mm >= 0.0);
+            }
+        }
+    }
+}
