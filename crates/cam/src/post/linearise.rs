@@ -153,7 +153,7 @@ impl MachineMotion<'_> {
             // Leaving the pole for a point of another C: C is free at the pole, so the table
             // turns there first, the tool standing still on the part (the turn is then halved
             // like any move; without it, every half would still hold the whole turn).
-            let a = *out.last().expect("out starts non-empty");
+            let a = *out.last().unwrap_or(&first);
             if self.orienter.at_pole(&a.axis) && (next.angles.c - a.angles.c).abs() > 1e-12 {
                 let angles = self.orienter.keeping_c(&a.axis, next.angles.c);
                 let joints =
@@ -207,7 +207,11 @@ impl MachineMotion<'_> {
             // Depth-first halving: a stack of pending ends with their depth.
             let mut stack = vec![(next, 0u32)];
             while let Some((b, depth)) = stack.pop() {
-                let a = *out.last().expect("out starts non-empty");
+                // `out` holds at least the path's first point (refine pushes it first).
+                let Some(&a) = out.last() else {
+                    out.push(b);
+                    continue;
+                };
                 let d = self.deviation(&a, &b)?;
                 if d <= tolerance {
                     *worst = worst.max(d);
