@@ -2,6 +2,7 @@
 //!
 //! Every command is a thin shell over a library call; see the README for the commands.
 
+mod cam;
 mod diagnostics;
 mod library;
 mod plot;
@@ -91,6 +92,54 @@ enum Command {
         #[command(flatten)]
         inputs: Inputs,
     },
+    /// Finishing tool path on a surface, post-processed for a table-tilting machine and
+    /// verified by a dexel simulation of the cut.
+    Cam {
+        /// The surface (STEP file).
+        surface: PathBuf,
+        /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm).
+        #[arg(long)]
+        tool: String,
+        /// zigzag, zigzag-oneway or iso-scallop.
+        #[arg(long)]
+        strategy: String,
+        /// Largest scallop height, mm.
+        #[arg(long)]
+        scallop: f64,
+        /// Chord and linearisation tolerance, mm.
+        #[arg(long)]
+        tolerance: f64,
+        /// Lead angle: the tool tilted from the normal toward the feed, degrees.
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        lead: f64,
+        /// Tilt angle: the tool tilted from the normal across the feed, degrees.
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        tilt: f64,
+        /// Cutting feed, mm/min (the tip's speed on the part).
+        #[arg(long, default_value_t = 1000.0)]
+        feed: f64,
+        /// Write feeds in inverse time (G93).
+        #[arg(long)]
+        inverse_time: bool,
+        /// Write machine joints (G43, no tool-centre-point control) instead of G43.4 output.
+        #[arg(long)]
+        joints: bool,
+        /// A table-tilting machine: built-in name or file (default table-ac).
+        #[arg(long)]
+        machine: Option<String>,
+        /// The program to write.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Write the report JSON here.
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// A tool table in LinuxCNC's format (the tool's length).
+        #[arg(long)]
+        tool_table: Option<PathBuf>,
+        /// The tool number for T and H words.
+        #[arg(long, default_value_t = 1)]
+        tool_number: u32,
+    },
     /// List the built-in machine definitions.
     Machines,
 }
@@ -131,6 +180,39 @@ fn main() -> ExitCode {
             subroutine_path: inputs.subroutine_path,
             ini: inputs.ini,
             params: inputs.params,
+        }),
+        Command::Cam {
+            surface,
+            tool,
+            strategy,
+            scallop,
+            tolerance,
+            lead,
+            tilt,
+            feed,
+            inverse_time,
+            joints,
+            machine,
+            output,
+            report,
+            tool_table,
+            tool_number,
+        } => cam::cam(cam::CamArgs {
+            surface,
+            tool,
+            strategy,
+            scallop,
+            tolerance,
+            lead_deg: lead,
+            tilt_deg: tilt,
+            feed,
+            inverse_time,
+            joints,
+            machine,
+            output,
+            report,
+            tool_table,
+            tool_number,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };

@@ -1,0 +1,362 @@
+//! Post-processor for table-tilting five-axis machines (`table-ac`, `table-bc`): turns a
+//! [`ToolPath`] into G-code that `tezgah check` accepts and `tezgah run` executes. Comes after
+//! the strategies; its output feeds the verifying simulation ([`crate::verify`]) and the CLI.
+//!
+//! Steps, one module each: [`links`] (stations: passes plus retract / link / plunge through
+//! the safe plane), [`orient`] (both inverse solutions, the branch choice along the whole
+//! path, the pole, C unwrapped), the joints through the kinematics crate (limits checked),
+//! [`linearise`] (points inserted where the machine's motion strays from the path), [`emit`]
+//! (the G-code text, feed per minute or inverse time).
+
+pub mod emit;
+pub mod linearise;
+pub mod links;
+pub mod orient;
+
+use tezgah_geom::{Axis, Vec3};
+use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, Tool};
+
+use crate::toolpath::ToolPath;
+use crate::verify::CutterPose;
+use linearise::MachineMotion;
+use links::{Motion, Station};
+use orient::{Orienter, TableAngles};
+
+/// What the program's X Y Z A C mean.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputForm {
+    /// Tool-centre-point control (`G43.4 H<n>`): X Y Z are the tool tip in the part frame and
+    /// the rotary words the table angles; the controller moves the tip straight.
+    CentrePoint,
+    /// No TCP (`G43 H<n>`): X Y Z are the tip in machine coordinates (the spindle stays
+    /// vertical on a table-tilting machine, so the tool length only shifts Z, which G43 does),
+    /// and the controller interpolates the joints.
+    Joints,
+}
+
+/// How feeds are written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FeedOutput {
+    /// G94: F in mm/min, once per change.
+    PerMinute,
+    /// G93: every feed block carries F = 1/(its time in minutes), the time being the tip's
+    /// travel on the part at the feed (a pure turn: its degrees at the feed as deg/min).
+    InverseTime,
+}
+
+/// Everything the post needs besides the path and the machine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PostOptions {
+    pub form: OutputForm,
+    pub feed_output: FeedOutput,
+    /// Cutting feed: the tip's speed on the part, mm/min.
+    pub feed_mm_per_min: f64,
+    /// Largest linearisation deviation allowed between output points, mm.
+    pub tolerance_mm: f64,
+    /// Tool number for `T… M6` and `H…`.
+    pub tool_number: u32,
+    /// The tool's length (tool table), mm: enters the machine's Z and its limit check.
+    pub tool_length_mm: f64,
+    /// Highest point of the part, if known (else the highest point of the path is used).
+    pub part_top_z: Option<f64>,
+    /// Safe plane clearance above the part plus the cutter radius, mm.
+    pub clearance_mm: f64,
+    /// Spindle speed for `S… M3`, if any.
+    pub spindle_rpm: Option<f64>,
+    /// Largest number of halvings of one segment before the post gives up.
+    pub max_halvings: u32,
+    /// A title for the header comment.
+    pub title: String,
+}
+
+impl PostOptions {
+    /// Defaults for the rest: TCP output, feed per minute, tool 1 of length 0, 5 mm clearance.
+    pub fn new(feed_mm_per_min: f64, tolerance_mm: f64) -> Self {
+        Self {
+            form: OutputForm::CentrePoint,
+            feed_output: FeedOutput::PerMinute,
+            feed_mm_per_min,
+            tolerance_mm,
+            tool_number: 1,
+            tool_length_mm: 0.0,
+            part_top_z: None,
+            clearance_mm: 5.0,
+            spindle_rpm: None,
+            max_halvings: 24,
+            title: String::new(),
+        }
+    }
+}
+
+/// Why a path could not be posted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PostError {
+    #[error("the post-processor handles table-ac and table-bc machines, not {0}")]
+    Machine(&'static str),
+    #[error("{what} must be a finite number > 0, got {value}")]
+    Option { what: &'static str, value: f64 },
+    #[error("pass {pass} point {point}: tip or tool axis not finite, or the axis is zero")]
+    BadLocation { pass: usize, point: usize },
+    #[error("pass {pass} point {point}: the tool axis does not point up, so the tool cannot retract to the safe plane along it")]
+    NoRetract { pass: usize, point: usize },
+    #[error("{}: {error}", place(*at))]
+    Kinematics {
+        at: Option<(usize, usize)>,
+        error: KinematicsError,
+    },
+    #[error("{}: the machine's motion strays {deviation:.4} mm from the path after every halving (tolerance {tolerance} mm)", place(*at))]
+    Linearisation {
+        at: Option<(usize, usize)>,
+        deviation: f64,
+        tolerance: f64,
+    },
+    #[error("the tool path has no cutter locations")]
+    Empty,
+}
+
+fn place(at: Option<(usize, usize)>) -> String {
+    match at {
+        Some((p, i)) => format!("pass {p} point {i}"),
+        None => "a link move".to_owned(),
+    }
+}
+
+/// One output point: where the tool is, the angles chosen and the machine joints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PostedPoint {
+    /// Tip, part frame, mm.
+    pub tip: Vec3,
+    /// Requested unit tool axis, part frame.
+    pub axis: Vec3,
+    pub angles: TableAngles,
+    /// Machine joints (gauge point with the tool length, mm; tilt and C, rad).
+    pub joints: Joints,
+    /// How the tool gets here.
+    pub motion: Motion,
+    /// The (pass, point) of the tool path, or the one after an inserted point; `None` on links.
+    pub source: Option<(usize, usize)>,
+    /// Inserted by the linearisation check.
+    pub inserted: bool,
+}
+
+/// Figures of a posted program.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PostStats {
+    /// Tip travel on the part while cutting, mm.
+    pub cutting_length_mm: f64,
+    /// Tip travel on the part while plunging, mm.
+    pub plunge_length_mm: f64,
+    /// Tip travel on the part in rapid links, mm.
+    pub rapid_length_mm: f64,
+    /// (cutting + plunge length) / feed, s.
+    pub feed_time_s: f64,
+    /// Output points (motion blocks).
+    pub points: usize,
+    /// Points the linearisation check inserted.
+    pub inserted: usize,
+    /// Largest deviation of the machine's motion from the path left after insertion, mm.
+    pub max_linearisation_mm: f64,
+    /// Height of the safe plane (part frame), mm.
+    pub safe_z: f64,
+}
+
+/// A posted program: its points, text and figures.
+#[derive(Debug, Clone)]
+pub struct Posted {
+    pub points: Vec<PostedPoint>,
+    pub program: String,
+    pub stats: PostStats,
+    /// The program's letters for the tilt and C (A C or B C).
+    pub rotary_letters: [char; 2],
+    /// How the program was written, with the tool it was posted for (for [`Posted::sweep`]).
+    pub form: OutputForm,
+    pub tool: Tool,
+    /// The cutter's reach from its tip, mm ([`reach`]).
+    pub reach: f64,
+}
+
+/// The cutter's reach from its tip: `√(R² + r²)`, the farthest point of the cutting end.
+pub fn reach(path: &ToolPath) -> f64 {
+    let s = path.cutter.shape;
+    s.radius().hypot(s.corner_radius())
+}
+
+fn positive(what: &'static str, value: f64) -> Result<f64, PostError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(PostError::Option { what, value })
+    }
+}
+
+/// Posts `path` for `machine` (table-ac or table-bc).
+pub fn post(
+    path: &ToolPath,
+    machine: &Machine,
+    options: &PostOptions,
+) -> Result<Posted, PostError> {
+    let feed = positive("the feed", options.feed_mm_per_min)?;
+    let tolerance = positive("the tolerance", options.tolerance_mm)?;
+    if !(options.clearance_mm.is_finite() && options.clearance_mm >= 0.0) {
+        return Err(PostError::Option {
+            what: "the clearance",
+            value: options.clearance_mm,
+        });
+    }
+    if !(options.tool_length_mm.is_finite()) {
+        return Err(PostError::Option {
+            what: "the tool length",
+            value: options.tool_length_mm,
+        });
+    }
+    let model = match &machine.kinematics {
+        Model::TableAc(t) | Model::TableBc(t) => t,
+        other => return Err(PostError::Machine(other.type_name())),
+    };
+    let letters = match machine.tcp_axes().ok().as_deref() {
+        Some([Axis::B, Axis::C]) => ['B', 'C'],
+        _ => ['A', 'C'],
+    };
+    // Validate and normalise the path's locations.
+    let mut path = path.clone();
+    for (p, pass) in path.passes.iter_mut().enumerate() {
+        for (i, cl) in pass.points.iter_mut().enumerate() {
+            let n = cl.axis.norm();
+            if !(cl.tip.iter().all(|x| x.is_finite()) && n.is_finite() && n > 1e-12) {
+                return Err(PostError::BadLocation { pass: p, point: i });
+            }
+            cl.axis /= n;
+        }
+    }
+    if path.contact_count() == 0 {
+        return Err(PostError::Empty);
+    }
+    let reach = reach(&path);
+    let limits = model.joint_limits();
+    let orienter = Orienter {
+        tilt_axis: model.tilt_axis(),
+        tilt_limit: limits[3].clone(),
+        c_limit: limits[4].clone(),
+        // C is held inside the cone whose axis error costs at most half the tolerance at
+        // the cutter's reach.
+        pole_sin: (0.5 * tolerance / reach).min(1.0),
+    };
+    let tool = Tool::with_length(options.tool_length_mm);
+    let motion = MachineMotion {
+        model,
+        orienter: &orienter,
+        tool,
+        form: options.form,
+        reach,
+    };
+
+    let safe = links::safe_height(&path, options.part_top_z, options.clearance_mm);
+    let stations = links::stations(&path, safe)?;
+    let axes: Vec<Vec3> = stations.iter().map(|s| s.axis).collect();
+    let home = TableAngles { tilt: 0.0, c: 0.0 };
+    let angles = orienter
+        .choose(&axes, home)
+        .map_err(|e| PostError::Kinematics {
+            at: stations[e.index].place,
+            error: e.error,
+        })?;
+    let mut points = Vec::with_capacity(stations.len());
+    let mut previous = machine.home();
+    for (s, a) in stations.iter().zip(&angles) {
+        let joints = motion
+            .joints(&s.tip, *a, &previous)
+            .map_err(|e| PostError::Kinematics {
+                at: s.place,
+                error: e,
+            })?;
+        previous = joints;
+        points.push(point(s, *a, joints));
+    }
+    let (points, worst, inserted) = motion.refine(points, tolerance, options.max_halvings)?;
+
+    let mut stats = PostStats {
+        points: points.len(),
+        inserted,
+        max_linearisation_mm: worst,
+        safe_z: safe,
+        ..PostStats::default()
+    };
+    for w in points.windows(2) {
+        let d = (w[1].tip - w[0].tip).norm();
+        match w[1].motion {
+            Motion::Cut => stats.cutting_length_mm += d,
+            Motion::Plunge => stats.plunge_length_mm += d,
+            Motion::Rapid => stats.rapid_length_mm += d,
+        }
+    }
+    stats.feed_time_s = 60.0 * (stats.cutting_length_mm + stats.plunge_length_mm) / feed;
+    let program = emit::program(&points, &motion, options, letters, safe)?;
+    Ok(Posted {
+        points,
+        program,
+        stats,
+        rotary_letters: letters,
+        form: options.form,
+        tool,
+        reach,
+    })
+}
+
+fn point(s: &Station, angles: TableAngles, joints: Joints) -> PostedPoint {
+    PostedPoint {
+        tip: s.tip,
+        axis: s.axis,
+        angles,
+        joints,
+        motion: s.motion,
+        source: s.source,
+        inserted: false,
+    }
+}
+
+impl Posted {
+    /// The cutter's poses along the program as the machine moves it, no point of the cutting
+    /// end moving more than `spacing` between consecutive poses: what the verifying
+    /// simulation sweeps. `machine` is the one the program was posted for.
+    pub fn sweep(&self, machine: &Machine, spacing: f64) -> Result<Vec<CutterPose>, PostError> {
+        let spacing = positive("the sweep spacing", spacing)?;
+        let model = match &machine.kinematics {
+            Model::TableAc(t) | Model::TableBc(t) => t,
+            other => return Err(PostError::Machine(other.type_name())),
+        };
+        let limits = model.joint_limits();
+        let orienter = Orienter {
+            tilt_axis: model.tilt_axis(),
+            tilt_limit: limits[3].clone(),
+            c_limit: limits[4].clone(),
+            pole_sin: 0.0,
+        };
+        let reach = self.reach;
+        let motion = MachineMotion {
+            model,
+            orienter: &orienter,
+            tool: self.tool,
+            form: self.form,
+            reach,
+        };
+        let mut out = Vec::new();
+        if let Some(p) = self.points.first() {
+            out.push(CutterPose {
+                tip: p.tip,
+                axis: orienter.axis(p.angles),
+            });
+        }
+        for w in self.points.windows(2) {
+            let (a, b) = (&w[0], &w[1]);
+            // The axis turns at most |Δtilt| + |ΔC| (rad) on the way, whatever the form.
+            let turn = (b.angles.tilt - a.angles.tilt).abs() + (b.angles.c - a.angles.c).abs();
+            let span = (b.tip - a.tip).norm() + reach * turn;
+            let n = ((span / spacing).ceil() as usize).clamp(1, 1_000_000);
+            for k in 1..=n {
+                let (tip, axis) = motion.pose_at(a, b, k as f64 / n as f64)?;
+                out.push(CutterPose { tip, axis });
+            }
+        }
+        Ok(out)
+    }
+}

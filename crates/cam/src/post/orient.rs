@@ -1,0 +1,416 @@
+//! The rotary angles of a table-tilting machine along a whole tool path: both inverse
+//! solutions of every tool axis, the choice between them, the pole and the unwrap of C.
+//! Called by the post-processor before the linear axes and the linearisation check.
+//!
+//! A tool axis away from the C axis has two solutions, (θ, C) with θ ≥ 0 and (−θ, C + π)
+//! (reference 001 §2.15, eq. 3.32 and its digest). Choosing per point by nearness to the
+//! previous point (what the kinematics' `inverse` does) is greedy; here the branch sequence
+//! is chosen for the whole path at once (a two-state Viterbi search, least total rotary travel
+//! |Δθ| + |ΔC| within the tilt limits), so a path that crosses the pole flips the tilt's sign
+//! and keeps C instead of spinning the table half a turn. Inside the pole cone C is undefined:
+//! the previous C is kept and the tilt is the one nearest the axis in the plane it sweeps.
+//! Finally C is unwrapped the shortest way within its limits.
+
+use tezgah_geom::Vec3;
+use tezgah_kinematics::angle::{unwrap_within, wrap_pi};
+use tezgah_kinematics::trunnion::TiltAxis;
+use tezgah_kinematics::{table_ac, table_bc, JointLimit, KinematicsError};
+
+/// Table angles of one output point, rad: the tilt (A on table-ac, B on table-bc) and C.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TableAngles {
+    pub tilt: f64,
+    pub c: f64,
+}
+
+/// The orientation map of one trunnion with its rotary limits and pole cone.
+#[derive(Debug, Clone)]
+pub struct Orienter {
+    pub tilt_axis: TiltAxis,
+    pub tilt_limit: JointLimit,
+    pub c_limit: JointLimit,
+    /// Sine of the pole cone's half-angle: inside it C is held.
+    pub pole_sin: f64,
+}
+
+/// Why no angles were found for a point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OrientError {
+    /// Index of the offending axis in the sequence given.
+    pub index: usize,
+    pub error: KinematicsError,
+}
+
+impl Orienter {
+    /// The tool axis (part frame) the table angles produce.
+    pub fn axis(&self, a: TableAngles) -> Vec3 {
+        match self.tilt_axis {
+            TiltAxis::X => table_ac::axis(a.tilt, a.c),
+            TiltAxis::Y => table_bc::axis(a.tilt, a.c),
+        }
+    }
+
+    /// True when the axis is inside the pole cone (C undefined there).
+    pub fn at_pole(&self, k: &Vec3) -> bool {
+        // Both trunnions turn C about the part's Z.
+        k.x.hypot(k.y) <= self.pole_sin && k.z > 0.0
+    }
+
+    /// Both solutions away from the pole: branch 0 has tilt ≥ 0, branch 1 is (−tilt, C + π).
+    pub fn solutions(&self, k: &Vec3) -> [TableAngles; 2] {
+        let s = match self.tilt_axis {
+            TiltAxis::X => table_ac::solutions(k),
+            TiltAxis::Y => table_bc::solutions(k),
+        };
+        s.map(|(tilt, c)| TableAngles { tilt, c })
+    }
+
+    /// At the pole: C kept, the tilt nearest the axis.
+    pub fn keeping_c(&self, k: &Vec3, c: f64) -> TableAngles {
+        let tilt = match self.tilt_axis {
+            TiltAxis::X => table_ac::tilt_keeping_c(k, c),
+            TiltAxis::Y => table_bc::tilt_keeping_c(k, c),
+        };
+        TableAngles { tilt, c }
+    }
+
+    /// The tilt moved into its limits by whole turns, if any turn fits.
+    fn tilt_in_limits(&self, tilt: f64) -> Option<f64> {
+        unwrap_within(tilt, tilt, self.tilt_limit.min, self.tilt_limit.max)
+    }
+
+    /// The candidates of one axis given the two states of the point before (for the pole).
+    fn candidates(&self, k: &Vec3, before: [TableAngles; 2]) -> ([Option<TableAngles>; 2], bool) {
+        if self.at_pole(k) {
+            let c = before.map(|b| self.keeping_c(k, b.c));
+            (c.map(|a| self.fit(a)), true)
+        } else {
+            (self.solutions(k).map(|a| self.fit(a)), false)
+        }
+    }
+
+    fn fit(&self, a: TableAngles) -> Option<TableAngles> {
+        self.tilt_in_limits(a.tilt)
+            .map(|tilt| TableAngles { tilt, c: a.c })
+    }
+
+    /// Table angles for every axis of `axes` (unit vectors, part frame), starting from the
+    /// machine at `start`: the branch sequence of least rotary travel within the tilt limits,
+    /// C held at the pole, C unwrapped the shortest way within its limits.
+    pub fn choose(
+        &self,
+        axes: &[Vec3],
+        start: TableAngles,
+    ) -> Result<Vec<TableAngles>, OrientError> {
+        if axes.is_empty() {
+            return Ok(Vec::new());
+        }
+        let step =
+            |a: &TableAngles, b: &TableAngles| (b.tilt - a.tilt).abs() + wrap_pi(b.c - a.c).abs();
+        // Viterbi over the two branches: cost, state values and back pointers per point.
+        let mut states: Vec<[Option<TableAngles>; 2]> = Vec::with_capacity(axes.len());
+        let mut back: Vec<[usize; 2]> = Vec::with_capacity(axes.len());
+        let mut cost = [0.0_f64; 2];
+        let mut before = [start, start];
+        for (i, k) in axes.iter().enumerate() {
+            let (cand, pole) = self.candidates(k, before);
+            let mut next_cost = [f64::INFINITY; 2];
+            let mut ptr = [0usize; 2];
+            for (s, c) in cand.iter().enumerate() {
+                let Some(c) = c else { continue };
+                for p in 0..2 {
+                    // A pole state holds the C of its own predecessor only.
+                    if pole && p != s {
+                        continue;
+                    }
+                    let prev = if i == 0 {
+                        Some(start)
+                    } else {
+                        states[i - 1][p]
+                    };
+                    let Some(prev) = prev else { continue };
+                    let total = cost[p] + step(&prev, c);
+                    if total < next_cost[s] {
+                        next_cost[s] = total;
+                        ptr[s] = p;
+                    }
+                }
+            }
+            if next_cost.iter().all(|c| !c.is_finite()) {
+                let tilt = if pole {
+                    self.keeping_c(k, before[0].c).tilt
+                } else {
+                    self.solutions(k)[0].tilt
+                };
+                return Err(OrientError {
+                    index: i,
+                    error: self.tilt_limit.violation(3, tilt),
+                });
+            }
+            let values = [0, 1].map(|s| {
+                if next_cost[s].is_finite() {
+                    cand[s]
+                } else {
+                    None
+                }
+            });
+            before = [0, 1].map(|s| values[s].or(values[1 - s]).unwrap_or(before[s]));
+            states.push(values);
+            back.push(ptr);
+            cost = next_cost;
+        }
+        // Back-track the cheapest end state.
+        let mut s = if cost[0] <= cost[1] { 0 } else { 1 };
+        let mut chosen = vec![start; axes.len()];
+        for i in (0..axes.len()).rev() {
+            // Finite cost implies the state holds a value.
+            chosen[i] = states[i][s].unwrap_or(start);
+            s = back[i][s];
+        }
+        // Shortest unwrap of C, within its limits.
+        let mut previous_c = start.c;
+        for (i, a) in chosen.iter_mut().enumerate() {
+            a.c = unwrap_within(a.c, previous_c, self.c_limit.min, self.c_limit.max).ok_or(
+                OrientError {
+                    index: i,
+                    error: self.c_limit.violation(4, a.c),
+                },
+            )?;
+            previous_c = a.c;
+        }
+        Ok(chosen)
+    }
+
+    /// The angles for one extra axis between two chosen neighbours (a point the linearisation
+    /// inserts): the candidate nearest the interpolated neighbours, C held at the pole and
+    /// unwrapped next to `from`.
+    pub fn between(
+        &self,
+        k: &Vec3,
+        from: TableAngles,
+        to: TableAngles,
+    ) -> Result<TableAngles, KinematicsError> {
+        let mid = TableAngles {
+            tilt: 0.5 * (from.tilt + to.tilt),
+            c: 0.5 * (from.c + to.c),
+        };
+        // At the pole C is free: halfway between the neighbours' (already unwrapped) C, so
+        // that halving a turn of C made there converges.
+        let cands: Vec<TableAngles> = if self.at_pole(k) {
+            vec![self.keeping_c(k, mid.c)]
+        } else {
+            self.solutions(k).to_vec()
+        };
+        let mut best: Option<(f64, TableAngles)> = None;
+        for c in cands {
+            let Some(mut c) = self.fit(c) else { continue };
+            c.c = unwrap_within(c.c, mid.c, self.c_limit.min, self.c_limit.max)
+                .ok_or_else(|| self.c_limit.violation(4, c.c))?;
+            let d = (c.tilt - mid.tilt).abs() + (c.c - mid.c).abs();
+            if best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, c));
+            }
+        }
+        best.map(|(_, c)| c).ok_or_else(|| {
+            let t = self.solutions(k)[0].tilt;
+            self.tilt_limit.violation(3, t)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+    use tezgah_kinematics::JointKind;
+
+    fn ac(tilt_min_deg: f64, tilt_max_deg: f64) -> Orienter {
+        Orienter {
+            tilt_axis: TiltAxis::X,
+            tilt_limit: JointLimit::new(
+                "a",
+                JointKind::Rotary,
+                tilt_min_deg.to_radians(),
+                tilt_max_deg.to_radians(),
+            ),
+            c_limit: JointLimit::endless("c"),
+            pole_sin: 1e-6,
+        }
+    }
+
+    const ZERO: TableAngles = TableAngles { tilt: 0.0, c: 0.0 };
+
+    fn deg(a: &TableAngles) -> (f64, f64) {
+        (a.tilt.to_degrees(), a.c.to_degrees())
+    }
+
+    #[test]
+    fn reference_t11_both_branches() {
+        // Reference 001 T11: n = (0, −0.5, 0.86603) has (30°, 180°) and (−30°, 0°).
+        let o = ac(-90.0, 90.0);
+        let k = Vec3::new(0.0, -0.5, 0.75_f64.sqrt());
+        let [b0, b1] = o.solutions(&k);
+        assert!((deg(&b0).0 - 30.0).abs() < 1e-9 && (deg(&b0).1.abs() - 180.0).abs() < 1e-9);
+        assert!((deg(&b1).0 + 30.0).abs() < 1e-9 && deg(&b1).1.abs() < 1e-9);
+        // From the home position the A ≤ 0 branch needs no turn of C: it is chosen.
+        let got = o.choose(&[k], ZERO).unwrap();
+        assert!((deg(&got[0]).0 + 30.0).abs() < 1e-9 && deg(&got[0]).1.abs() < 1e-9);
+        // With A limited to ≥ −20° only branch 0 is left.
+        let got = ac(-20.0, 120.0).choose(&[k], ZERO).unwrap();
+        assert!((deg(&got[0]).0 - 30.0).abs() < 1e-9);
+        assert!((o.axis(got[0]) - k).norm() < 1e-12);
+    }
+
+    #[test]
+    fn crossing_the_pole_flips_the_tilt_and_keeps_c() {
+        // A great circle through the pole in the Y-Z plane: the axis tilts from +Y to −Y.
+        let o = ac(-60.0, 120.0);
+        let axes: Vec<Vec3> = (-10..=10)
+            .map(|i| {
+                let t = (i as f64 * 3.0).to_radians();
+                Vec3::new(0.0, t.sin(), t.cos())
+            })
+            .collect();
+        let got = o.choose(&axes, ZERO).unwrap();
+        for (a, k) in got.iter().zip(&axes) {
+            assert!((o.axis(*a) - k).norm() < 1e-9);
+            assert_eq!(a.c, got[0].c, "C never moves");
+        }
+        let travel: f64 = got.windows(2).map(|w| (w[1].tilt - w[0].tilt).abs()).sum();
+        assert!((travel.to_degrees() - 60.0).abs() < 1e-9);
+        // When the negative tilt is not allowed the table turns half a turn at the pole,
+        // once, and every axis is still reproduced.
+        let got = ac(0.0, 120.0).choose(&axes, ZERO).unwrap();
+        for (a, k) in got.iter().zip(&axes) {
+            assert!((o.axis(*a) - k).norm() < 1e-9);
+            assert!(a.tilt >= 0.0);
+        }
+        let c_travel: f64 = got.windows(2).map(|w| (w[1].c - w[0].c).abs()).sum();
+        assert!((c_travel - PI).abs() < 1e-9, "{c_travel}");
+    }
+
+    #[test]
+    fn c_unwraps_the_shortest_way_and_past_a_turn() {
+        // The axis circles the pole twice at 30°: C grows continuously to 720°.
+        let o = ac(-30.0, 120.0);
+        let axes: Vec<Vec3> = (0..=96)
+            .map(|i| {
+                let c = (i as f64 * 7.5).to_radians();
+                table_ac::axis(30f64.to_radians(), c)
+            })
+            .collect();
+        let got = o.choose(&axes, ZERO).unwrap();
+        for w in got.windows(2) {
+            assert!((w[1].c - w[0].c - 7.5f64.to_radians()).abs() < 1e-9);
+        }
+        assert!((got.last().unwrap().c.to_degrees() - 720.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn at_the_pole_c_is_held() {
+        let o = ac(-30.0, 120.0);
+        let start = TableAngles { tilt: 0.2, c: 1.0 };
+        let got = o.choose(&[Vec3::z(), Vec3::z()], start).unwrap();
+        assert!(got.iter().all(|a| a.c == 1.0 && a.tilt == 0.0));
+    }
+
+    #[test]
+    fn unreachable_tilt_is_an_error_naming_the_point() {
+        let o = ac(-30.0, 30.0);
+        let k = table_ac::axis(60f64.to_radians(), 0.3);
+        let err = o.choose(&[Vec3::z(), k], ZERO).unwrap_err();
+        assert_eq!(err.index, 1);
+        assert!(err.error.to_string().contains('a'), "{}", err.error);
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+        use tezgah_kinematics::trunnion::Trunnion;
+        use tezgah_kinematics::{Joints, Kinematics, Tolerances, Tool, ToolPose};
+
+        /// A smooth random walk of tool axes within 80° of the C axis.
+        fn walk(start: (f64, f64), steps: &[(f64, f64)]) -> Vec<Vec3> {
+            let (mut t, mut c) = start;
+            steps
+                .iter()
+                .map(|(dt, dc)| {
+                    t = (t + dt).clamp(-1.4, 1.4);
+                    c += dc;
+                    table_ac::axis(t, c)
+                })
+                .collect()
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(200))]
+
+            /// Every chosen pair reproduces its axis, stays in the tilt limits, C moves
+            /// continuously, and the whole-path choice never travels more than the per-point
+            /// nearest choice of the kinematics crate.
+            #[test]
+            fn chosen_angles_reproduce_axes_and_beat_greedy(
+                start in (-1.0f64..1.0, -3.0f64..3.0),
+                steps in proptest::collection::vec((-0.08f64..0.08, -0.3f64..0.3), 2..60),
+                lo in -100.0f64..0.0,
+            ) {
+                let o = ac(lo, 120.0);
+                let axes = walk(start, &steps);
+                let got = match o.choose(&axes, ZERO) {
+                    Ok(g) => g,
+                    // Only a tilt beyond the limits may refuse.
+                    Err(e) => {
+                        let k = axes[e.index];
+                        let need = k.x.hypot(k.y).atan2(k.z);
+                        prop_assert!(need > 120f64.to_radians() && need > -lo.to_radians());
+                        return Ok(());
+                    }
+                };
+                let mut last = ZERO;
+                for (a, k) in got.iter().zip(&axes) {
+                    prop_assert!((o.axis(*a) - k).norm() < 1e-6);
+                    prop_assert!(o.tilt_limit.contains(a.tilt));
+                    prop_assert!((a.c - last.c).abs() <= PI + 1e-9);
+                    last = *a;
+                }
+                let travel = |v: &[(f64, f64)]| -> f64 {
+                    let mut prev = (0.0, 0.0);
+                    let mut sum = 0.0;
+                    for &(t, c) in v {
+                        sum += (t - prev.0).abs() + (c - prev.1).abs();
+                        prev = (t, c);
+                    }
+                    sum
+                };
+                let limits = vec![
+                    JointLimit::unlimited("x", tezgah_kinematics::JointKind::Linear),
+                    JointLimit::unlimited("y", tezgah_kinematics::JointKind::Linear),
+                    JointLimit::unlimited("z", tezgah_kinematics::JointKind::Linear),
+                    o.tilt_limit.clone(),
+                    o.c_limit.clone(),
+                ];
+                let greedy_model = Trunnion::new(
+                    TiltAxis::X,
+                    nalgebra::Vector3::zeros(),
+                    nalgebra::Vector3::zeros(),
+                    limits,
+                    Tolerances::default(),
+                )
+                .unwrap();
+                let mut q = Joints::zeros(5);
+                let mut greedy = Vec::new();
+                for k in &axes {
+                    match greedy_model.inverse(&ToolPose::new(nalgebra::Vector3::zeros(), *k), &Tool::default(), &q) {
+                        Ok(next) => {
+                            q = next;
+                            greedy.push((q[3], q[4]));
+                        }
+                        Err(_) => return Ok(()),
+                    }
+                }
+                let ours: Vec<(f64, f64)> = got.iter().map(|a| (a.tilt, a.c)).collect();
+                prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+            }
+        }
+    }
+}

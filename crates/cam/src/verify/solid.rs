@@ -1,0 +1,164 @@
+//! The cutter as a solid for the verifying simulation: every cutter (ball, flat, bull-nose,
+//! with its flutes) is the set of points within the corner radius `r` of a core cylinder on
+//! the axis — radius `R − r`, from `r` to the flute length above the tip. Its entry along a
+//! dexel is the first root of a convex function, found by Newton from below.
+//!
+//! `φ(t) = dist(P + t·n, core) − r` is convex in `t` (the distance to a convex set is convex),
+//! so Newton started left of the first root climbs to it monotonically (every tangent lies
+//! under the graph) and a non-negative slope with `φ > 0` proves there is no root ahead.
+
+use tezgah_geom::Vec3;
+
+use crate::cutter::Cutter;
+
+/// One placement of the cutter: tip and unit axis, part frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CutterPose {
+    pub tip: Vec3,
+    pub axis: Vec3,
+}
+
+/// The cutter's solid: core cylinder and corner radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CutterSolid {
+    /// Corner radius r (ball: R; flat: 0).
+    pub corner: f64,
+    /// Core radius R − r.
+    pub core_radius: f64,
+    /// Core from `corner` to this height above the tip (the flute length, at least `corner`).
+    pub core_top: f64,
+}
+
+/// Newton's convergence: the distance function is 1-Lipschitz, so |φ| below this is the
+/// entry to within this many mm.
+const ROOT_TOLERANCE: f64 = 1e-10;
+const MAX_STEPS: usize = 60;
+
+impl CutterSolid {
+    pub fn of(cutter: &Cutter) -> Self {
+        let corner = cutter.shape.corner_radius();
+        Self {
+            corner,
+            core_radius: cutter.shape.radius() - corner,
+            core_top: cutter.flute_length.max(corner),
+        }
+    }
+
+    /// Radius of a sphere about the tip that holds the whole solid.
+    pub fn bound(&self) -> f64 {
+        (self.core_radius + self.corner).hypot(self.core_top + self.corner)
+    }
+
+    /// Distance from `x` to the core, and its gradient (zero inside).
+    #[inline]
+    fn core_distance(&self, pose: &CutterPose, x: &Vec3) -> (f64, Vec3) {
+        let rel = x - pose.tip;
+        let z = rel.dot(&pose.axis);
+        let w = rel - pose.axis * z;
+        let rho = w.norm();
+        let dz = if z < self.corner {
+            z - self.corner
+        } else if z > self.core_top {
+            z - self.core_top
+        } else {
+            0.0
+        };
+        let dr = (rho - self.core_radius).max(0.0);
+        let d = dz.hypot(dr);
+        if d == 0.0 {
+            return (0.0, Vec3::zeros());
+        }
+        let mut g = pose.axis * (dz / d);
+        if dr > 0.0 {
+            g += w * (dr / (d * rho));
+        }
+        (d, g)
+    }
+
+    /// The first `t` in `[lo, hi]` where `p + t·n` is inside the cutter, if any (`lo` itself
+    /// when the ray starts inside).
+    pub fn entry(&self, pose: &CutterPose, p: &Vec3, n: &Vec3, lo: f64, hi: f64) -> Option<f64> {
+        let mut t = lo;
+        for _ in 0..MAX_STEPS {
+            let x = p + n * t;
+            let (d, g) = self.core_distance(pose, &x);
+            let phi = d - self.corner;
+            if phi <= ROOT_TOLERANCE {
+                return Some(t);
+            }
+            let slope = g.dot(n);
+            if slope >= 0.0 {
+                return None;
+            }
+            t -= phi / slope;
+            if t > hi {
+                return None;
+            }
+        }
+        Some(t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cutter::{Cutter, CutterShape};
+
+    #[test]
+    fn entries_match_closed_forms() {
+        // Ball R = 3 with its tip at the origin, axis +Z; rays straight up at offset d hit
+        // the sphere at 3 − √(9 − d²).
+        let ball = CutterSolid::of(&Cutter::standard(CutterShape::Ball { radius: 3.0 }));
+        let pose = CutterPose {
+            tip: Vec3::zeros(),
+            axis: Vec3::z(),
+        };
+        for d in [0.0, 0.5, 1.0, 2.0, 2.9] {
+            let t = ball
+                .entry(&pose, &Vec3::new(d, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+                .unwrap();
+            assert!(
+                (t - 1.0 - (3.0 - (9.0_f64 - d * d).sqrt())).abs() < 1e-9,
+                "{d}: {t}"
+            );
+        }
+        // Beside the ball the flank cylinder is met from the side.
+        let t = ball
+            .entry(&pose, &Vec3::new(-10.0, 0.0, 6.0), &Vec3::x(), -1.0, 20.0)
+            .unwrap();
+        assert!((t - 7.0).abs() < 1e-9);
+        assert!(ball
+            .entry(&pose, &Vec3::new(3.5, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+            .is_none());
+        // Bull-nose D = 10, r = 2: the flat part reaches radius 3, the torus beyond.
+        let bull = CutterSolid::of(&Cutter::standard(CutterShape::BullNose {
+            radius: 5.0,
+            corner_radius: 2.0,
+        }));
+        let t = bull
+            .entry(&pose, &Vec3::new(2.5, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+            .unwrap();
+        assert!((t - 1.0).abs() < 1e-9);
+        let t = bull
+            .entry(&pose, &Vec3::new(4.0, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+            .unwrap();
+        assert!(
+            (t - 1.0 - (2.0 - (4.0_f64 - 1.0).sqrt())).abs() < 1e-9,
+            "{t}"
+        );
+        // Flat D = 6: the end face, and nothing beyond the rim.
+        let flat = CutterSolid::of(&Cutter::standard(CutterShape::Flat { radius: 3.0 }));
+        let t = flat
+            .entry(&pose, &Vec3::new(2.99, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+            .unwrap();
+        assert!((t - 1.0).abs() < 1e-9);
+        assert!(flat
+            .entry(&pose, &Vec3::new(3.01, 0.0, -1.0), &Vec3::z(), -5.0, 5.0)
+            .is_none());
+        // A ray starting inside reports its start.
+        assert_eq!(
+            ball.entry(&pose, &Vec3::new(0.0, 0.0, 1.0), &Vec3::z(), 0.0, 5.0),
+            Some(0.0)
+        );
+    }
+}
