@@ -2,10 +2,24 @@
 //!
 //! It sits beside the G-code interpreter as a second source of moves: surfaces come in
 //! (`tezgah-geom`'s `NurbsSurface`), a strategy places the [`Cutter`] along them as a
-//! [`ToolPath`], and the post-processor turns that into G-code for a table-tilting machine.
+//! [`ToolPath`] ([`strategy::plan`] is the entry point), and the post-processor turns that
+//! into G-code for a table-tilting machine.
 
 pub mod cutter;
+pub mod effective_radius;
+pub mod error;
+pub mod forward_step;
+pub mod gouge;
+pub mod orientation;
+pub mod scallop;
+pub mod select;
+pub mod strategy;
+#[doc(hidden)]
+pub mod testing;
 pub mod toolpath;
 
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};
+pub use effective_radius::LeadTilt;
+pub use error::CamError;
+pub use strategy::{plan, FeedDirection, Plan, Settings, StrategyKind, ToolAxis};
 pub use toolpath::{CutterLocation, Pass, ToolPath};
