@@ -118,6 +118,23 @@ pub fn cylinder(radius: f64, length: f64, outside: bool) -> NurbsSurface {
     NurbsSurface::new(2, 1, &pts, &ws, clamped(2, &[]), clamped(1, &[])).expect("valid cylinder")
 }
 
+/// A trough: the bottom quarter of a cylinder of `radius` about the y axis (angles 225°…315°),
+/// `length` along y, normal pointing up toward the axis — concave across x for a tool from
+/// above, as a 3-axis machine sees it.
+pub fn trough(radius: f64, length: f64) -> NurbsSurface {
+    let q = std::f64::consts::FRAC_PI_4;
+    let (p, w) = arc(radius, 5.0 * q, 7.0 * q);
+    let mut pts = Vec::new();
+    let mut ws = Vec::new();
+    for (pp, ww) in p.iter().zip(w) {
+        for y in [0.0, length] {
+            pts.push(Vec3::new(pp[0], y, pp[1]));
+            ws.push(ww);
+        }
+    }
+    NurbsSurface::new(2, 1, &pts, &ws, clamped(2, &[]), clamped(1, &[])).expect("valid trough")
+}
+
 /// A sphere patch of `radius` about the origin: latitudes 10°…60°, longitudes 0°…90°, as
 /// the revolution of a rational quadratic arc (P&T §8.5), normal pointing outward.
 pub fn sphere(radius: f64) -> NurbsSurface {
@@ -202,6 +219,10 @@ mod tests {
                 assert!((p.z - (p.x * p.x - p.y * p.y) / 80.0).abs() < 1e-12);
             }
         }
+        let t = trough(20.0, 50.0);
+        let p = t.point(0.5, 0.5);
+        assert!((p - Vec3::new(0.0, 25.0, -20.0)).norm() < 1e-12);
+        assert!((t.normal(0.5, 0.5).unwrap().into_inner() - Vec3::z()).norm() < 1e-12);
         let trough = cylinder(20.0, 50.0, false);
         let p = trough.point(0.3, 0.4);
         let n = trough.normal(0.3, 0.4).unwrap();

@@ -38,18 +38,10 @@ pub fn cylinders(cutter: &Cutter) -> Vec<(ToolPart, Cylinder)> {
         (ToolPart::Shank, cutter.shank),
         (ToolPart::Holder, cutter.holder),
     ] {
-        // The part of a cylinder inside the checked cutting end is the cutting end's job.
-        let from = c.from.max(end);
-        let length = c.from + c.length - from;
-        if length > 0.0 && c.radius > 0.0 {
-            parts.push((
-                part,
-                Cylinder {
-                    radius: c.radius,
-                    from,
-                    length,
-                },
-            ));
+        // Whole, even where it overlaps the checked cutting end: a holder wider than the
+        // tool can sit lower than two radii on a stubby tool.
+        if c.length > 0.0 && c.radius > 0.0 {
+            parts.push((part, c));
         }
     }
     parts

@@ -25,6 +25,11 @@ struct FrontPoint {
     repeat: bool,
 }
 
+/// Relative excess of the gap between fronts over the allowed step tolerated before
+/// [`pull_back`] moves a point.
+const PULL_BACK_SLACK: f64 = 0.002;
+/// Front points on either side used for the front's tangent.
+const TANGENT_STENCIL: usize = 3;
 /// Root-search iterations for one offset (bracketed, so the bound only stops a stall).
 const OFFSET_ITERATIONS: usize = 40;
 
@@ -99,9 +104,15 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
     let axes = ctx.axes;
     let n = front.len();
     let mut next = Vec::with_capacity(n + 8);
+    let mut steps = Vec::with_capacity(n);
     for i in 0..n {
         let p = front[i];
-        let (a, b) = (front[i.saturating_sub(1)], front[(i + 1).min(n - 1)]);
+        // A wide stencil: the side direction follows the front's course, not the jitter of
+        // neighbouring points (their offsets would amplify it, pass after pass).
+        let (a, b) = (
+            front[i.saturating_sub(TANGENT_STENCIL)],
+            front[(i + TANGENT_STENCIL).min(n - 1)],
+        );
         let tangent = axes.uv(b.s - a.s, b.f - a.f);
         let (u, v) = axes.uv(p.s, p.f);
         let local = ctx
@@ -116,6 +127,7 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
         let (dir_s, dir_f) = cross_direction(ctx, &local, p);
         let moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
         next.push(moved);
+        steps.push(w);
     }
     // The feed parameter must increase along the front: a point that falls back (where the
     // front folds over itself near a converging region) is dropped.
@@ -145,7 +157,55 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
             });
         }
     }
-    Ok(densify(ctx, clean, guide))
+    let mut dense = densify(ctx, clean, guide);
+    pull_back(ctx, front, &steps, &mut dense);
+    Ok(dense)
+}
+
+/// Where the new front runs farther from the old one than the side step allowed there (the
+/// offsets of a front with a corner fan out ahead of it, and dropping the points that fold
+/// back shortcuts the corner), its points are moved back toward their nearest old point until
+/// the distance is the allowed step: the scallop between two passes is set by the gap
+/// between them, wherever it is measured from.
+fn pull_back(ctx: &Context, old: &[FrontPoint], steps: &[f64], new: &mut [FrontPoint]) {
+    let axes = ctx.axes;
+    let xyz = |s: f64, f: f64| {
+        let (u, v) = axes.uv(s, f);
+        ctx.surface.point(u, v)
+    };
+    let old_xyz: Vec<Vec3> = old.iter().map(|p| xyz(p.s, p.f)).collect();
+    for q in new.iter_mut().filter(|q| !q.edge) {
+        for _ in 0..3 {
+            let here = xyz(q.s, q.f);
+            // Nearest point of the old front's polyline, with its parameters and allowed step.
+            let mut best = (f64::INFINITY, 0.0, 0.0, 0.0);
+            for k in 0..old.len().saturating_sub(1) {
+                let (a, b) = (old_xyz[k], old_xyz[k + 1]);
+                let ab = b - a;
+                let len2 = ab.norm_squared();
+                let x = if len2 > 0.0 {
+                    ((here - a).dot(&ab) / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let d = (here - (a + ab * x)).norm();
+                if d < best.0 {
+                    let (s, f) = (
+                        old[k].s + (old[k + 1].s - old[k].s) * x,
+                        old[k].f + (old[k + 1].f - old[k].f) * x,
+                    );
+                    best = (d, s, f, steps[k] + (steps[k + 1] - steps[k]) * x);
+                }
+            }
+            let (d, s, f, w) = best;
+            if !(d > w * (1.0 + PULL_BACK_SLACK)) {
+                break;
+            }
+            let x = w / d;
+            q.s = s + (q.s - s) * x;
+            q.f = f + (q.f - f) * x;
+        }
+    }
 }
 
 /// The cross-feed direction `t` at `p` in (side, feed) parameters, oriented toward the far
