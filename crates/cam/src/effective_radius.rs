@@ -118,7 +118,7 @@ impl CutterShape {
     pub fn matching_lead(&self, radius: f64) -> Option<f64> {
         let (big_r, r) = (self.radius(), self.corner_radius());
         let r0 = big_r - r;
-        if !(radius > r) {
+        if radius.is_nan() || radius <= r {
             return None;
         }
         if r0 <= 0.0 {

@@ -55,7 +55,7 @@ const PLANE: f64 = 1e-12;
 /// cutter (`κ r_e ≥ 1`: local gouge); `Some(f64::INFINITY)` where the cusp never reaches `h`
 /// (a concave section matched closely by the cutter) — the caller caps it.
 pub fn stepover_exact(r_e: f64, kappa: f64, h: f64) -> Option<f64> {
-    if !(h > 0.0 && h < r_e) || !kappa.is_finite() {
+    if !(h > 0.0 && h < r_e && kappa.is_finite()) {
         return None;
     }
     if r_e.is_infinite() {
@@ -156,7 +156,10 @@ mod tests {
         // A ball r = 3 inside a cylinder bore of radius 20 (concave) and on its outside
         // (convex): the cusp between contact points at angles ±θ, from plane geometry.
         let (r, rho, h) = (3.0, 20.0, 0.01);
-        for (kappa, oc, op) in [(1.0 / rho, rho - r, rho - h), (-1.0 / rho, rho + r, rho + h)] {
+        for (kappa, oc, op) in [
+            (1.0 / rho, rho - r, rho - h),
+            (-1.0 / rho, rho + r, rho + h),
+        ] {
             let w = stepover_exact(r, kappa, h).unwrap();
             let theta = (w / (2.0 * rho)).asin();
             // Law of cosines in O, C, P: |CP|² = |OC|² + |OP|² − 2|OC||OP| cos θ.

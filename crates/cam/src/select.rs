@@ -85,7 +85,9 @@ pub fn propose(
             .iter()
             .copied()
             .filter(|d| fits(*d))
-            .fold(None, |best: Option<f64>, d| Some(best.map_or(d, |b| b.max(d))))
+            .fold(None, |best: Option<f64>, d| {
+                Some(best.map_or(d, |b| b.max(d)))
+            })
     };
     match concave_radius {
         None => {
@@ -135,13 +137,22 @@ mod tests {
         // T2: ρ = 100 → r = 34.20 (D ≈ 68, impractical: the set's largest is proposed).
         assert!((max_flat_radius(100.0, 20.0) - 34.202_014_332_566_87).abs() < 1e-12);
         assert_eq!(
-            propose(Some(100.0), &THESIS_SET, 20.0).unwrap().flat.unwrap().diameter,
+            propose(Some(100.0), &THESIS_SET, 20.0)
+                .unwrap()
+                .flat
+                .unwrap()
+                .diameter,
             20.0
         );
         // T3 (EK-B): min concave 26.0544985816258 → ball D < 52.11, flat D = 16 at
         // 17.8814613349°.
         let rho = 26.054_498_581_625_8;
-        let p = propose(Some(rho), &[6.0, 10.0, 12.0, 16.0, 20.0, 50.0, 52.0, 60.0], 20.0).unwrap();
+        let p = propose(
+            Some(rho),
+            &[6.0, 10.0, 12.0, 16.0, 20.0, 50.0, 52.0, 60.0],
+            20.0,
+        )
+        .unwrap();
         assert_eq!(p.ball, Some(52.0));
         let flat = p.flat.unwrap();
         assert_eq!(flat.diameter, 16.0);
@@ -154,7 +165,10 @@ mod tests {
         let r = tightest_concave_radius(&testing::cylinder(20.0, 50.0, false), 8, false).unwrap();
         assert!((r - 20.0).abs() < 1e-9, "{r}");
         // The roller is convex: nothing concave, unless machined from inside.
-        assert_eq!(tightest_concave_radius(&testing::cylinder(20.0, 50.0, true), 8, false), None);
+        assert_eq!(
+            tightest_concave_radius(&testing::cylinder(20.0, 50.0, true), 8, false),
+            None
+        );
         let r = tightest_concave_radius(&testing::sphere(30.0), 8, true).unwrap();
         assert!((r - 30.0).abs() < 1e-9, "{r}");
         // Saddle z = (x² − y²)/80 over [−50, 50]²: the sharpest concave curvature is at the

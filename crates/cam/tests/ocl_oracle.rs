@@ -40,13 +40,21 @@ fn triangulate(s: &NurbsSurface) -> (Vec<f64>, f64) {
     let mut sag = 0.0f64;
     for i in 0..N {
         for j in 0..N {
-            for corners in [[(i, j), (i + 1, j), (i + 1, j + 1)], [(i, j), (i + 1, j + 1), (i, j + 1)]] {
+            for corners in [
+                [(i, j), (i + 1, j), (i + 1, j + 1)],
+                [(i, j), (i + 1, j + 1), (i, j + 1)],
+            ] {
                 let pts: Vec<Vec3> = corners.iter().map(|&(a, b)| p(a, b)).collect();
                 for q in &pts {
                     tris.extend_from_slice(&[q.x, q.y, q.z]);
                 }
                 let uvs: Vec<(f64, f64)> = corners.iter().map(|&(a, b)| uv(a, b)).collect();
-                for w in [[1.0 / 3.0; 3], [0.5, 0.5, 0.0], [0.0, 0.5, 0.5], [0.5, 0.0, 0.5]] {
+                for w in [
+                    [1.0 / 3.0; 3],
+                    [0.5, 0.5, 0.0],
+                    [0.0, 0.5, 0.5],
+                    [0.5, 0.0, 0.5],
+                ] {
                     let (u, v) = (
                         w[0] * uvs[0].0 + w[1] * uvs[1].0 + w[2] * uvs[2].0,
                         w[0] * uvs[0].1 + w[1] * uvs[1].1 + w[2] * uvs[2].1,

@@ -35,9 +35,8 @@ fn distance_to_polyline(p: &Vec3, pass: &Pass) -> f64 {
 /// spaces slanted passes closer there (never farther).
 fn spacing(passes: &[Pass]) -> (f64, f64, f64) {
     let (mut lo, mut hi, mut sum, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
-    let inner = |cl: &&tezgah_cam::CutterLocation| {
-        cl.uv.0 <= 0.8 && (0.05..=0.95).contains(&cl.uv.1)
-    };
+    let inner =
+        |cl: &&tezgah_cam::CutterLocation| cl.uv.0 <= 0.8 && (0.05..=0.95).contains(&cl.uv.1);
     for k in 0..passes.len().saturating_sub(1) {
         for cl in passes[k].points.iter().filter(inner) {
             let d = distance_to_polyline(&cl.contact, &passes[k + 1]);
@@ -64,7 +63,10 @@ fn iso_scallop_spacing_on_a_sphere_is_the_closed_form() {
     println!("sphere: ω = {want:.5}, measured {lo:.5} … {hi:.5} (mean {mean:.5})");
     // The distance to the next pass's polyline of contacts is the perpendicular one; the
     // contacts lie on the surface, the polyline cuts the chord by ≤ the tolerance.
-    assert!(hi <= want * 1.01 && lo >= want * 0.97, "{lo} {hi} vs {want}");
+    assert!(
+        hi <= want * 1.01 && lo >= want * 0.97,
+        "{lo} {hi} vs {want}"
+    );
 }
 
 #[test]
@@ -88,7 +90,10 @@ fn iso_parametric_step_on_a_cylinder_is_the_closed_form() {
     )
     .unwrap();
     let (lo, hi, _) = spacing(&q.path.passes);
-    assert!(lo >= want * 0.98 && hi <= want * 1.01, "{lo} {hi} vs {want}");
+    assert!(
+        lo >= want * 0.98 && hi <= want * 1.01,
+        "{lo} {hi} vs {want}"
+    );
     assert!(q.path.passes.len() < p.path.passes.len());
 }
 
@@ -124,7 +129,11 @@ fn compare(name: &str, s: &NurbsSurface, cutter: &Cutter, h: f64) -> f64 {
     for kind in [StrategyKind::ZigZag, StrategyKind::IsoScallop] {
         let settings = Settings::new(kind, h, 0.01);
         let p = plan(s, cutter, &settings).unwrap();
-        assert!(p.refused.is_empty(), "{name} {kind}: {:?}", p.refused.first());
+        assert!(
+            p.refused.is_empty(),
+            "{name} {kind}: {:?}",
+            p.refused.first()
+        );
         let worst = worst_spacing_ratio(s, &p.path.passes, cutter.shape.radius(), h);
         println!("{name} {kind}: largest spacing / local allowed step = {worst:.4}");
         // ≤ 3 % over the allowed step (≈ 6 % over h, scallop ∝ ω²): the front is linear in
@@ -206,7 +215,9 @@ fn flat_end_in_a_trough_is_curvature_matched_and_rear_gouges_are_corrected() {
     settings.direction = FeedDirection::AlongV;
     let p = plan(&s, &flat, &settings).unwrap();
     assert!(p.refused.is_empty(), "{:?}", p.refused.first());
-    let lean = p.path.passes[0].points[0].axis.dot(&p.path.passes[0].points[0].normal);
+    let lean = p.path.passes[0].points[0]
+        .axis
+        .dot(&p.path.passes[0].points[0].normal);
     let want = (5.0f64 / (0.95 * 20.0)).asin().cos();
     assert!((lean - want).abs() < 1e-9, "{lean} vs {want}");
     assert!(worst_penetration(&s, &p) < 0.002 + 1e-3);
@@ -239,7 +250,10 @@ fn flat_end_in_a_trough_is_curvature_matched_and_rear_gouges_are_corrected() {
     assert!(p.refused.is_empty(), "{:?}", p.refused.first());
     assert!(p.corrected > 0);
     let worst = worst_penetration(&s, &p);
-    println!("trough across, corrected {} points, worst penetration {worst:.4} mm", p.corrected);
+    println!(
+        "trough across, corrected {} points, worst penetration {worst:.4} mm",
+        p.corrected
+    );
     assert!(worst < 0.002 + 1e-3, "{worst}");
 }
 
@@ -283,7 +297,12 @@ fn bad_settings_are_errors() {
     let mut settings = Settings::new(StrategyKind::IsoScallop, 0.01, 0.01);
     settings.axis = ToolAxis::Fixed(Vec3::zeros());
     assert!(plan(&s, &ball(6.0), &settings).is_err());
-    let step = iso_parametric_side_step(&s, &ball(6.0), &Settings::new(StrategyKind::ZigZag, 0.01, 0.01)).unwrap();
+    let step = iso_parametric_side_step(
+        &s,
+        &ball(6.0),
+        &Settings::new(StrategyKind::ZigZag, 0.01, 0.01),
+    )
+    .unwrap();
     // Plane 10 mm across in u ∈ [0, 1]: Δu = 2√(2rh − h²) / 10.
     assert!((step - 2.0 * (0.06f64 - 1e-4).sqrt() / 10.0).abs() < 1e-12);
 }

@@ -76,7 +76,11 @@ impl PointGrid {
             (lo, hi) = (Vec3::zeros(), Vec3::zeros());
         }
         let extent = hi - lo;
-        let mut cell = if cell.is_finite() && cell > 0.0 { cell } else { 1.0 };
+        let mut cell = if cell.is_finite() && cell > 0.0 {
+            cell
+        } else {
+            1.0
+        };
         let dims = loop {
             let d = [0, 1, 2].map(|k| (extent[k] / cell).floor() as usize + 1);
             if d[0] * d[1] * d[2] <= MAX_CELLS {

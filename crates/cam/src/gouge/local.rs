@@ -27,7 +27,7 @@ pub fn surface_curvature(d: &SurfaceDerivs, frame: &ContactFrame) -> Option<Curv
     let n = frame.normal.into_inner();
     let (e, f, g) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
     let det = e * g - f * f;
-    if !(det > 0.0) {
+    if det.is_nan() || det <= 0.0 {
         return None;
     }
     let to_uv = |w: &Vec3| {
@@ -35,9 +35,8 @@ pub fn surface_curvature(d: &SurfaceDerivs, frame: &ContactFrame) -> Option<Curv
         ((g * a - f * b) / det, (e * b - f * a) / det)
     };
     let (l, m, nn) = (d.suu.dot(&n), d.suv.dot(&n), d.svv.dot(&n));
-    let ii = |x: (f64, f64), y: (f64, f64)| {
-        l * x.0 * y.0 + m * (x.0 * y.1 + x.1 * y.0) + nn * x.1 * y.1
-    };
+    let ii =
+        |x: (f64, f64), y: (f64, f64)| l * x.0 * y.0 + m * (x.0 * y.1 + x.1 * y.0) + nn * x.1 * y.1;
     let (xf, xt) = (to_uv(&frame.feed), to_uv(&frame.cross));
     Some(Curvature2 {
         ff: ii(xf, xf),
@@ -102,7 +101,10 @@ mod tests {
         let n = s.normal(0.5, 0.5).unwrap();
         let frame = ContactFrame::new(n, d.sv).unwrap();
         let k = surface_curvature(&d, &frame).unwrap();
-        assert!((k.tt - 1.0 / 20.0).abs() < 1e-9 && k.ff.abs() < 1e-9, "{k:?}");
+        assert!(
+            (k.tt - 1.0 / 20.0).abs() < 1e-9 && k.ff.abs() < 1e-9,
+            "{k:?}"
+        );
         let a = frame.axis(LeadTilt::default());
         let m = |shape: CutterShape, a| local_margin(&shape, &frame, &a, &k);
         assert!(m(CutterShape::Ball { radius: 25.0 }, a) < 0.0);

@@ -34,7 +34,11 @@ pub enum Gouge {
     /// point; `margin` is the most negative eigenvalue of `K_cutter − K_surface` (1/mm).
     Local { margin: f64 },
     /// A surface point lies `depth` mm inside the given part of the tool.
-    Interference { part: ToolPart, depth: f64, point: Vec3 },
+    Interference {
+        part: ToolPart,
+        depth: f64,
+        point: Vec3,
+    },
 }
 
 /// Settings of the rear and global checks.

@@ -124,7 +124,7 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
             crate::scallop::stepover_exact(ctx.shape().radius(), 0.0, ctx.settings.scallop)
                 .unwrap_or(ctx.settings.scallop)
         });
-        let (dir_s, dir_f) = cross_direction(ctx, &local, p);
+        let (dir_s, dir_f) = cross_direction(ctx, &local);
         let moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
         next.push(moved);
         steps.push(w);
@@ -198,7 +198,7 @@ fn pull_back(ctx: &Context, old: &[FrontPoint], steps: &[f64], new: &mut [FrontP
                 }
             }
             let (d, s, f, w) = best;
-            if !(d > w * (1.0 + PULL_BACK_SLACK)) {
+            if d.is_nan() || d <= w * (1.0 + PULL_BACK_SLACK) {
                 break;
             }
             let x = w / d;
@@ -208,9 +208,9 @@ fn pull_back(ctx: &Context, old: &[FrontPoint], steps: &[f64], new: &mut [FrontP
     }
 }
 
-/// The cross-feed direction `t` at `p` in (side, feed) parameters, oriented toward the far
+/// The cross-feed direction `t` at a front point in (side, feed) parameters, oriented toward the far
 /// side; pure `+s` where `t` has no side component.
-fn cross_direction(ctx: &Context, local: &super::Local, p: FrontPoint) -> (f64, f64) {
+fn cross_direction(ctx: &Context, local: &super::Local) -> (f64, f64) {
     let d = &local.d;
     let t = local.frame.cross.into_inner();
     let (e, f, g) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
@@ -221,9 +221,8 @@ fn cross_direction(ctx: &Context, local: &super::Local, p: FrontPoint) -> (f64, 
     if ds < 0.0 {
         (ds, df) = (-ds, -df);
     }
-    if !(ds > 1e-12 * (ds.abs() + df.abs())) || !ds.is_finite() || !df.is_finite() {
+    if !(ds.is_finite() && df.is_finite()) || ds <= 1e-12 * (ds.abs() + df.abs()) {
         let ss = if ctx.axes.along_v { d.su } else { d.sv };
-        let _ = p;
         return (1.0 / ss.norm().max(1e-300), 0.0);
     }
     (ds, df)
@@ -253,7 +252,7 @@ fn offset(ctx: &Context, p: FrontPoint, dir: (f64, f64), origin: &Vec3, w: f64) 
             repeat: p.edge,
         }
     };
-    if !(to_edge > 0.0) {
+    if to_edge.is_nan() || to_edge <= 0.0 {
         return edge_point(0.0);
     }
     let g_edge = dist(to_edge);

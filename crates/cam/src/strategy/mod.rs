@@ -198,7 +198,11 @@ pub struct Plan {
 /// Plans a finishing tool path of `cutter` over `surface` (the public entry of the CAM
 /// strategies). Errors are bad settings or cutter, or a search that failed; gouges are not
 /// errors but corrected (5-axis) or listed in [`Plan::refused`] with their pass split there.
-pub fn plan(surface: &NurbsSurface, cutter: &Cutter, settings: &Settings) -> Result<Plan, CamError> {
+pub fn plan(
+    surface: &NurbsSurface,
+    cutter: &Cutter,
+    settings: &Settings,
+) -> Result<Plan, CamError> {
     settings.validate()?;
     validate_cutter(cutter)?;
     let ctx = Context::new(surface, cutter, settings)?;
@@ -236,9 +240,11 @@ fn validate_cutter(cutter: &Cutter) -> Result<(), CamError> {
         && r >= 0.0
         && r <= big_r
         && cutter.flute_length.is_finite()
-        && [cutter.shank, cutter.holder]
-            .iter()
-            .all(|c| [c.radius, c.from, c.length].iter().all(|x| x.is_finite() && *x >= 0.0));
+        && [cutter.shank, cutter.holder].iter().all(|c| {
+            [c.radius, c.from, c.length]
+                .iter()
+                .all(|x| x.is_finite() && *x >= 0.0)
+        });
     if ok {
         Ok(())
     } else {
@@ -388,8 +394,7 @@ impl<'a> Context<'a> {
                 let mut lead = lead_deg.to_radians();
                 let max_lead = max_lead_deg.to_radians();
                 let k = local.curvature.tt;
-                if match_curvature && k > 0.0 && !matches!(self.shape(), CutterShape::Ball { .. })
-                {
+                if match_curvature && k > 0.0 && !matches!(self.shape(), CutterShape::Ball { .. }) {
                     let need = self
                         .shape()
                         .matching_lead((1.0 - MATCH_MARGIN) / k)
@@ -418,7 +423,12 @@ impl<'a> Context<'a> {
 
     /// Places the cutter at the contact `(u, v)` on a path running along `tangent_uv`, leaning
     /// it further while it gouges (5-axis). `Ok((location, corrected))` or the refusal.
-    fn place(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Result<(CutterLocation, bool), GougeReport> {
+    fn place(
+        &self,
+        u: f64,
+        v: f64,
+        tangent_uv: (f64, f64),
+    ) -> Result<(CutterLocation, bool), GougeReport> {
         let contact = self.surface.point(u, v);
         let refuse = |refusal| GougeReport {
             uv: (u, v),
@@ -459,7 +469,8 @@ impl<'a> Context<'a> {
             match self.settings.axis {
                 ToolAxis::Surface { max_lead_deg, .. }
                     if !ball_local
-                        && angles.lead.to_degrees() + CORRECTION_STEP_DEG <= max_lead_deg + 1e-9 =>
+                        && angles.lead.to_degrees() + CORRECTION_STEP_DEG
+                            <= max_lead_deg + 1e-9 =>
                 {
                     angles.lead += CORRECTION_STEP_DEG.to_radians();
                     corrected = true;
