@@ -61,7 +61,13 @@ impl SurfacePath for UvPolyline {
         (0.0, self.points.len().saturating_sub(1) as f64)
     }
     fn uv(&self, t: f64) -> (f64, f64) {
-        let last = self.points.len().saturating_sub(1);
+        let Some(&first) = self.points.first() else {
+            return (0.0, 0.0);
+        };
+        if t.is_nan() {
+            return first;
+        }
+        let last = self.points.len() - 1;
         let t = t.clamp(0.0, last as f64);
         let i = (t.floor() as usize).min(last.saturating_sub(1));
         let s = t - i as f64;
@@ -124,6 +130,12 @@ pub fn chord_error(surface: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb:
     worst.max(f1).max(f2)
 }
 
+/// The chord of a circle of radius `rho` whose sagitta is `eps`: `λ = 2√(2ρε − ε²)` (001
+/// Eq. 3.22, Choi 1991) — the forward step on a path of constant curvature.
+pub fn chord_for_sagitta(rho: f64, eps: f64) -> f64 {
+    2.0 * (2.0 * rho * eps - eps * eps).max(0.0).sqrt()
+}
+
 /// Contact-point parameters along `path` from its start to its end such that every chord's
 /// [`chord_error`] is at most `tolerance` and every chord is at most `max_step` long (mm).
 /// Both ends are included. `first_guess` is the parameter step to try first (e.g. the last
@@ -135,9 +147,11 @@ pub fn forward_steps(
     max_step: f64,
     first_guess: Option<f64>,
 ) -> Result<Vec<f64>, CamError> {
+    crate::error::positive("tolerance", tolerance)?;
+    crate::error::positive("max_step", max_step)?;
     let (t0, t1) = path.range();
     let mut ts = vec![t0];
-    if t1 <= t0 {
+    if !(t0.is_finite() && t1.is_finite()) || t1 <= t0 {
         return Ok(ts);
     }
     let span = t1 - t0;
@@ -264,6 +278,38 @@ mod tests {
             // Not wastefully dense either: the steps use at least half the tolerance.
             assert!(ts.len() < 40, "ε = {eps}: {} points", ts.len());
         }
+    }
+
+    #[test]
+    fn chord_error_on_a_circle_is_the_sagitta() {
+        // 001 §5.3 T8: ρ = 100, ε = 0.05 → λ = 6.3238 mm.
+        assert!((chord_for_sagitta(100.0, 0.05) - 6.3238).abs() < 5e-5);
+        // On a roller of radius 100 (an exact rational arc across u), two points a chord λ
+        // apart deviate from the arc by exactly ε in the middle.
+        let s = testing::cylinder(100.0, 10.0, true);
+        let path = IsoLine {
+            fixed: 0.5,
+            along_v: false,
+            start: 0.0,
+            end: 1.0,
+        };
+        let a = at(&s, &path, 0.3);
+        // Find tb with |P(tb) − P(0.3)| = λ by bisection.
+        let lambda = chord_for_sagitta(100.0, 0.05);
+        let (mut lo, mut hi) = (0.3, 1.0);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if (at(&s, &path, mid) - a).norm() < lambda {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let err = chord_error(&s, &path, 0.3, lo);
+        assert!((err - 0.05).abs() < 1e-9, "{err}");
+        assert!(forward_steps(&s, &path, f64::NAN, 1.0, None).is_err());
+        assert!(forward_steps(&s, &path, 0.01, -1.0, None).is_err());
+        assert_eq!(UvPolyline { points: vec![] }.uv(0.5), (0.0, 0.0));
     }
 
     #[test]

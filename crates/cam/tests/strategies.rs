@@ -306,3 +306,32 @@ fn bad_settings_are_errors() {
     // Plane 10 mm across in u ∈ [0, 1]: Δu = 2√(2rh − h²) / 10.
     assert!((step - 2.0 * (0.06f64 - 1e-4).sqrt() / 10.0).abs() < 1e-12);
 }
+
+#[test]
+fn random_surfaces_and_cutters_plan_without_failing() {
+    // Wavy patches with steep and tight spots: every plan succeeds, every emitted location is
+    // finite with a unit axis on the normal's side, and whatever gouges is listed.
+    for seed in 0..3u64 {
+        let s = testing::random_bicubic(seed);
+        for (spec, kind) in [
+            ("ball:6", StrategyKind::IsoScallop),
+            ("flat:10", StrategyKind::ZigZag),
+            ("bull:10:2", StrategyKind::ZigZagOneWay),
+        ] {
+            let cutter = Cutter::standard(spec.parse().unwrap());
+            let p = plan(&s, &cutter, &Settings::new(kind, 0.1, 0.02)).unwrap();
+            assert!(p.path.contact_count() > 0, "{seed} {spec}");
+            for cl in p.path.passes.iter().flat_map(|p| &p.points) {
+                assert!(cl.tip.iter().all(|x| x.is_finite()));
+                assert!((cl.axis.norm() - 1.0).abs() < 1e-12);
+                assert!(cl.axis.dot(&cl.normal) > 0.0);
+            }
+            println!(
+                "seed {seed} {spec} {kind}: {} points, {} refused, {} corrected",
+                p.path.contact_count(),
+                p.refused.len(),
+                p.corrected
+            );
+        }
+    }
+}

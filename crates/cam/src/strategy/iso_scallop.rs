@@ -105,6 +105,7 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
     let n = front.len();
     let mut next = Vec::with_capacity(n + 8);
     let mut steps = Vec::with_capacity(n);
+    let mut kept = Vec::with_capacity(n);
     for i in 0..n {
         let p = front[i];
         // A wide stencil: the side direction follows the front's course, not the jitter of
@@ -115,9 +116,10 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
         );
         let tangent = axes.uv(b.s - a.s, b.f - a.f);
         let (u, v) = axes.uv(p.s, p.f);
-        let local = ctx
-            .local(u, v, tangent)
-            .ok_or(CamError::Degenerate { u, v })?;
+        // No normal here (a pole): the point drops out and its neighbours fill the gap.
+        let Some(local) = ctx.local(u, v, tangent) else {
+            continue;
+        };
         // Where the cutter gouges locally the placement refuses the point anyway; step by the
         // plane's value so the front moves on.
         let w = ctx.side_step(&local).unwrap_or_else(|| {
@@ -128,6 +130,11 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
         let moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
         next.push(moved);
         steps.push(w);
+        kept.push(p);
+    }
+    if next.is_empty() {
+        let (u, v) = axes.uv(front[0].s, front[0].f);
+        return Err(CamError::Degenerate { u, v });
     }
     // The feed parameter must increase along the front: a point that falls back (where the
     // front folds over itself near a converging region) is dropped.
@@ -158,7 +165,7 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
         }
     }
     let mut dense = densify(ctx, clean, guide);
-    pull_back(ctx, front, &steps, &mut dense);
+    pull_back(ctx, &kept, &steps, &mut dense);
     Ok(dense)
 }
 
