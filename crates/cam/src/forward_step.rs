@@ -274,6 +274,10 @@ mod tests {
         for eps in [0.05, 0.02, 0.01] {
             let ts = forward_steps(&s, &path, eps, 1e3, None).unwrap();
             let dev = dense_error(&s, &path, &ts);
+            println!(
+                "001 boundary curve, ε = {eps}: {} points, true deviation {dev:.5}",
+                ts.len()
+            );
             assert!(dev <= eps * 1.0001, "ε = {eps}: {dev}");
             // Not wastefully dense either: the steps use at least half the tolerance.
             assert!(ts.len() < 40, "ε = {eps}: {} points", ts.len());

@@ -95,6 +95,19 @@ fn iso_parametric_step_on_a_cylinder_is_the_closed_form() {
         "{lo} {hi} vs {want}"
     );
     assert!(q.path.passes.len() < p.path.passes.len());
+    // The same quarter cylinder parametrised with its normal toward the axis, machined from
+    // outside (`reverse_normal`): the same convex section, the same spacing.
+    let inner = testing::cylinder(20.0, 60.0, false);
+    let mut settings = Settings::new(StrategyKind::IsoScallop, h, 0.005);
+    settings.reverse_normal = true;
+    let r = plan(&inner, &ball(6.0), &settings).unwrap();
+    assert!(r.refused.is_empty());
+    let (lo, hi, _) = spacing(&r.path.passes);
+    assert!(
+        lo >= want * 0.98 && hi <= want * 1.01,
+        "{lo} {hi} vs {want}"
+    );
+    assert_eq!(r.path.passes.len(), q.path.passes.len());
 }
 
 /// The largest ratio, over inner contacts, of the distance to the next pass and the side step

@@ -527,3 +527,40 @@ impl<'a> Context<'a> {
         Ok(out)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strategy_names_round_trip_and_bad_ones_are_refused() {
+        for name in ["zigzag", "zigzag-oneway", "iso-scallop"] {
+            assert_eq!(name.parse::<StrategyKind>().unwrap().to_string(), name);
+        }
+        assert!("spiral".parse::<StrategyKind>().is_err());
+    }
+
+    #[test]
+    fn settings_out_of_range_are_refused() {
+        let base = Settings::new(StrategyKind::ZigZag, 0.01, 0.01);
+        assert!(base.validate().is_ok());
+        let mut s = base.clone();
+        s.max_step = 0.0;
+        assert!(s.validate().is_err());
+        for (lead, tilt, max) in [(-1.0, 0.0, 30.0), (10.0, 95.0, 30.0), (40.0, 0.0, 30.0)] {
+            let mut s = base.clone();
+            s.axis = ToolAxis::Surface {
+                lead_deg: lead,
+                tilt_deg: tilt,
+                max_lead_deg: max,
+                match_curvature: true,
+            };
+            assert!(s.validate().is_err(), "{lead} {tilt} {max}");
+        }
+        let mut s = base;
+        s.gouge.rear_spacing = f64::NAN;
+        let surface = crate::testing::plane(10.0);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 1.0 });
+        assert!(plan(&surface, &cutter, &s).is_err());
+    }
+}
