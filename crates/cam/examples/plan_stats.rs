@@ -1,7 +1,8 @@
 //! Plans the benchmark's case (100 × 100 mm free-form patch, 6 mm ball, h = 0.01 mm) with
 //! both strategies and prints the figures: passes, contact points, length, refusals, time.
 //!
-//! cargo run --release -p tezgah-cam --example plan_stats
+//! cargo run --release -p tezgah-cam --example plan_stats [STRATEGY]   (STRATEGY: only that one,
+//! gouge checks on — for timing it alone, e.g. under `time` for its CPU seconds)
 
 use std::time::Instant;
 
@@ -10,8 +11,20 @@ use tezgah_cam::{plan, testing, Cutter, CutterShape, Settings, StrategyKind};
 fn main() {
     let surface = testing::freeform(0.0);
     let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
-    for kind in [StrategyKind::ZigZag, StrategyKind::IsoScallop] {
-        for gouge in [true, false] {
+    let only: Option<StrategyKind> = std::env::args()
+        .nth(1)
+        .map(|a| a.parse().expect("strategy"));
+    let kinds = match only {
+        Some(k) => vec![k],
+        None => vec![StrategyKind::ZigZag, StrategyKind::IsoScallop],
+    };
+    let checks: &[bool] = if only.is_some() {
+        &[true]
+    } else {
+        &[true, false]
+    };
+    for kind in kinds {
+        for &gouge in checks {
             let mut settings = Settings::new(kind, 0.01, 0.01);
             settings.gouge.rear = gouge;
             settings.gouge.global = gouge;

@@ -92,23 +92,27 @@ pub fn boundary_curve_001() -> NurbsSurface {
     NurbsSurface::bspline(1, 3, &pts, clamped(1, &[]), kv).expect("valid 001 strip")
 }
 
-/// A 100 × 100 mm bicubic patch with a hill and a valley (curvature radii from ≈ 20 mm to
-/// flat, convex and concave), on a 7 × 7 control grid. `warp` > 0 spaces the control columns
-/// along x unevenly (`x = 100·s^(1+warp)`), as CAD parametrisations often are.
+/// A 100 × 100 mm bicubic patch with a hill and a valley (principal radii down to ≈ 46 mm
+/// convex and ≈ 60 mm concave), on a 7 × 7 control grid. The control points stand at the
+/// Greville abscissae of the knot vector, so with `warp = 0` the parametrisation is linear in
+/// x and y (B-spline linear precision) and only the slopes and curvature vary; `warp` > 0
+/// moves the columns to `x = 100·g^(1+warp)`, a distorted parametrisation as CAD often makes.
 pub fn freeform(warp: f64) -> NurbsSurface {
     let n = 7;
+    let k = clamped(3, &[0.25, 0.5, 0.75]);
+    let greville: Vec<f64> = (0..n)
+        .map(|i| (k[i + 1] + k[i + 2] + k[i + 3]) / 3.0)
+        .collect();
     let mut pts = Vec::with_capacity(n * n);
-    for i in 0..n {
-        let s = i as f64 / (n - 1) as f64;
-        let x = 100.0 * s.powf(1.0 + warp);
-        for j in 0..n {
-            let y = 100.0 * j as f64 / (n - 1) as f64;
+    for &gx in &greville {
+        let x = 100.0 * gx.powf(1.0 + warp);
+        for &gy in &greville {
+            let y = 100.0 * gy;
             let z = 9.0 * (std::f64::consts::PI * x / 60.0).sin() * (y / 45.0).cos()
                 + 6.0 * (-((x - 65.0).powi(2) + (y - 60.0).powi(2)) / 500.0).exp();
             pts.push(Vec3::new(x, y, z));
         }
     }
-    let k = clamped(3, &[0.25, 0.5, 0.75]);
     NurbsSurface::bspline(3, 3, &pts, k.clone(), k).expect("valid freeform")
 }
 
