@@ -348,3 +348,68 @@ fn random_surfaces_and_cutters_plan_without_failing() {
         }
     }
 }
+
+/// The material a ball path leaves above the surface, measured independently of the planner:
+/// at a surface point `q`, the cut surface lies `min_k dist(q, centre path) − R` above it (the
+/// ball centres move on straight segments between locations; 5-axis along the normal, so the
+/// centre is `tip + R·axis`). Returns the largest such height over a lattice of inner points.
+fn largest_residual(s: &NurbsSurface, p: &tezgah_cam::Plan, r: f64, lattice: usize) -> f64 {
+    let segments: Vec<(Vec3, Vec3)> = p
+        .path
+        .passes
+        .iter()
+        .flat_map(|pass| {
+            pass.points
+                .windows(2)
+                .map(|w| (w[0].tip + w[0].axis * r, w[1].tip + w[1].axis * r))
+        })
+        .collect();
+    let mut worst = 0.0f64;
+    for i in 0..=lattice {
+        for j in 0..=lattice {
+            // Inner points only: along the edges the first and last passes run on the boundary.
+            let (u, v) = (
+                0.05 + 0.9 * i as f64 / lattice as f64,
+                0.05 + 0.9 * j as f64 / lattice as f64,
+            );
+            let q = s.point(u, v);
+            let d = segments
+                .iter()
+                .map(|(a, b)| {
+                    let ab = b - a;
+                    let t = ((q - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                    (q - (a + ab * t)).norm()
+                })
+                .fold(f64::INFINITY, f64::min);
+            worst = worst.max(d - r);
+        }
+    }
+    worst
+}
+
+#[test]
+fn material_left_by_a_ball_path_is_the_target_scallop() {
+    // Free-form, ball D6, h = 0.05, tight chord tolerance so chords add little: the highest
+    // residual is the scallop itself — h for iso-scallop (everywhere), and at most h for
+    // zig-zag (at its binding point; less elsewhere).
+    let s = testing::freeform(0.0);
+    let h = 0.05;
+    for kind in [StrategyKind::IsoScallop, StrategyKind::ZigZag] {
+        let p = plan(&s, &ball(6.0), &Settings::new(kind, h, 0.002)).unwrap();
+        let worst = largest_residual(&s, &p, 3.0, 90);
+        println!("{kind}: largest residual {worst:.4} mm for h = {h}");
+        assert!(worst <= 1.06 * h + 0.002, "{kind}: {worst}");
+        assert!(worst >= 0.8 * h, "{kind}: {worst}");
+    }
+    // The saddle, where the iso-scallop front bends slightly on the centre line.
+    let s = testing::saddle(50.0, 40.0);
+    let p = plan(
+        &s,
+        &ball(6.0),
+        &Settings::new(StrategyKind::IsoScallop, h, 0.002),
+    )
+    .unwrap();
+    let worst = largest_residual(&s, &p, 3.0, 90);
+    println!("saddle iso-scallop: largest residual {worst:.4} mm for h = {h}");
+    assert!(worst <= 1.06 * h + 0.002 && worst >= 0.8 * h, "{worst}");
+}
