@@ -20,6 +20,8 @@ pub const CHORD_SAMPLES: usize = 16;
 const REFINE_ITERATIONS: usize = 12;
 /// Trials allowed for one forward step before the search is declared stalled.
 const MAX_TRIALS: usize = 60;
+/// Contact points allowed on one path.
+pub const MAX_POINTS: usize = 1_000_000;
 
 /// A curve on the surface: `t ↦ (u, v)` over `[start, end]`.
 pub trait SurfacePath {
@@ -209,6 +211,12 @@ pub fn forward_steps(
         };
         t = if t + step >= t1 { t1 } else { t + step };
         ts.push(t);
+        if ts.len() > MAX_POINTS {
+            return Err(CamError::TooLarge {
+                what: "contact points on one pass",
+                limit: MAX_POINTS,
+            });
+        }
         dt = step;
     }
     Ok(ts)

@@ -8,11 +8,14 @@ use tezgah_geom::{NurbsSurface, Vec3};
 
 /// Cells allowed in a grid; the cell grows when the surface's box would need more.
 const MAX_CELLS: usize = 1 << 22;
+/// Samples allowed per index (≈ 100 MB of points); more is refused rather than coarsened, so
+/// the check never silently loses resolution.
+pub const MAX_SAMPLES: usize = 4_000_000;
 
 /// Points sampled on the surface on a parametric lattice fine enough that neighbours are at
 /// most about `spacing` mm apart: the lattice counts come from the longest of a few iso
-/// lines' polygon lengths in each direction.
-pub fn sample_surface(surface: &NurbsSurface, spacing: f64) -> Vec<Vec3> {
+/// lines' polygon lengths in each direction. `None` when that would exceed [`MAX_SAMPLES`].
+pub fn sample_surface(surface: &NurbsSurface, spacing: f64) -> Option<Vec<Vec3>> {
     let (u0, u1) = surface.domain_u();
     let (v0, v1) = surface.domain_v();
     let probe = 48;
@@ -40,8 +43,13 @@ pub fn sample_surface(surface: &NurbsSurface, spacing: f64) -> Vec<Vec3> {
     };
     // The polygon underestimates a wiggly line's length; 1.2 and the speed's variation along
     // the line are covered by sampling each direction a little denser than needed.
-    let count = |len: f64| ((1.2 * len / spacing).ceil() as usize).clamp(2, 20_000);
+    let count = |len: f64| (1.2 * len / spacing).ceil().max(2.0);
     let (nu, nv) = (count(length(true)), count(length(false)));
+    let total = (nu + 1.0) * (nv + 1.0);
+    if total.is_nan() || total > MAX_SAMPLES as f64 {
+        return None;
+    }
+    let (nu, nv) = (nu as usize, nv as usize);
     let mut points = Vec::with_capacity((nu + 1) * (nv + 1));
     for i in 0..=nu {
         let u = u0 + (u1 - u0) * i as f64 / nu as f64;
@@ -49,7 +57,7 @@ pub fn sample_surface(surface: &NurbsSurface, spacing: f64) -> Vec<Vec3> {
             points.push(surface.point(u, v0 + (v1 - v0) * j as f64 / nv as f64));
         }
     }
-    points
+    Some(points)
 }
 
 /// Points bucketed in a uniform grid of cubic cells.
@@ -162,7 +170,8 @@ mod tests {
 
     #[test]
     fn box_queries_find_exactly_the_points_a_scan_finds() {
-        let pts = sample_surface(&crate::testing::freeform(0.3), 1.5);
+        let pts = sample_surface(&crate::testing::freeform(0.3), 1.5).unwrap();
+        assert!(sample_surface(&crate::testing::plane(1e5), 0.01).is_none());
         assert!(pts.len() > 4000);
         let grid = PointGrid::new(pts.clone(), 4.0);
         for (lo, hi) in [

@@ -87,18 +87,25 @@ impl GougeChecker {
         positive("gouge global_spacing", settings.global_spacing)?;
         positive("gouge depth_tolerance", settings.depth_tolerance)?;
         let r = cutter.shape.radius();
-        let fine = settings.rear.then(|| {
-            PointGrid::new(
-                index::sample_surface(surface, settings.rear_spacing),
-                2.0 * r,
-            )
-        });
-        let coarse = settings.global.then(|| {
-            PointGrid::new(
-                index::sample_surface(surface, settings.global_spacing),
+        let sample = |spacing| {
+            index::sample_surface(surface, spacing).ok_or(CamError::TooLarge {
+                what: "gouge-check samples (raise the gouge spacing)",
+                limit: index::MAX_SAMPLES,
+            })
+        };
+        let fine = if settings.rear {
+            Some(PointGrid::new(sample(settings.rear_spacing)?, 2.0 * r))
+        } else {
+            None
+        };
+        let coarse = if settings.global {
+            Some(PointGrid::new(
+                sample(settings.global_spacing)?,
                 (2.0 * r).max(4.0 * settings.global_spacing),
-            )
-        });
+            ))
+        } else {
+            None
+        };
         Ok(GougeChecker {
             cutter: *cutter,
             settings,
