@@ -7,7 +7,7 @@
 use tezgah_geom::{NurbsSurface, Vec3};
 
 /// Cells allowed in a grid; the cell grows when the surface's box would need more.
-const MAX_CELLS: usize = 1 << 22;
+pub const MAX_CELLS: usize = 1 << 22;
 /// Samples allowed per index (≈ 100 MB of points); more is refused rather than coarsened, so
 /// the check never silently loses resolution.
 pub const MAX_SAMPLES: usize = 4_000_000;
