@@ -413,3 +413,20 @@ fn material_left_by_a_ball_path_is_the_target_scallop() {
     println!("saddle iso-scallop: largest residual {worst:.4} mm for h = {h}");
     assert!(worst <= 1.06 * h + 0.002 && worst >= 0.8 * h, "{worst}");
 }
+
+#[test]
+fn one_way_and_two_way_zigzag_differ_only_in_direction() {
+    let s = testing::plane(40.0);
+    let run = |kind| plan(&s, &ball(6.0), &Settings::new(kind, 0.05, 0.01)).unwrap();
+    let (two, one) = (run(StrategyKind::ZigZag), run(StrategyKind::ZigZagOneWay));
+    assert_eq!(two.path.passes.len(), one.path.passes.len());
+    // Plane 40 mm wide, ball R 3, h 0.05: ω = 2√(2·3·0.05 − 0.05²) = 1.0909 → ⌈40/ω⌉ + 1 passes.
+    let w = 2.0 * (0.3f64 - 0.0025).sqrt();
+    assert_eq!(one.path.passes.len(), (40.0 / w).ceil() as usize + 1);
+    for (k, (a, b)) in two.path.passes.iter().zip(&one.path.passes).enumerate() {
+        assert_eq!(b.points[0].uv.1, 0.0, "one-way pass {k} starts at v = 0");
+        let start = if k % 2 == 0 { 0.0 } else { 1.0 };
+        assert_eq!(a.points[0].uv.1, start, "two-way pass {k}");
+        assert!((a.length() - 40.0).abs() < 1e-9 && (b.length() - 40.0).abs() < 1e-9);
+    }
+}
