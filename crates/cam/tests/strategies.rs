@@ -326,13 +326,21 @@ fn random_surfaces_and_cutters_plan_without_failing() {
     // finite with a unit axis on the normal's side, and whatever gouges is listed.
     for seed in 0..3u64 {
         let s = testing::random_bicubic(seed);
-        for (spec, kind) in [
-            ("ball:6", StrategyKind::IsoScallop),
-            ("flat:10", StrategyKind::ZigZag),
-            ("bull:10:2", StrategyKind::ZigZagOneWay),
+        for (spec, kind, lead, tilt) in [
+            ("ball:6", StrategyKind::IsoScallop, 0.0, 0.0),
+            ("flat:10", StrategyKind::ZigZag, 0.0, 0.0),
+            ("bull:10:2", StrategyKind::ZigZagOneWay, 0.0, 0.0),
+            ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
         ] {
             let cutter = Cutter::standard(spec.parse().unwrap());
-            let p = plan(&s, &cutter, &Settings::new(kind, 0.1, 0.02)).unwrap();
+            let mut settings = Settings::new(kind, 0.1, 0.02);
+            settings.axis = ToolAxis::Surface {
+                lead_deg: lead,
+                tilt_deg: tilt,
+                max_lead_deg: 30.0,
+                match_curvature: true,
+            };
+            let p = plan(&s, &cutter, &settings).unwrap();
             assert!(p.path.contact_count() > 0, "{seed} {spec}");
             for cl in p.path.passes.iter().flat_map(|p| &p.points) {
                 assert!(cl.tip.iter().all(|x| x.is_finite()));
@@ -401,6 +409,14 @@ fn material_left_by_a_ball_path_is_the_target_scallop() {
         assert!(worst <= 1.06 * h + 0.002, "{kind}: {worst}");
         assert!(worst >= 0.8 * h, "{kind}: {worst}");
     }
+    // Feeding along u on the warped patch (passes across the distorted parametrisation).
+    let s = testing::freeform(0.6);
+    let mut settings = Settings::new(StrategyKind::IsoScallop, h, 0.002);
+    settings.direction = FeedDirection::AlongU;
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    let worst = largest_residual(&s, &p, 3.0, 90);
+    println!("warped free-form along u, iso-scallop: largest residual {worst:.4} mm for h = {h}");
+    assert!(worst <= 1.06 * h + 0.002 && worst >= 0.8 * h, "{worst}");
     // The saddle, where the iso-scallop front bends slightly on the centre line.
     let s = testing::saddle(50.0, 40.0);
     let p = plan(
