@@ -118,7 +118,7 @@ impl GougeChecker {
     /// needs the contact's curvature and lives in [`local`]).
     pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {
         if let Some(grid) = &self.fine {
-            if let Some((depth, point)) = rear::deepest_penetration(
+            if let Some(rear::Penetration { depth, point }) = rear::first_penetration(
                 grid,
                 &self.cutter.shape,
                 tip,
@@ -144,13 +144,5 @@ impl GougeChecker {
             }
         }
         None
-    }
-
-    /// Number of indexed samples (rear, global).
-    pub fn sample_counts(&self) -> (usize, usize) {
-        (
-            self.fine.as_ref().map_or(0, PointGrid::len),
-            self.coarse.as_ref().map_or(0, PointGrid::len),
-        )
     }
 }

@@ -44,15 +44,23 @@ pub fn penetration(shape: &CutterShape, tip: &Vec3, axis: &Unit<Vec3>, p: &Vec3)
     bottom.min(side)
 }
 
-/// The first surface sample found more than `tolerance` inside the cutting end, with its
-/// depth; `None` if there is none.
-pub fn deepest_penetration(
+/// A surface sample inside the cutting end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Penetration {
+    /// How deep, mm.
+    pub depth: f64,
+    pub point: Vec3,
+}
+
+/// The first surface sample found more than `tolerance` inside the cutting end; `None` if
+/// there is none (the scan stops at the first: a gouge is a gouge, its depth is reported).
+pub fn first_penetration(
     grid: &PointGrid,
     shape: &CutterShape,
     tip: &Vec3,
     axis: &Unit<Vec3>,
     tolerance: f64,
-) -> Option<(f64, Vec3)> {
+) -> Option<Penetration> {
     let big_r = shape.radius();
     let top = tip + axis.into_inner() * (CUTTING_END_RADII * big_r);
     let (lo, hi) = (
@@ -63,7 +71,7 @@ pub fn deepest_penetration(
     grid.visit_box(&lo, &hi, |p| {
         let depth = penetration(shape, tip, axis, p);
         if depth > tolerance {
-            hit = Some((depth, *p));
+            hit = Some(Penetration { depth, point: *p });
             false
         } else {
             true
