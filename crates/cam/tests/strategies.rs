@@ -360,7 +360,7 @@ fn random_surfaces_and_cutters_plan_without_failing() {
 /// The material a ball path leaves above the surface, measured independently of the planner:
 /// at a surface point `q`, the cut surface lies `min_k dist(q, centre path) − R` above it (the
 /// ball centres move on straight segments between locations; 5-axis along the normal, so the
-/// centre is `tip + R·axis`). Returns the largest such height over a lattice of inner points.
+/// centre is `tip + R·axis`). Returns the largest such height over a lattice of the patch.
 fn largest_residual(s: &NurbsSurface, p: &tezgah_cam::Plan, r: f64, lattice: usize) -> f64 {
     let segments: Vec<(Vec3, Vec3)> = p
         .path
@@ -375,11 +375,8 @@ fn largest_residual(s: &NurbsSurface, p: &tezgah_cam::Plan, r: f64, lattice: usi
     let mut worst = 0.0f64;
     for i in 0..=lattice {
         for j in 0..=lattice {
-            // Inner points only: along the edges the first and last passes run on the boundary.
-            let (u, v) = (
-                0.05 + 0.9 * i as f64 / lattice as f64,
-                0.05 + 0.9 * j as f64 / lattice as f64,
-            );
+            // The whole patch, edges included (the first and last passes run on them).
+            let (u, v) = (i as f64 / lattice as f64, j as f64 / lattice as f64);
             let q = s.point(u, v);
             let d = segments
                 .iter()
