@@ -196,6 +196,21 @@ fn local_gouge_in_a_trough_tighter_than_the_ball_is_reported() {
     assert!(p.refused.is_empty(), "{:?}", p.refused.first());
 }
 
+/// The largest change of the tool's inclination to the normal between neighbouring locations
+/// of a pass (degrees).
+fn largest_lead_jump(p: &tezgah_cam::Plan) -> f64 {
+    let lean = |c: &tezgah_cam::CutterLocation| c.axis.dot(&c.normal).clamp(-1.0, 1.0).acos();
+    p.path
+        .passes
+        .iter()
+        .flat_map(|pass| {
+            pass.points
+                .windows(2)
+                .map(|w| (lean(&w[1]) - lean(&w[0])).abs().to_degrees())
+        })
+        .fold(0.0f64, f64::max)
+}
+
 /// Deepest penetration of any emitted cutting end into the surface, against samples 0.05 mm
 /// apart independent of the planner's index.
 fn worst_penetration(s: &NurbsSurface, p: &tezgah_cam::Plan) -> f64 {
@@ -268,6 +283,19 @@ fn flat_end_in_a_trough_is_curvature_matched_and_rear_gouges_are_corrected() {
         p.corrected
     );
     assert!(worst < 0.002 + 1e-3, "{worst}");
+    // Limiting the lead change between neighbours to 1.5° (the corrections step by 1° on
+    // neighbours that differ a little, so 2° jumps occur): still gouge-free, within the limit.
+    let before = largest_lead_jump(&p);
+    settings.max_lead_change_deg = Some(1.5);
+    let q = plan(&s, &flat, &settings).unwrap();
+    assert!(q.refused.is_empty());
+    let after = largest_lead_jump(&q);
+    println!("largest lead change between neighbours: {before:.2}° → {after:.2}° (limit 1.5°)");
+    assert!(
+        before > 1.5 + 1e-6 && after <= 1.5 + 1e-6,
+        "{before} {after}"
+    );
+    assert!(worst_penetration(&s, &q) < 0.002 + 1e-3);
 }
 
 #[test]

@@ -105,6 +105,13 @@ pub struct Settings {
     pub max_step: f64,
     /// The surface's `S_u × S_v` points into the material: cut the other side.
     pub reverse_normal: bool,
+    /// 5-axis only: the most the lead may change between consecutive cutter locations
+    /// (degrees; Jun 2003 in 001 §2.11c keeps orientation changes ≤ 5° per step). Where a
+    /// correction or curvature matching jumps further, the neighbours are leaned further too
+    /// (never less: leaning more keeps a flat or bull-nose cutter clear of local gouges, and
+    /// every raised location is checked again). Raising the lead shrinks a flat or bull-nose
+    /// cutter's effective radius, so the scallop there grows a little. `None`: no limit.
+    pub max_lead_change_deg: Option<f64>,
     pub gouge: GougeSettings,
 }
 
@@ -123,6 +130,7 @@ impl Settings {
             direction: FeedDirection::AlongV,
             max_step: 5.0,
             reverse_normal: false,
+            max_lead_change_deg: None,
             gouge: GougeSettings::default(),
         }
     }
@@ -131,6 +139,9 @@ impl Settings {
         positive("scallop", self.scallop)?;
         positive("tolerance", self.tolerance)?;
         positive("max_step", self.max_step)?;
+        if let Some(rate) = self.max_lead_change_deg {
+            positive("max_lead_change", rate)?;
+        }
         let angle = |name, x: f64, lo: f64, hi: f64| {
             if x.is_finite() && x >= lo && x <= hi {
                 Ok(())
@@ -320,6 +331,13 @@ struct Context<'a> {
     fixed_axis: Option<Unit<Vec3>>,
 }
 
+/// A placed cutter location and the lead it stands at.
+struct Placed {
+    location: CutterLocation,
+    corrected: bool,
+    lead: f64,
+}
+
 struct PassResult {
     passes: Vec<Pass>,
     refused: Vec<GougeReport>,
@@ -422,13 +440,14 @@ impl<'a> Context<'a> {
     }
 
     /// Places the cutter at the contact `(u, v)` on a path running along `tangent_uv`, leaning
-    /// it further while it gouges (5-axis). `Ok((location, corrected))` or the refusal.
+    /// it at least `min_lead` (radians, 5-axis) and further while it gouges.
     fn place(
         &self,
         u: f64,
         v: f64,
         tangent_uv: (f64, f64),
-    ) -> Result<(CutterLocation, bool), GougeReport> {
+        min_lead: f64,
+    ) -> Result<Placed, GougeReport> {
         let contact = self.surface.point(u, v);
         let refuse = |refusal| GougeReport {
             uv: (u, v),
@@ -443,6 +462,10 @@ impl<'a> Context<'a> {
             .ok_or_else(|| refuse(Refusal::AxisBelowSurface))?;
         let shape = self.shape();
         let mut corrected = false;
+        if self.fixed_axis.is_none() && min_lead > angles.lead {
+            angles.lead = min_lead;
+            corrected = true;
+        }
         loop {
             let axis = self.axis_for(&local.frame, angles);
             let margin = local_margin(shape, &local.frame, &axis, &local.curvature);
@@ -459,7 +482,11 @@ impl<'a> Context<'a> {
                             normal: local.frame.normal.into_inner(),
                             uv: (u, v),
                         };
-                        return Ok((location, corrected));
+                        return Ok(Placed {
+                            location,
+                            corrected,
+                            lead: angles.lead,
+                        });
                     }
                     Some(g) => g,
                 }
@@ -500,16 +527,27 @@ impl<'a> Context<'a> {
             refused: Vec::new(),
             corrected: 0,
         };
+        let sign = if reverse { -1.0 } else { 1.0 };
+        let contacts: Vec<((f64, f64), (f64, f64))> = ts
+            .iter()
+            .map(|&t| {
+                let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
+                (path.uv(t), (sign * (b.0 - a.0), sign * (b.1 - a.1)))
+            })
+            .collect();
+        let mut placed: Vec<Result<Placed, GougeReport>> = contacts
+            .iter()
+            .map(|&((u, v), tangent)| self.place(u, v, tangent, 0.0))
+            .collect();
+        if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
+            self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
+        }
         let mut current = Pass::default();
-        for &t in &ts {
-            let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
-            let sign = if reverse { -1.0 } else { 1.0 };
-            let tangent = (sign * (b.0 - a.0), sign * (b.1 - a.1));
-            let (u, v) = path.uv(t);
-            match self.place(u, v, tangent) {
-                Ok((cl, corrected)) => {
-                    out.corrected += usize::from(corrected);
-                    current.points.push(cl);
+        for item in placed {
+            match item {
+                Ok(p) => {
+                    out.corrected += usize::from(p.corrected);
+                    current.points.push(p.location);
                 }
                 Err(report) => {
                     out.refused.push(report);
@@ -525,6 +563,50 @@ impl<'a> Context<'a> {
             out.passes.push(current);
         }
         Ok(out)
+    }
+
+    /// Raises leads so consecutive placed locations differ by at most `rate` (radians): each
+    /// lead becomes at least its neighbours' minus `rate` (a forward and a backward sweep), and
+    /// raised locations are placed again (kept as they were if that fails). A few rounds, as a
+    /// re-placement may lean further than asked to clear a gouge.
+    fn limit_lead_change(
+        &self,
+        contacts: &[((f64, f64), (f64, f64))],
+        placed: &mut [Result<Placed, GougeReport>],
+        rate: f64,
+    ) {
+        for _ in 0..4 {
+            let leads: Vec<Option<f64>> = placed
+                .iter()
+                .map(|p| p.as_ref().ok().map(|p| p.lead))
+                .collect();
+            let mut target = leads.clone();
+            for i in 1..target.len() {
+                if let (Some(prev), Some(here)) = (target[i - 1], target[i]) {
+                    target[i] = Some(here.max(prev - rate));
+                }
+            }
+            for i in (0..target.len().saturating_sub(1)).rev() {
+                if let (Some(next), Some(here)) = (target[i + 1], target[i]) {
+                    target[i] = Some(here.max(next - rate));
+                }
+            }
+            let mut changed = false;
+            for (i, (want, have)) in target.iter().zip(&leads).enumerate() {
+                if let (Some(want), Some(have)) = (want, have) {
+                    if *want > have + 1e-12 {
+                        let ((u, v), tangent) = contacts[i];
+                        if let Ok(p) = self.place(u, v, tangent, *want) {
+                            placed[i] = Ok(p);
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
     }
 }
 
