@@ -331,6 +331,13 @@ struct Context<'a> {
     fixed_axis: Option<Unit<Vec3>>,
 }
 
+/// A contact point to place: its parameters and the path's direction there (in `(u, v)`).
+#[derive(Debug, Clone, Copy)]
+struct Contact {
+    uv: (f64, f64),
+    tangent: (f64, f64),
+}
+
 /// A placed cutter location and the lead it stands at.
 struct Placed {
     location: CutterLocation,
@@ -528,16 +535,19 @@ impl<'a> Context<'a> {
             corrected: 0,
         };
         let sign = if reverse { -1.0 } else { 1.0 };
-        let contacts: Vec<((f64, f64), (f64, f64))> = ts
+        let contacts: Vec<Contact> = ts
             .iter()
             .map(|&t| {
                 let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
-                (path.uv(t), (sign * (b.0 - a.0), sign * (b.1 - a.1)))
+                Contact {
+                    uv: path.uv(t),
+                    tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
+                }
             })
             .collect();
         let mut placed: Vec<Result<Placed, GougeReport>> = contacts
             .iter()
-            .map(|&((u, v), tangent)| self.place(u, v, tangent, 0.0))
+            .map(|c| self.place(c.uv.0, c.uv.1, c.tangent, 0.0))
             .collect();
         if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
             self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
@@ -571,7 +581,7 @@ impl<'a> Context<'a> {
     /// re-placement may lean further than asked to clear a gouge.
     fn limit_lead_change(
         &self,
-        contacts: &[((f64, f64), (f64, f64))],
+        contacts: &[Contact],
         placed: &mut [Result<Placed, GougeReport>],
         rate: f64,
     ) {
@@ -595,8 +605,8 @@ impl<'a> Context<'a> {
             for (i, (want, have)) in target.iter().zip(&leads).enumerate() {
                 if let (Some(want), Some(have)) = (want, have) {
                     if *want > have + 1e-12 {
-                        let ((u, v), tangent) = contacts[i];
-                        if let Ok(p) = self.place(u, v, tangent, *want) {
+                        let c = contacts[i];
+                        if let Ok(p) = self.place(c.uv.0, c.uv.1, c.tangent, *want) {
                             placed[i] = Ok(p);
                             changed = true;
                         }
