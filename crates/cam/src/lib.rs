@@ -2,13 +2,27 @@
 //!
 //! It sits beside the G-code interpreter as a second source of moves: surfaces come in
 //! (`tezgah-geom`'s `NurbsSurface`), a strategy places the [`Cutter`] along them as a
-//! [`ToolPath`], the post-processor ([`post`]) turns that into G-code for a table-tilting
-//! machine, and the dexel simulation ([`verify`]) measures scallop and gouge independently.
+//! [`ToolPath`] ([`strategy::plan`] is the entry point), the post-processor ([`post`]) turns
+//! that into G-code for a table-tilting machine, and the dexel simulation ([`verify`])
+//! measures scallop and gouge independently.
 
 pub mod cutter;
+pub mod effective_radius;
+pub mod error;
+pub mod forward_step;
+pub mod gouge;
+pub mod orientation;
 pub mod post;
+pub mod scallop;
+pub mod select;
+pub mod strategy;
+#[doc(hidden)]
+pub mod testing;
 pub mod toolpath;
 pub mod verify;
 
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};
+pub use effective_radius::LeadTilt;
+pub use error::CamError;
+pub use strategy::{plan, FeedDirection, Plan, Settings, StrategyKind, ToolAxis};
 pub use toolpath::{CutterLocation, Pass, ToolPath};

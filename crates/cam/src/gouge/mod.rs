@@ -1,0 +1,148 @@
+//! Gouge checks for a placed cutter: local (curvature interference at the contact), rear
+//! (the whole cutting end against the surface, through a spatial index of surface samples)
+//! and global (flutes above the cutting end, shank and holder against the surface). The
+//! strategies call [`GougeChecker::check`] for every cutter location and correct the tool
+//! axis or report the point; nothing gouging is emitted silently.
+
+pub mod global;
+pub mod index;
+pub mod local;
+pub mod rear;
+
+use nalgebra::Unit;
+use tezgah_geom::{NurbsSurface, Vec3};
+
+use crate::cutter::Cutter;
+use crate::error::{positive, CamError};
+use index::PointGrid;
+
+/// Which part of the tool meets the surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ToolPart {
+    /// The cutting end (ball, torus or flat bottom and the flutes up to two radii).
+    CuttingEnd,
+    /// The flutes above the cutting end.
+    Flutes,
+    Shank,
+    Holder,
+}
+
+/// What kind of gouge a cutter location has.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Gouge {
+    /// The cutter is more curved than the surface is concave in some direction at the contact
+    /// point; `margin` is the most negative eigenvalue of `K_cutter − K_surface` (1/mm).
+    Local { margin: f64 },
+    /// A surface point lies `depth` mm inside the given part of the tool.
+    Interference {
+        part: ToolPart,
+        depth: f64,
+        point: Vec3,
+    },
+}
+
+/// Settings of the rear and global checks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GougeSettings {
+    /// Spacing of the surface samples of the rear check (mm); 001 scans at 0.15 mm.
+    pub rear_spacing: f64,
+    /// Spacing of the samples for the shank/holder check (mm); the check keeps a clearance of
+    /// this spacing so the surface between samples cannot reach the tool unseen.
+    pub global_spacing: f64,
+    /// Penetration below which a surface point does not count as a rear gouge (mm).
+    pub depth_tolerance: f64,
+    pub rear: bool,
+    pub global: bool,
+}
+
+impl Default for GougeSettings {
+    fn default() -> Self {
+        GougeSettings {
+            rear_spacing: 0.3,
+            global_spacing: 1.0,
+            depth_tolerance: 0.002,
+            rear: true,
+            global: true,
+        }
+    }
+}
+
+/// The surface indexed for the checks of one cutter.
+#[derive(Debug, Clone)]
+pub struct GougeChecker {
+    cutter: Cutter,
+    settings: GougeSettings,
+    fine: Option<PointGrid>,
+    coarse: Option<PointGrid>,
+}
+
+impl GougeChecker {
+    /// Samples and indexes `surface` for `cutter`.
+    pub fn new(
+        surface: &NurbsSurface,
+        cutter: &Cutter,
+        settings: GougeSettings,
+    ) -> Result<GougeChecker, CamError> {
+        positive("gouge rear_spacing", settings.rear_spacing)?;
+        positive("gouge global_spacing", settings.global_spacing)?;
+        positive("gouge depth_tolerance", settings.depth_tolerance)?;
+        let r = cutter.shape.radius();
+        let sample = |spacing| {
+            index::sample_surface(surface, spacing).ok_or(CamError::TooLarge {
+                what: "gouge-check samples (raise the gouge spacing)",
+                limit: index::MAX_SAMPLES,
+            })
+        };
+        let fine = if settings.rear {
+            Some(PointGrid::new(sample(settings.rear_spacing)?, 2.0 * r))
+        } else {
+            None
+        };
+        let coarse = if settings.global {
+            Some(PointGrid::new(
+                sample(settings.global_spacing)?,
+                (2.0 * r).max(4.0 * settings.global_spacing),
+            ))
+        } else {
+            None
+        };
+        Ok(GougeChecker {
+            cutter: *cutter,
+            settings,
+            fine,
+            coarse,
+        })
+    }
+
+    /// Rear and global checks of the cutter standing at `tip` along `axis` (the local check
+    /// needs the contact's curvature and lives in [`local`]).
+    pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {
+        if let Some(grid) = &self.fine {
+            if let Some(rear::Penetration { depth, point }) = rear::first_penetration(
+                grid,
+                &self.cutter.shape,
+                tip,
+                axis,
+                self.settings.depth_tolerance,
+            ) {
+                return Some(Gouge::Interference {
+                    part: ToolPart::CuttingEnd,
+                    depth,
+                    point,
+                });
+            }
+        }
+        if let Some(grid) = &self.coarse {
+            if let Some(hit) =
+                global::collision(grid, &self.cutter, tip, axis, self.settings.global_spacing)
+            {
+                return Some(Gouge::Interference {
+                    part: hit.part,
+                    depth: hit.depth,
+                    point: hit.point,
+                });
+            }
+        }
+        None
+    }
+}

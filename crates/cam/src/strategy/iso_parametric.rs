@@ -1,0 +1,85 @@
+//! Iso-parametric zig-zag (001 §2.14 (1)–(2)): passes along the feed parameter at one
+//! constant parametric side step, chosen so the scallop stays within the target everywhere.
+//! 001 §2.9 sizes it at the point of tightest convex radius only; here, as its digest
+//! recommends, the step is the minimum over a lattice of the whole surface of the local
+//! allowed step `ω / |S_s · t|` (the side step's component across the feed per unit parameter).
+
+use super::{Axes, Context, PassPath};
+use crate::error::CamError;
+use crate::forward_step::IsoLine;
+
+/// Lattice size (per direction) over which the constant side step is minimised.
+const LATTICE: usize = 48;
+/// Most passes a plan may have.
+pub(super) const MAX_PASSES: usize = 200_000;
+
+/// The constant parametric side step of the iso-parametric strategies.
+pub fn iso_parametric_side_step(
+    surface: &tezgah_geom::NurbsSurface,
+    cutter: &crate::cutter::Cutter,
+    settings: &super::Settings,
+) -> Result<f64, CamError> {
+    settings.validate()?;
+    super::validate_cutter(cutter)?;
+    let ctx = Context::new(surface, cutter, settings)?;
+    side_step(&ctx)
+}
+
+fn side_step(ctx: &Context) -> Result<f64, CamError> {
+    let Axes { side, feed, .. } = ctx.axes;
+    let mut best = side.1 - side.0;
+    for i in 0..=LATTICE {
+        let s = side.0 + (side.1 - side.0) * i as f64 / LATTICE as f64;
+        for j in 0..=LATTICE {
+            let f = feed.0 + (feed.1 - feed.0) * j as f64 / LATTICE as f64;
+            let (u, v) = ctx.axes.uv(s, f);
+            let tangent = ctx.axes.uv(0.0, 1.0);
+            let Some(local) = ctx.local(u, v, tangent) else {
+                continue;
+            };
+            // Where the cutter gouges locally there is no scallop to size; placement reports it.
+            let Some(w) = ctx.side_step(&local) else {
+                continue;
+            };
+            let ss = if ctx.axes.along_v {
+                local.d.su
+            } else {
+                local.d.sv
+            };
+            let across = ss.dot(&local.frame.cross).abs();
+            if across > 0.0 {
+                best = best.min(w / across);
+            }
+        }
+    }
+    Ok(best)
+}
+
+/// The passes: iso lines at `side.0 + k·Δ`, `k = 0..=n`, `n = ⌈range / Δs⌉`, in order.
+pub(super) fn passes(ctx: &Context) -> Result<Vec<PassPath>, CamError> {
+    let Axes {
+        side,
+        feed,
+        along_v,
+    } = ctx.axes;
+    let step = side_step(ctx)?;
+    let range = side.1 - side.0;
+    let count = (range / step).ceil();
+    if !(count.is_finite() && count < MAX_PASSES as f64) {
+        return Err(CamError::TooLarge {
+            what: "passes",
+            limit: MAX_PASSES,
+        });
+    }
+    let n = (count as usize).max(1);
+    Ok((0..=n)
+        .map(|k| {
+            PassPath::Iso(IsoLine {
+                fixed: side.0 + range * k as f64 / n as f64,
+                along_v,
+                start: feed.0,
+                end: feed.1,
+            })
+        })
+        .collect())
+}

@@ -1,0 +1,658 @@
+//! Finishing strategies on one NURBS surface: the public entry [`plan`] turns a surface, a
+//! [`Cutter`] and [`Settings`] into a [`ToolPath`] of cutter locations plus a report of what
+//! the gouge checks corrected or refused. Iso-parametric zig-zag (one-way and two-way) lives in
+//! `iso_parametric`, iso-scallop in `iso_scallop`; both step along their passes by the true
+//! chord error (`forward_step`), size side steps by the exact scallop model (`scallop`) and place
+//! every contact here (orientation, CC → CL, gouge checks and correction).
+
+mod iso_parametric;
+mod iso_scallop;
+
+use std::fmt;
+use std::str::FromStr;
+
+use nalgebra::Unit;
+use rayon::prelude::*;
+use tezgah_geom::{NurbsSurface, Vec3};
+
+use crate::cutter::{Cutter, CutterShape};
+use crate::effective_radius::LeadTilt;
+use crate::error::{positive, CamError};
+use crate::forward_step::{forward_steps, IsoLine, SurfacePath, UvPolyline};
+use crate::gouge::local::{local_margin, surface_curvature, Curvature2};
+use crate::gouge::{Gouge, GougeChecker, GougeSettings};
+use crate::orientation::ContactFrame;
+use crate::scallop::stepover_exact;
+use crate::toolpath::{CutterLocation, Pass, ToolPath};
+
+pub use iso_parametric::iso_parametric_side_step;
+
+/// The finishing strategy, by DESIGN.md's `tezgah cam --strategy NAME`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrategyKind {
+    /// Iso-parametric passes at a constant parametric side step, alternating direction.
+    ZigZag,
+    /// Iso-parametric passes all cut in the same direction (the tool links back between them).
+    ZigZagOneWay,
+    /// Each pass offset from the previous one so the scallop height equals the target,
+    /// alternating direction.
+    IsoScallop,
+}
+
+impl FromStr for StrategyKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "zigzag" => Ok(StrategyKind::ZigZag),
+            "zigzag-oneway" => Ok(StrategyKind::ZigZagOneWay),
+            "iso-scallop" => Ok(StrategyKind::IsoScallop),
+            _ => Err(format!(
+                "unknown strategy '{s}': expected zigzag, zigzag-oneway or iso-scallop"
+            )),
+        }
+    }
+}
+
+impl fmt::Display for StrategyKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            StrategyKind::ZigZag => "zigzag",
+            StrategyKind::ZigZagOneWay => "zigzag-oneway",
+            StrategyKind::IsoScallop => "iso-scallop",
+        })
+    }
+}
+
+/// Which surface parameter the passes run along (the feed); the other is stepped over.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum FeedDirection {
+    /// Passes along `v` at increasing `u` (001's convention).
+    #[default]
+    AlongV,
+    AlongU,
+}
+
+/// How the tool axis stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ToolAxis {
+    /// 3-axis: one fixed axis for the whole path (e.g. `+z`). Nothing can be corrected by
+    /// tilting; gouging points are reported.
+    Fixed(Vec3),
+    /// 5-axis: the axis follows the surface normal, leaned `lead_deg` toward the feed and
+    /// `tilt_deg` sideways. With `match_curvature`, flat and bull-nose cutters lean further
+    /// where the cross-feed section is concave, so their effective radius fits it (001 §2.6).
+    /// Gouges are corrected by leaning further, up to `max_lead_deg`.
+    Surface {
+        lead_deg: f64,
+        tilt_deg: f64,
+        max_lead_deg: f64,
+        match_curvature: bool,
+    },
+}
+
+/// Planning settings. [`Settings::new`] gives 5-axis along the normal with curvature
+/// matching, feed along `v`, a 5 mm forward-step cap and the default gouge checks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Settings {
+    pub strategy: StrategyKind,
+    /// Target scallop height `h`, mm.
+    pub scallop: f64,
+    /// Chord tolerance between contact points, mm.
+    pub tolerance: f64,
+    pub axis: ToolAxis,
+    pub direction: FeedDirection,
+    /// Longest move between contact points, mm.
+    pub max_step: f64,
+    /// The surface's `S_u × S_v` points into the material: cut the other side.
+    pub reverse_normal: bool,
+    /// 5-axis only: the most the lead may change between consecutive cutter locations
+    /// (degrees; Jun 2003 in 001 §2.11c keeps orientation changes ≤ 5° per step). Where a
+    /// correction or curvature matching jumps further, the neighbours are leaned further too
+    /// (never less: leaning more keeps a flat or bull-nose cutter clear of local gouges, and
+    /// every raised location is checked again). Raising the lead shrinks a flat or bull-nose
+    /// cutter's effective radius, so the scallop there grows a little. `None`: no limit.
+    pub max_lead_change_deg: Option<f64>,
+    pub gouge: GougeSettings,
+}
+
+impl Settings {
+    pub fn new(strategy: StrategyKind, scallop: f64, tolerance: f64) -> Settings {
+        Settings {
+            strategy,
+            scallop,
+            tolerance,
+            axis: ToolAxis::Surface {
+                lead_deg: 0.0,
+                tilt_deg: 0.0,
+                max_lead_deg: 30.0,
+                match_curvature: true,
+            },
+            direction: FeedDirection::AlongV,
+            max_step: 5.0,
+            reverse_normal: false,
+            max_lead_change_deg: None,
+            gouge: GougeSettings::default(),
+        }
+    }
+
+    fn validate(&self) -> Result<(), CamError> {
+        positive("scallop", self.scallop)?;
+        positive("tolerance", self.tolerance)?;
+        positive("max_step", self.max_step)?;
+        if let Some(rate) = self.max_lead_change_deg {
+            positive("max_lead_change", rate)?;
+        }
+        let angle = |name, x: f64, lo: f64, hi: f64| {
+            if x.is_finite() && x >= lo && x <= hi {
+                Ok(())
+            } else {
+                Err(CamError::Setting {
+                    name,
+                    want: "an angle within its range (degrees; lead 0..=89, tilt −89..=89)",
+                    got: x,
+                })
+            }
+        };
+        match self.axis {
+            ToolAxis::Fixed(a) => {
+                if !(a.iter().all(|c| c.is_finite()) && a.norm() > 0.0) {
+                    return Err(CamError::Setting {
+                        name: "axis",
+                        want: "a finite non-zero vector",
+                        got: a.norm(),
+                    });
+                }
+            }
+            ToolAxis::Surface {
+                lead_deg,
+                tilt_deg,
+                max_lead_deg,
+                ..
+            } => {
+                angle("lead", lead_deg, 0.0, 89.0)?;
+                angle("tilt", tilt_deg, -89.0, 89.0)?;
+                angle("max_lead", max_lead_deg, lead_deg, 89.0)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A contact point the planner could not emit, and why.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Refusal {
+    /// The cutter gouges here at every orientation tried.
+    Gouge(Gouge),
+    /// The surface has no normal here (a degenerate point).
+    NoNormal,
+    /// The fixed tool axis points into the surface here.
+    AxisBelowSurface,
+}
+
+/// One refused contact point: where, and why. The pass is split around it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GougeReport {
+    pub uv: (f64, f64),
+    pub contact: Vec3,
+    pub refusal: Refusal,
+}
+
+/// The planner's result: the tool path, the contact points it refused, and how many points it
+/// corrected by leaning the tool further than the nominal orientation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    pub path: ToolPath,
+    pub refused: Vec<GougeReport>,
+    pub corrected: usize,
+}
+
+/// Plans a finishing tool path of `cutter` over `surface` (the public entry of the CAM
+/// strategies). Errors are bad settings or cutter, or a search that failed; gouges are not
+/// errors but corrected (5-axis) or listed in [`Plan::refused`] with their pass split there.
+pub fn plan(
+    surface: &NurbsSurface,
+    cutter: &Cutter,
+    settings: &Settings,
+) -> Result<Plan, CamError> {
+    settings.validate()?;
+    validate_cutter(cutter)?;
+    let ctx = Context::new(surface, cutter, settings)?;
+    let paths = match settings.strategy {
+        StrategyKind::ZigZag | StrategyKind::ZigZagOneWay => iso_parametric::passes(&ctx)?,
+        StrategyKind::IsoScallop => iso_scallop::passes(&ctx)?,
+    };
+    let one_way = settings.strategy == StrategyKind::ZigZagOneWay;
+    let results: Vec<PassResult> = paths
+        .par_iter()
+        .enumerate()
+        .map(|(k, path)| ctx.run_pass(path, !one_way && k % 2 == 1))
+        .collect::<Result<_, _>>()?;
+    let mut plan = Plan {
+        path: ToolPath {
+            cutter: *cutter,
+            passes: Vec::new(),
+        },
+        refused: Vec::new(),
+        corrected: 0,
+    };
+    for r in results {
+        plan.path.passes.extend(r.passes);
+        plan.refused.extend(r.refused);
+        plan.corrected += r.corrected;
+    }
+    Ok(plan)
+}
+
+fn validate_cutter(cutter: &Cutter) -> Result<(), CamError> {
+    let (big_r, r) = (cutter.shape.radius(), cutter.shape.corner_radius());
+    let ok = big_r.is_finite()
+        && big_r > 0.0
+        && r.is_finite()
+        && r >= 0.0
+        && r <= big_r
+        && cutter.flute_length.is_finite()
+        && [cutter.shank, cutter.holder].iter().all(|c| {
+            [c.radius, c.from, c.length]
+                .iter()
+                .all(|x| x.is_finite() && *x >= 0.0)
+        });
+    if ok {
+        Ok(())
+    } else {
+        Err(CamError::Cutter(format!("{:?}", cutter)))
+    }
+}
+
+/// One pass to cut: an iso-parametric line or a polyline in the parameter plane.
+#[derive(Debug, Clone, PartialEq)]
+enum PassPath {
+    Iso(IsoLine),
+    Poly(UvPolyline),
+}
+
+impl SurfacePath for PassPath {
+    fn range(&self) -> (f64, f64) {
+        match self {
+            PassPath::Iso(p) => p.range(),
+            PassPath::Poly(p) => p.range(),
+        }
+    }
+    fn uv(&self, t: f64) -> (f64, f64) {
+        match self {
+            PassPath::Iso(p) => p.uv(t),
+            PassPath::Poly(p) => p.uv(t),
+        }
+    }
+}
+
+/// The surface's parameters as (side, feed).
+#[derive(Debug, Clone, Copy)]
+struct Axes {
+    along_v: bool,
+    side: (f64, f64),
+    feed: (f64, f64),
+}
+
+impl Axes {
+    fn uv(&self, s: f64, f: f64) -> (f64, f64) {
+        if self.along_v {
+            (s, f)
+        } else {
+            (f, s)
+        }
+    }
+    fn sf(&self, (u, v): (f64, f64)) -> (f64, f64) {
+        if self.along_v {
+            (u, v)
+        } else {
+            (v, u)
+        }
+    }
+}
+
+/// Geometry at one contact point.
+struct Local {
+    d: tezgah_geom::SurfaceDerivs,
+    frame: ContactFrame,
+    curvature: Curvature2,
+}
+
+/// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
+const MATCH_MARGIN: f64 = 0.05;
+/// Lean added per correction trial, degrees.
+const CORRECTION_STEP_DEG: f64 = 1.0;
+
+struct Context<'a> {
+    surface: &'a NurbsSurface,
+    cutter: &'a Cutter,
+    settings: &'a Settings,
+    axes: Axes,
+    checker: GougeChecker,
+    fixed_axis: Option<Unit<Vec3>>,
+}
+
+/// A contact point to place: its parameters and the path's direction there (in `(u, v)`).
+#[derive(Debug, Clone, Copy)]
+struct Contact {
+    uv: (f64, f64),
+    tangent: (f64, f64),
+}
+
+/// A placed cutter location and the lead it stands at.
+struct Placed {
+    location: CutterLocation,
+    corrected: bool,
+    lead: f64,
+}
+
+struct PassResult {
+    passes: Vec<Pass>,
+    refused: Vec<GougeReport>,
+    corrected: usize,
+}
+
+impl<'a> Context<'a> {
+    fn new(
+        surface: &'a NurbsSurface,
+        cutter: &'a Cutter,
+        settings: &'a Settings,
+    ) -> Result<Self, CamError> {
+        let along_v = settings.direction == FeedDirection::AlongV;
+        let (du, dv) = (surface.domain_u(), surface.domain_v());
+        let axes = if along_v {
+            Axes {
+                along_v,
+                side: du,
+                feed: dv,
+            }
+        } else {
+            Axes {
+                along_v,
+                side: dv,
+                feed: du,
+            }
+        };
+        let fixed_axis = match settings.axis {
+            ToolAxis::Fixed(a) => Some(Unit::new_normalize(a)),
+            ToolAxis::Surface { .. } => None,
+        };
+        Ok(Context {
+            surface,
+            cutter,
+            settings,
+            axes,
+            checker: GougeChecker::new(surface, cutter, settings.gouge)?,
+            fixed_axis,
+        })
+    }
+
+    fn shape(&self) -> &CutterShape {
+        &self.cutter.shape
+    }
+
+    /// Frame and curvature at `(u, v)` for a path running along `tangent_uv`.
+    fn local(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Option<Local> {
+        let d = self.surface.derivs(u, v);
+        let n = self.surface.normal(u, v)?;
+        let n = if self.settings.reverse_normal { -n } else { n };
+        let tangent = d.su * tangent_uv.0 + d.sv * tangent_uv.1;
+        let frame = ContactFrame::new(n, tangent)?;
+        let curvature = surface_curvature(&d, &frame)?;
+        Some(Local {
+            d,
+            frame,
+            curvature,
+        })
+    }
+
+    /// The orientation before gouge correction: the settings' lead and tilt, leaned further
+    /// for curvature matching; `None` when a fixed axis points into the surface.
+    fn nominal_angles(&self, local: &Local) -> Option<LeadTilt> {
+        match self.settings.axis {
+            ToolAxis::Fixed(_) => local.frame.lead_tilt(&self.fixed_axis?),
+            ToolAxis::Surface {
+                lead_deg,
+                tilt_deg,
+                max_lead_deg,
+                match_curvature,
+            } => {
+                let mut lead = lead_deg.to_radians();
+                let max_lead = max_lead_deg.to_radians();
+                let k = local.curvature.tt;
+                if match_curvature && k > 0.0 && !matches!(self.shape(), CutterShape::Ball { .. }) {
+                    let need = self
+                        .shape()
+                        .matching_lead((1.0 - MATCH_MARGIN) / k)
+                        .unwrap_or(max_lead);
+                    lead = lead.max(need.min(max_lead));
+                }
+                Some(LeadTilt::new(lead, tilt_deg.to_radians()))
+            }
+        }
+    }
+
+    fn axis_for(&self, frame: &ContactFrame, angles: LeadTilt) -> Unit<Vec3> {
+        self.fixed_axis.unwrap_or_else(|| frame.axis(angles))
+    }
+
+    /// The side step (mm, a chord across the feed) that leaves the target scallop at this
+    /// point with the nominal orientation, capped at the tool radius (beyond it the osculating
+    /// circle no longer describes a flat or bull-nose profile). `None` where the cutter gouges
+    /// locally at the nominal orientation.
+    fn side_step(&self, local: &Local) -> Option<f64> {
+        let angles = self.nominal_angles(local)?;
+        let r_e = self.shape().effective_radius(angles);
+        let w = stepover_exact(r_e, local.curvature.tt, self.settings.scallop)?;
+        Some(w.min(self.shape().radius()))
+    }
+
+    /// Places the cutter at the contact `(u, v)` on a path running along `tangent_uv`, leaning
+    /// it at least `min_lead` (radians, 5-axis) and further while it gouges.
+    fn place(
+        &self,
+        u: f64,
+        v: f64,
+        tangent_uv: (f64, f64),
+        min_lead: f64,
+    ) -> Result<Placed, GougeReport> {
+        let contact = self.surface.point(u, v);
+        let refuse = |refusal| GougeReport {
+            uv: (u, v),
+            contact,
+            refusal,
+        };
+        let local = self
+            .local(u, v, tangent_uv)
+            .ok_or_else(|| refuse(Refusal::NoNormal))?;
+        let mut angles = self
+            .nominal_angles(&local)
+            .ok_or_else(|| refuse(Refusal::AxisBelowSurface))?;
+        let shape = self.shape();
+        let mut corrected = false;
+        if self.fixed_axis.is_none() && min_lead > angles.lead {
+            angles.lead = min_lead;
+            corrected = true;
+        }
+        loop {
+            let axis = self.axis_for(&local.frame, angles);
+            let margin = local_margin(shape, &local.frame, &axis, &local.curvature);
+            let problem = if margin < -1e-9 {
+                Gouge::Local { margin }
+            } else {
+                let tip = shape.tip_for_contact(&local.d.point, &local.frame, &axis);
+                match self.checker.check(&tip, &axis) {
+                    None => {
+                        let location = CutterLocation {
+                            tip,
+                            axis: axis.into_inner(),
+                            contact: local.d.point,
+                            normal: local.frame.normal.into_inner(),
+                            uv: (u, v),
+                        };
+                        return Ok(Placed {
+                            location,
+                            corrected,
+                            lead: angles.lead,
+                        });
+                    }
+                    Some(g) => g,
+                }
+            };
+            let ball_local =
+                matches!(shape, CutterShape::Ball { .. }) && matches!(problem, Gouge::Local { .. });
+            match self.settings.axis {
+                ToolAxis::Surface { max_lead_deg, .. }
+                    if !ball_local
+                        && angles.lead.to_degrees() + CORRECTION_STEP_DEG
+                            <= max_lead_deg + 1e-9 =>
+                {
+                    angles.lead += CORRECTION_STEP_DEG.to_radians();
+                    corrected = true;
+                }
+                _ => return Err(refuse(Refusal::Gouge(problem))),
+            }
+        }
+    }
+
+    /// Steps along `path` by the chord error and places the cutter at every contact point;
+    /// `reverse` cuts it from its end to its start. Refused points split the pass.
+    fn run_pass(&self, path: &impl SurfacePath, reverse: bool) -> Result<PassResult, CamError> {
+        let mut ts = forward_steps(
+            self.surface,
+            path,
+            self.settings.tolerance,
+            self.settings.max_step,
+            None,
+        )?;
+        if reverse {
+            ts.reverse();
+        }
+        let (t0, t1) = path.range();
+        let h = (t1 - t0) * 1e-6;
+        let mut out = PassResult {
+            passes: Vec::new(),
+            refused: Vec::new(),
+            corrected: 0,
+        };
+        let sign = if reverse { -1.0 } else { 1.0 };
+        let contacts: Vec<Contact> = ts
+            .iter()
+            .map(|&t| {
+                let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
+                Contact {
+                    uv: path.uv(t),
+                    tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
+                }
+            })
+            .collect();
+        let mut placed: Vec<Result<Placed, GougeReport>> = contacts
+            .iter()
+            .map(|c| self.place(c.uv.0, c.uv.1, c.tangent, 0.0))
+            .collect();
+        if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
+            self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
+        }
+        let mut current = Pass::default();
+        for item in placed {
+            match item {
+                Ok(p) => {
+                    out.corrected += usize::from(p.corrected);
+                    current.points.push(p.location);
+                }
+                Err(report) => {
+                    out.refused.push(report);
+                    if current.points.len() >= 2 {
+                        out.passes.push(std::mem::take(&mut current));
+                    } else {
+                        current.points.clear();
+                    }
+                }
+            }
+        }
+        if current.points.len() >= 2 {
+            out.passes.push(current);
+        }
+        Ok(out)
+    }
+
+    /// Raises leads so consecutive placed locations differ by at most `rate` (radians): each
+    /// lead becomes at least its neighbours' minus `rate` (a forward and a backward sweep), and
+    /// raised locations are placed again (kept as they were if that fails). A few rounds, as a
+    /// re-placement may lean further than asked to clear a gouge.
+    fn limit_lead_change(
+        &self,
+        contacts: &[Contact],
+        placed: &mut [Result<Placed, GougeReport>],
+        rate: f64,
+    ) {
+        for _ in 0..4 {
+            let leads: Vec<Option<f64>> = placed
+                .iter()
+                .map(|p| p.as_ref().ok().map(|p| p.lead))
+                .collect();
+            let mut target = leads.clone();
+            for i in 1..target.len() {
+                if let (Some(prev), Some(here)) = (target[i - 1], target[i]) {
+                    target[i] = Some(here.max(prev - rate));
+                }
+            }
+            for i in (0..target.len().saturating_sub(1)).rev() {
+                if let (Some(next), Some(here)) = (target[i + 1], target[i]) {
+                    target[i] = Some(here.max(next - rate));
+                }
+            }
+            let mut changed = false;
+            for (i, (want, have)) in target.iter().zip(&leads).enumerate() {
+                if let (Some(want), Some(have)) = (want, have) {
+                    if *want > have + 1e-12 {
+                        let c = contacts[i];
+                        if let Ok(p) = self.place(c.uv.0, c.uv.1, c.tangent, *want) {
+                            placed[i] = Ok(p);
+                            changed = true;
+                        }
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn strategy_names_round_trip_and_bad_ones_are_refused() {
+        for name in ["zigzag", "zigzag-oneway", "iso-scallop"] {
+            assert_eq!(name.parse::<StrategyKind>().unwrap().to_string(), name);
+        }
+        assert!("spiral".parse::<StrategyKind>().is_err());
+    }
+
+    #[test]
+    fn settings_out_of_range_are_refused() {
+        let base = Settings::new(StrategyKind::ZigZag, 0.01, 0.01);
+        assert!(base.validate().is_ok());
+        let mut s = base.clone();
+        s.max_step = 0.0;
+        assert!(s.validate().is_err());
+        for (lead, tilt, max) in [(-1.0, 0.0, 30.0), (10.0, 95.0, 30.0), (40.0, 0.0, 30.0)] {
+            let mut s = base.clone();
+            s.axis = ToolAxis::Surface {
+                lead_deg: lead,
+                tilt_deg: tilt,
+                max_lead_deg: max,
+                match_curvature: true,
+            };
+            assert!(s.validate().is_err(), "{lead} {tilt} {max}");
+        }
+        let mut s = base;
+        s.gouge.rear_spacing = f64::NAN;
+        let surface = crate::testing::plane(10.0);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 1.0 });
+        assert!(plan(&surface, &cutter, &s).is_err());
+    }
+}
