@@ -5,6 +5,7 @@
 //! [`ToolPath`], and the post-processor turns that into G-code for a table-tilting machine.
 
 pub mod cutter;
+pub mod step;
 pub mod toolpath;
 
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};

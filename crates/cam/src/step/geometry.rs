@@ -1,0 +1,236 @@
+//! Geometry entities (ISO 10303-42) to `tezgah-geom` types: `CARTESIAN_POINT`,
+//! `B_SPLINE_SURFACE_WITH_KNOTS` and the rational complex instance → [`NurbsSurface`];
+//! `B_SPLINE_CURVE_WITH_KNOTS` (plain or rational), `LINE`, `SURFACE_CURVE`/`SEAM_CURVE` →
+//! [`Nurbs`] edge curves. Coordinates are scaled to mm here; knots are parameters and kept.
+
+use tezgah_geom::basis::MAX_DEGREE;
+use tezgah_geom::{Nurbs, NurbsSurface, Vec3};
+
+use super::entity::{real_of, Entity, Resolve};
+use super::error::StepError;
+use super::exchange::{Exchange, Param};
+
+/// What geometry is read against: the exchange and the length unit's mm.
+pub(crate) struct Geometry<'a> {
+    pub ex: &'a Exchange,
+    pub mm: f64,
+}
+
+impl<'a> Geometry<'a> {
+    /// A `CARTESIAN_POINT` (3-D) in mm.
+    pub fn point(&self, id: u64, from: &Entity<'_>) -> Result<Vec3, StepError> {
+        let e = self.ex.get(id, from)?;
+        if e.name() != "CARTESIAN_POINT" || e.instance.complex {
+            return Err(StepError::Unsupported {
+                at: e.at(),
+                role: format!("a point of {}", from.at()),
+            });
+        }
+        let c = e.reals(1, "coordinates")?;
+        if c.len() != 3 {
+            return Err(e.invalid(format!("has {} coordinates, a 3-D point needs 3", c.len())));
+        }
+        Ok(Vec3::new(c[0], c[1], c[2]) * self.mm)
+    }
+
+    /// A `VERTEX_POINT`'s point.
+    pub fn vertex(&self, id: u64, from: &Entity<'_>) -> Result<Vec3, StepError> {
+        let v = self.ex.get(id, from)?;
+        if v.name() != "VERTEX_POINT" {
+            return Err(StepError::Unsupported {
+                at: v.at(),
+                role: format!("a vertex of {}", from.at()),
+            });
+        }
+        self.point(v.reference(1, "vertex geometry")?, &v)
+    }
+
+    /// A B-spline surface, plain (`B_SPLINE_SURFACE_WITH_KNOTS`) or the complex instance
+    /// `(BOUNDED_SURFACE() B_SPLINE_SURFACE(…) B_SPLINE_SURFACE_WITH_KNOTS(…)
+    /// GEOMETRIC_REPRESENTATION_ITEM() RATIONAL_B_SPLINE_SURFACE(…) REPRESENTATION_ITEM('')
+    /// SURFACE())`, in which the supertype's attributes sit in their own partial record.
+    pub fn bspline_surface(&self, s: &Entity<'_>) -> Result<NurbsSurface, StepError> {
+        // (the record holding degrees and points, index of u_degree in it)
+        let (base, first) = if s.instance.complex {
+            (s.part("B_SPLINE_SURFACE")?, 0)
+        } else {
+            (*s, 1)
+        };
+        let knots = if s.instance.complex {
+            s.part("B_SPLINE_SURFACE_WITH_KNOTS")?
+        } else {
+            *s
+        };
+        let k0 = if s.instance.complex { 0 } else { first + 7 };
+        let p = base.count(first, "u_degree")?;
+        let q = base.count(first + 1, "v_degree")?;
+        let rows = base.list(first + 2, "control_points_list")?;
+        let mut grid: Vec<Vec<u64>> = Vec::with_capacity(rows.len());
+        for row in rows {
+            match row {
+                Param::List(items) => grid.push(
+                    items
+                        .iter()
+                        .map(|p| match p {
+                            Param::Ref(id) => Ok(*id),
+                            _ => Err(base.invalid("control_points_list must hold references")),
+                        })
+                        .collect::<Result<_, _>>()?,
+                ),
+                _ => return Err(base.invalid("control_points_list must be a list of rows")),
+            }
+        }
+        let n_rows = grid.len();
+        let n_cols = grid.first().map_or(0, Vec::len);
+        if let Some(bad) = grid.iter().position(|r| r.len() != n_cols) {
+            return Err(base.invalid(format!(
+                "control point row {} has {} points, row 1 has {n_cols}",
+                bad + 1,
+                grid[bad].len()
+            )));
+        }
+        let ku = expand_knots(&knots, k0, k0 + 2, "u", n_rows, p)?;
+        let kv = expand_knots(&knots, k0 + 1, k0 + 3, "v", n_cols, q)?;
+        let weights = if s.instance.has("RATIONAL_B_SPLINE_SURFACE") {
+            let r = s.part("RATIONAL_B_SPLINE_SURFACE")?;
+            let w = r.list(0, "weights_data")?;
+            let mut flat = Vec::with_capacity(n_rows * n_cols);
+            for row in w {
+                let Param::List(items) = row else {
+                    return Err(r.invalid("weights_data must be a list of rows"));
+                };
+                if items.len() != n_cols {
+                    return Err(r.invalid(format!(
+                        "a weights row has {} values, the control grid has {n_cols} columns",
+                        items.len()
+                    )));
+                }
+                for x in items {
+                    flat.push(real_of(x).ok_or_else(|| r.invalid("weights must be numbers"))?);
+                }
+            }
+            if flat.len() != n_rows * n_cols {
+                return Err(r.invalid(format!(
+                    "weights_data has {} rows, the control grid has {n_rows}",
+                    w.len()
+                )));
+            }
+            flat
+        } else {
+            vec![1.0; n_rows * n_cols]
+        };
+        let mut points = Vec::with_capacity(n_rows * n_cols);
+        for id in grid.iter().flatten() {
+            points.push(self.point(*id, &base)?);
+        }
+        NurbsSurface::new(p, q, &points, &weights, ku, kv).map_err(|e| s.invalid(e.to_string()))
+    }
+
+    /// A 3-D edge curve: a B-spline (plain or rational), or the 3-D curve of a
+    /// `SURFACE_CURVE`/`SEAM_CURVE`. `LINE`s are handled by the caller (an edge on a line is
+    /// the segment between its vertices). `depth` bounds surface-curve chains.
+    pub fn curve(&self, c: &Entity<'_>, depth: usize) -> Result<Nurbs, StepError> {
+        if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
+            return self.bspline_curve(c);
+        }
+        match c.name() {
+            "SURFACE_CURVE" | "SEAM_CURVE" | "INTERSECTION_CURVE" if depth < 4 => {
+                let inner = self.ex.get(c.reference(1, "curve_3d")?, c)?;
+                self.curve(&inner, depth + 1)
+            }
+            _ => Err(StepError::Unsupported {
+                at: c.at(),
+                role: "an edge curve".to_string(),
+            }),
+        }
+    }
+
+    fn bspline_curve(&self, c: &Entity<'_>) -> Result<Nurbs, StepError> {
+        let (base, first) = if c.instance.complex {
+            (c.part("B_SPLINE_CURVE")?, 0)
+        } else {
+            (*c, 1)
+        };
+        let knots = if c.instance.complex {
+            c.part("B_SPLINE_CURVE_WITH_KNOTS")?
+        } else {
+            *c
+        };
+        let k0 = if c.instance.complex { 0 } else { first + 5 };
+        let p = base.count(first, "degree")?;
+        let ids = base.refs(first + 1, "control_points_list")?;
+        let kv = expand_knots(&knots, k0, k0 + 1, "", ids.len(), p)?;
+        let weights = if c.instance.has("RATIONAL_B_SPLINE_CURVE") {
+            let r = c.part("RATIONAL_B_SPLINE_CURVE")?;
+            let w = r.reals(0, "weights_data")?;
+            if w.len() != ids.len() {
+                return Err(r.invalid(format!(
+                    "{} weights for {} control points",
+                    w.len(),
+                    ids.len()
+                )));
+            }
+            w
+        } else {
+            vec![1.0; ids.len()]
+        };
+        let points = ids
+            .iter()
+            .map(|id| self.point(*id, &base))
+            .collect::<Result<Vec<_>, _>>()?;
+        Nurbs::new(p, &points, &weights, kv).map_err(|e| c.invalid(e.to_string()))
+    }
+}
+
+/// The full knot vector from distinct knots and their multiplicities (ISO 10303-42
+/// `b_spline_*_with_knots`): each knot repeated by its multiplicity, and the sum must be
+/// `control points + degree + 1`.
+fn expand_knots(
+    e: &Entity<'_>,
+    mult_at: usize,
+    knot_at: usize,
+    dir: &str,
+    points: usize,
+    degree: usize,
+) -> Result<Vec<f64>, StepError> {
+    let label = |s: &str| {
+        if dir.is_empty() {
+            s.to_string()
+        } else {
+            format!("{dir}_{s}")
+        }
+    };
+    let mults = e.counts(mult_at, &label("multiplicities"))?;
+    let knots = e.reals(knot_at, &label("knots"))?;
+    if degree == 0 || degree > MAX_DEGREE {
+        return Err(e.invalid(format!(
+            "{} is {degree}; tezgah reads degrees 1 to {MAX_DEGREE}",
+            label("degree")
+        )));
+    }
+    let d = if dir.is_empty() {
+        String::new()
+    } else {
+        format!("{dir} ")
+    };
+    if mults.len() != knots.len() {
+        return Err(e.invalid(format!(
+            "{d}multiplicities list has {} entries but {d}knots has {}",
+            mults.len(),
+            knots.len()
+        )));
+    }
+    let sum = mults.iter().try_fold(0usize, |a, &m| a.checked_add(m));
+    let need = points + degree + 1;
+    if sum != Some(need) {
+        return Err(e.invalid(format!(
+            "{d}multiplicities sum to {}, but {points} control points of degree {degree} need {need}",
+            sum.map_or_else(|| "more than usize".to_string(), |s| s.to_string())
+        )));
+    }
+    let mut out = Vec::with_capacity(need);
+    for (k, m) in knots.iter().zip(&mults) {
+        out.extend(std::iter::repeat_n(*k, *m));
+    }
+    Ok(out)
+}

@@ -1,0 +1,99 @@
+//! What STEP input yields: the faces to machine, each a NURBS surface with its orientation
+//! and its boundary loops as 3-D edge curves, plus the file's length unit. Everything is in
+//! mm, whatever unit the file used.
+
+use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
+
+pub use super::units::LengthUnit;
+
+/// A STEP file's free-form faces, in the order of the file's shells (solids and
+/// shell-based surface models in increasing `#id`, faces in each shell's order).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepModel {
+    pub faces: Vec<Face>,
+    pub unit: LengthUnit,
+    /// `FILE_SCHEMA` of the header (`AUTOMOTIVE_DESIGN` for AP214, `CONFIG_CONTROL_DESIGN` for
+    /// AP203), as written.
+    pub schemas: Vec<String>,
+}
+
+/// One `ADVANCED_FACE` (or `FACE_SURFACE`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Face {
+    /// The face's `#id` in the file.
+    pub id: u64,
+    /// The face's surface in mm, with the file's own parameters (knots as written). A
+    /// `PLANE` becomes the bilinear patch over its bounds' extent, parametrised as
+    /// `origin + u·x_axis + v·y_axis` (u, v in mm), as ISO 10303-42 parametrises a plane.
+    pub surface: NurbsSurface,
+    /// True when the face's outward normal (toward the material's outside, for a solid) is
+    /// `S_u × S_v`; the face's `same_sense` combined with any `ORIENTED_FACE` and
+    /// `ORIENTED_*_SHELL` flips on the way to it.
+    pub same_sense: bool,
+    /// The face's boundary loops. The surface's own domain is always a bound too: the face
+    /// is the part of `S(domain)` inside these loops.
+    pub bounds: Vec<Bound>,
+}
+
+/// A `FACE_BOUND` or `FACE_OUTER_BOUND`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bound {
+    pub id: u64,
+    /// Declared `FACE_OUTER_BOUND`. Writers that only use `FACE_BOUND` (OpenCascade) leave
+    /// this false for every loop; the outer loop is then the one enclosing the others.
+    pub outer: bool,
+    /// The bound's `orientation`: false means the loop is used reversed.
+    pub orientation: bool,
+    pub kind: BoundKind,
+}
+
+/// A loop of edges, or a single vertex (`VERTEX_LOOP`, e.g. a sphere's degenerate pole).
+#[derive(Debug, Clone, PartialEq)]
+pub enum BoundKind {
+    Edges(Vec<BoundEdge>),
+    Vertex(Vec3),
+}
+
+/// One `ORIENTED_EDGE` of an `EDGE_LOOP`: the piece of its `EDGE_CURVE`'s 3-D curve between
+/// the edge's vertices, exactly (a B-spline as written, a line as the segment), and the
+/// direction the loop runs along it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundEdge {
+    /// The `ORIENTED_EDGE`'s `#id`.
+    pub id: u64,
+    /// The `EDGE_CURVE`'s `#id` (shared by the two faces meeting at the edge).
+    pub edge: u64,
+    /// The piece `[t0, t1]` of the curve the edge covers.
+    pub curve: Trimmed<Nurbs>,
+    /// True when the loop runs along increasing curve parameter (the oriented edge's
+    /// orientation agreeing with the edge curve's `same_sense`).
+    pub forward: bool,
+}
+
+impl BoundEdge {
+    /// Where the loop enters the edge.
+    pub fn start(&self) -> Vec3 {
+        let (a, b) = self.curve.domain();
+        self.curve.point(if self.forward { a } else { b })
+    }
+
+    /// Where the loop leaves the edge.
+    pub fn end(&self) -> Vec3 {
+        let (a, b) = self.curve.domain();
+        self.curve.point(if self.forward { b } else { a })
+    }
+
+    /// `segments + 1` points along the edge in loop order, at equal parameter steps
+    /// (a polyline of the boundary for classification or display).
+    pub fn polyline(&self, segments: usize) -> Vec<Vec3> {
+        let n = segments.max(1);
+        let (a, b) = self.curve.domain();
+        (0..=n)
+            .map(|k| {
+                let s = k as f64 / n as f64;
+                let s = if self.forward { s } else { 1.0 - s };
+                self.curve.point(a + (b - a) * s)
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,345 @@
+//! Topology entities (ISO 10303-42 §5) down to faces: `MANIFOLD_SOLID_BREP`,
+//! `BREP_WITH_VOIDS`, `SHELL_BASED_SURFACE_MODEL` → `OPEN_SHELL`/`CLOSED_SHELL` (and their
+//! oriented forms) → `ADVANCED_FACE`/`FACE_SURFACE` (and `ORIENTED_FACE`) → `FACE_BOUND`s →
+//! `EDGE_LOOP` of `ORIENTED_EDGE`s on `EDGE_CURVE`s, or `VERTEX_LOOP`.
+
+use std::collections::HashSet;
+
+use tezgah_geom::deviation::closest_point;
+use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
+
+use super::entity::{Entity, Resolve};
+use super::error::StepError;
+use super::exchange::Param;
+use super::geometry::Geometry;
+use super::model::{Bound, BoundEdge, BoundKind, Face};
+
+/// The entities that hold a shape; their shells' faces are the model's faces.
+const BODIES: [&str; 3] = [
+    "MANIFOLD_SOLID_BREP",
+    "BREP_WITH_VOIDS",
+    "SHELL_BASED_SURFACE_MODEL",
+];
+const SHELLS: [&str; 2] = ["OPEN_SHELL", "CLOSED_SHELL"];
+
+/// A vertex within this distance (mm) of a curve end is at that end.
+const VERTEX_AT_END_MM: f64 = 1e-6;
+/// Samples per knot span for locating a vertex inside an edge curve.
+const LOCATE_SAMPLES_PER_SPAN: usize = 16;
+
+/// Faces of every body in the file (in `#id` order), or of every shell when the file has no
+/// body entity; a face reached twice is read once.
+pub(crate) fn faces(g: &Geometry<'_>) -> Result<Vec<Face>, StepError> {
+    let ids = g.ex.ids();
+    let is = |id: &u64, names: &[&str]| {
+        g.ex.entity(*id)
+            .is_some_and(|e| names.contains(&e.name()) && !e.instance.complex)
+    };
+    let mut walker = Walker {
+        g,
+        seen: HashSet::new(),
+        out: Vec::new(),
+    };
+    let bodies: Vec<u64> = ids.iter().copied().filter(|id| is(id, &BODIES)).collect();
+    if bodies.is_empty() {
+        let shells: Vec<u64> = ids.iter().copied().filter(|id| is(id, &SHELLS)).collect();
+        if shells.is_empty() {
+            return Err(StepError::NoShape);
+        }
+        for id in shells {
+            if let Some(e) = g.ex.entity(id) {
+                walker.shell(&e, true, 0)?;
+            }
+        }
+    } else {
+        for id in bodies {
+            if let Some(e) = g.ex.entity(id) {
+                walker.body(&e)?;
+            }
+        }
+    }
+    Ok(walker.out)
+}
+
+struct Walker<'g, 'a> {
+    g: &'g Geometry<'a>,
+    seen: HashSet<u64>,
+    out: Vec<Face>,
+}
+
+impl Walker<'_, '_> {
+    fn body(&mut self, b: &Entity<'_>) -> Result<(), StepError> {
+        let shells = match b.name() {
+            "SHELL_BASED_SURFACE_MODEL" => b.refs(1, "sbsm_boundary")?,
+            "MANIFOLD_SOLID_BREP" => vec![b.reference(1, "outer")?],
+            _ => {
+                let mut s = vec![b.reference(1, "outer")?];
+                s.extend(b.refs(2, "voids")?);
+                s
+            }
+        };
+        for id in shells {
+            let s = self.g.ex.get(id, b)?;
+            self.shell(&s, true, 0)?;
+        }
+        Ok(())
+    }
+
+    /// `sense` accumulates `ORIENTED_*_SHELL` flips; `depth` bounds oriented-shell chains.
+    fn shell(&mut self, s: &Entity<'_>, sense: bool, depth: usize) -> Result<(), StepError> {
+        match s.name() {
+            "OPEN_SHELL" | "CLOSED_SHELL" => {
+                for id in s.refs(1, "cfs_faces")? {
+                    let f = self.g.ex.get(id, s)?;
+                    self.face(&f, sense, 0)?;
+                }
+                Ok(())
+            }
+            "ORIENTED_OPEN_SHELL" | "ORIENTED_CLOSED_SHELL" if depth < 4 => {
+                let inner = self.g.ex.get(s.reference(2, "shell element")?, s)?;
+                let flip = s.boolean(3, "orientation")?;
+                self.shell(&inner, sense == flip, depth + 1)
+            }
+            _ => Err(StepError::Unsupported {
+                at: s.at(),
+                role: "a shell".to_string(),
+            }),
+        }
+    }
+
+    fn face(&mut self, f: &Entity<'_>, sense: bool, depth: usize) -> Result<(), StepError> {
+        match f.name() {
+            "ADVANCED_FACE" | "FACE_SURFACE" => {
+                if !self.seen.insert(f.id) {
+                    return Ok(());
+                }
+                let face = read_face(self.g, f, sense)?;
+                self.out.push(face);
+                Ok(())
+            }
+            "ORIENTED_FACE" if depth < 4 => {
+                let inner = self.g.ex.get(f.reference(2, "face element")?, f)?;
+                let flip = f.boolean(3, "orientation")?;
+                self.face(&inner, sense == flip, depth + 1)
+            }
+            _ => Err(StepError::Unsupported {
+                at: f.at(),
+                role: "a face".to_string(),
+            }),
+        }
+    }
+}
+
+fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, StepError> {
+    let same_sense = f.boolean(3, "same_sense")?;
+    let mut bounds = Vec::new();
+    for id in f.refs(1, "bounds")? {
+        let b = g.ex.get(id, f)?;
+        bounds.push(read_bound(g, &b)?);
+    }
+    let s = g.ex.get(f.reference(2, "face_geometry")?, f)?;
+    let surface = if s.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
+        g.bspline_surface(&s)?
+    } else if s.name() == "PLANE" && !s.instance.complex {
+        plane(g, &s, &bounds)?
+    } else {
+        return Err(StepError::Unsupported {
+            at: s.at(),
+            role: format!("the surface of {}", f.at()),
+        });
+    };
+    Ok(Face {
+        id: f.id,
+        surface,
+        same_sense: same_sense == sense,
+        bounds,
+    })
+}
+
+fn read_bound(g: &Geometry<'_>, b: &Entity<'_>) -> Result<Bound, StepError> {
+    let outer = match b.name() {
+        "FACE_OUTER_BOUND" => true,
+        "FACE_BOUND" => false,
+        _ => {
+            return Err(StepError::Unsupported {
+                at: b.at(),
+                role: "a face bound".to_string(),
+            })
+        }
+    };
+    let orientation = b.boolean(2, "orientation")?;
+    let l = g.ex.get(b.reference(1, "bound")?, b)?;
+    let kind = match l.name() {
+        "VERTEX_LOOP" => BoundKind::Vertex(g.vertex(l.reference(1, "loop_vertex")?, &l)?),
+        "EDGE_LOOP" => {
+            let mut edges = Vec::new();
+            for id in l.refs(1, "edge_list")? {
+                let oe = g.ex.get(id, &l)?;
+                edges.push(read_edge(g, &oe)?);
+            }
+            BoundKind::Edges(edges)
+        }
+        _ => {
+            return Err(StepError::Unsupported {
+                at: l.at(),
+                role: format!("the loop of {}", b.at()),
+            })
+        }
+    };
+    Ok(Bound {
+        id: b.id,
+        outer,
+        orientation,
+        kind,
+    })
+}
+
+/// `ORIENTED_EDGE('', *, *, #edge_curve, orientation)` → the edge curve's piece between its
+/// vertices and the loop's direction along it.
+fn read_edge(g: &Geometry<'_>, oe: &Entity<'_>) -> Result<BoundEdge, StepError> {
+    if oe.name() != "ORIENTED_EDGE" {
+        return Err(StepError::Unsupported {
+            at: oe.at(),
+            role: "an edge of a loop".to_string(),
+        });
+    }
+    let orientation = oe.boolean(4, "orientation")?;
+    let e = g.ex.get(oe.reference(3, "edge_element")?, oe)?;
+    if e.name() != "EDGE_CURVE" {
+        return Err(StepError::Unsupported {
+            at: e.at(),
+            role: format!("the edge of {}", oe.at()),
+        });
+    }
+    let v0 = g.vertex(e.reference(1, "edge_start")?, &e)?;
+    let v1 = g.vertex(e.reference(2, "edge_end")?, &e)?;
+    let c = g.ex.get(e.reference(3, "edge_geometry")?, &e)?;
+    let same_sense = e.boolean(4, "same_sense")?;
+    let (curve, t0, t1) = if is_line(g, &c) {
+        // An edge on a (infinite) line is the segment between its vertices.
+        let seg = Nurbs::bspline(1, &[v0, v1], vec![0.0, 0.0, 1.0, 1.0])
+            .map_err(|err| e.invalid(err.to_string()))?;
+        (seg, 0.0, 1.0)
+    } else {
+        let curve = g.curve(&c, 0)?;
+        let (lo_pt, hi_pt) = if same_sense { (v0, v1) } else { (v1, v0) };
+        let lo = locate(&curve, &lo_pt, true);
+        let hi = locate(&curve, &hi_pt, false);
+        if hi <= lo {
+            return Err(e.invalid(
+                "its vertices do not bound a piece of its curve in the curve's direction",
+            ));
+        }
+        (curve, lo, hi)
+    };
+    let forward = if is_line(g, &c) {
+        orientation
+    } else {
+        orientation == same_sense
+    };
+    let curve = Trimmed::new(curve, t0, t1).map_err(|err| e.invalid(err.to_string()))?;
+    Ok(BoundEdge {
+        id: oe.id,
+        edge: e.id,
+        curve,
+        forward,
+    })
+}
+
+/// A `LINE`, directly or as the 3-D curve of a surface/seam curve.
+fn is_line(g: &Geometry<'_>, c: &Entity<'_>) -> bool {
+    match c.name() {
+        "LINE" => !c.instance.complex,
+        "SURFACE_CURVE" | "SEAM_CURVE" => match c.record.params.get(1) {
+            Some(Param::Ref(id)) => g.ex.entity(*id).is_some_and(|e| e.name() == "LINE"),
+            _ => false,
+        },
+        _ => false,
+    }
+}
+
+/// The parameter of `q` on `curve`: a domain end when `q` is there (`prefer_start` says which
+/// end wins on a closed curve), else the closest point.
+fn locate(curve: &Nurbs, q: &Vec3, prefer_start: bool) -> f64 {
+    let (a, b) = curve.domain();
+    let at = |t: f64| (curve.point(t) - q).norm() <= VERTEX_AT_END_MM;
+    let ends = if prefer_start { [a, b] } else { [b, a] };
+    for t in ends {
+        if at(t) {
+            return t;
+        }
+    }
+    let spans = curve.breakpoints().len().max(2) - 1;
+    closest_point(curve, q, a, b, LOCATE_SAMPLES_PER_SPAN * spans).u
+}
+
+/// A `PLANE` face as the bilinear patch over its bounds' extent in the plane's axes.
+fn plane(g: &Geometry<'_>, s: &Entity<'_>, bounds: &[Bound]) -> Result<NurbsSurface, StepError> {
+    let a = g.ex.get(s.reference(1, "position")?, s)?;
+    if a.name() != "AXIS2_PLACEMENT_3D" {
+        return Err(StepError::Unsupported {
+            at: a.at(),
+            role: format!("the position of {}", s.at()),
+        });
+    }
+    let origin = g.point(a.reference(1, "location")?, &a)?;
+    let z = direction(g, &a, 2)?.unwrap_or_else(Vec3::z);
+    let r = direction(g, &a, 3)?.unwrap_or_else(Vec3::x);
+    let x = r - z * r.dot(&z);
+    if x.norm() < 1e-12 {
+        return Err(a.invalid("ref_direction is parallel to axis"));
+    }
+    let x = x.normalize();
+    let y = z.cross(&x);
+    let (mut u0, mut u1, mut v0, mut v1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for b in bounds {
+        let pts = match &b.kind {
+            BoundKind::Vertex(p) => vec![*p],
+            BoundKind::Edges(edges) => edges.iter().flat_map(|e| e.polyline(32)).collect(),
+        };
+        for p in pts {
+            let d = p - origin;
+            let (u, v) = (d.dot(&x), d.dot(&y));
+            u0 = u0.min(u);
+            u1 = u1.max(u);
+            v0 = v0.min(v);
+            v1 = v1.max(v);
+        }
+    }
+    if !(u0 < u1 && v0 < v1) {
+        return Err(s.invalid("a plane face needs bounds that enclose an area"));
+    }
+    let corner = |u: f64, v: f64| origin + x * u + y * v;
+    let pts = [
+        corner(u0, v0),
+        corner(u0, v1),
+        corner(u1, v0),
+        corner(u1, v1),
+    ];
+    NurbsSurface::bspline(1, 1, &pts, vec![u0, u0, u1, u1], vec![v0, v0, v1, v1])
+        .map_err(|e| s.invalid(e.to_string()))
+}
+
+/// An optional `DIRECTION` attribute, normalised.
+fn direction(g: &Geometry<'_>, a: &Entity<'_>, i: usize) -> Result<Option<Vec3>, StepError> {
+    if matches!(a.param(i, "direction")?, Param::Unset) {
+        return Ok(None);
+    }
+    let d = g.ex.get(a.reference(i, "direction")?, a)?;
+    if d.name() != "DIRECTION" {
+        return Err(StepError::Unsupported {
+            at: d.at(),
+            role: format!("a direction of {}", a.at()),
+        });
+    }
+    let c = d.reals(1, "direction_ratios")?;
+    let v = match c.as_slice() {
+        [x, y, z] => Vec3::new(*x, *y, *z),
+        _ => return Err(d.invalid("a 3-D direction needs 3 ratios")),
+    };
+    let n = v.norm();
+    if !(n.is_finite() && n > 0.0) {
+        return Err(d.invalid("direction has zero length"));
+    }
+    Ok(Some(v / n))
+}

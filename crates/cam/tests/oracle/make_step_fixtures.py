@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""Generate the STEP fixtures of crates/cam/tests/step_occ.rs and their reference points.
+
+OpenCascade (the `cadquery-ocp-novtk` wheel from PyPI) builds three surfaces, writes each as a
+STEP AP214 file, reads the file back with its own STEPControl_Reader and evaluates every face of
+the re-read shape at a grid of (u, v): point and first partial derivatives, in mm. The reader
+works on the surface *as written in the file*, so the reference is at the file's parameters even
+where the writer re-knotted or re-parametrised a surface.
+
+Run once, commit the output (ordinary tests need no Python):
+
+    python3 -m venv /tmp/ocpvenv && /tmp/ocpvenv/bin/pip install cadquery-ocp-novtk
+    /tmp/ocpvenv/bin/python crates/cam/tests/oracle/make_step_fixtures.py crates/cam/tests/fixtures
+
+Fixtures:
+  freeform_patch.stp   bicubic 8x9 B-spline patch, ~100 x 100 mm, non-uniform knots (a face:
+                       SHELL_BASED_SURFACE_MODEL / OPEN_SHELL / ADVANCED_FACE)
+  freeform_patch_inch.stp  the same patch written in inches (CONVERSION_BASED_UNIT)
+  rational_sphere.stp  a sphere of radius 40 converted to NURBS (rational, poles degenerate;
+                       MANIFOLD_SOLID_BREP / CLOSED_SHELL)
+  twisted_blade.stp    a solid lofted through 5 elliptic sections twisted by 15 degrees each,
+                       converted to NURBS (rational B-spline sides, B-spline caps)
+Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "samples": [[u, v, x, y, z,
+dxdu, dydu, dzdu, dxdv, dydv, dzdv], ...]}, ...]} with faces in the order of the re-read shape.
+"""
+import json
+import math
+import os
+import re
+import sys
+
+from OCP.BRep import BRep_Tool
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace, BRepBuilderAPI_NurbsConvert
+from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeWire
+from OCP.BRepOffsetAPI import BRepOffsetAPI_ThruSections
+from OCP.BRepPrimAPI import BRepPrimAPI_MakeSphere
+from OCP.collections import Array1_double, Array1_int, Array2_gp_Pnt
+from OCP.Geom import Geom_BSplineSurface, Geom_Ellipse
+from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt, gp_Vec
+from OCP.IFSelect import IFSelect_RetDone
+from OCP.Interface import Interface_Static
+from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
+from OCP.TopAbs import TopAbs_FACE
+from OCP.TopExp import TopExp_Explorer
+from OCP.TopoDS import TopoDS
+
+SAMPLES = 12  # per direction: 144 per face
+
+
+def freeform_patch():
+    """Bicubic 8 x 9 patch over [0, 100] x [0, 100] mm, a wavy z, non-uniform knots."""
+    rows, cols = 8, 9
+    poles = Array2_gp_Pnt(1, rows, 1, cols)
+    for i in range(rows):
+        for j in range(cols):
+            x = 100.0 * i / (rows - 1)
+            y = 100.0 * j / (cols - 1) + 3.0 * math.sin(0.7 * i)
+            z = 8.0 * math.sin(0.9 * i + 0.3) * math.cos(0.6 * j) + 0.05 * x
+            poles.SetValue(i + 1, j + 1, gp_Pnt(x, y, z))
+    uk = [0.0, 0.13, 0.37, 0.52, 0.81, 1.0]  # 6 distinct, mults 4 1 1 1 1 4: 8 + 4 = 12 knots
+    um = [4, 1, 1, 1, 1, 4]
+    vk = [0.0, 0.08, 0.3, 0.45, 0.66, 0.7, 1.0]  # mults 4 1 1 1 1 1 4: 9 + 4 = 13 knots
+    vm = [4, 1, 1, 1, 1, 1, 4]
+    surf = Geom_BSplineSurface(poles, arr(uk), arr(vk), iarr(um), iarr(vm), 3, 3)
+    return BRepBuilderAPI_MakeFace(surf, 1e-7).Face()
+
+
+def rational_sphere():
+    return BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeSphere(40.0).Shape()).Shape()
+
+
+def twisted_blade():
+    loft = BRepOffsetAPI_ThruSections(True, False, 1e-6)
+    for k in range(5):
+        z = 25.0 * k
+        twist = math.radians(15.0 * k)
+        axes = gp_Ax2(gp_Pnt(0.0, 0.0, z), gp_Dir(0, 0, 1), gp_Dir(math.cos(twist), math.sin(twist), 0))
+        ellipse = Geom_Ellipse(axes, 30.0 - 2.0 * k, 6.0 + 0.5 * k)
+        edge = BRepBuilderAPI_MakeEdge(ellipse).Edge()
+        loft.AddWire(BRepBuilderAPI_MakeWire(edge).Wire())
+    loft.Build()
+    return BRepBuilderAPI_NurbsConvert(loft.Shape()).Shape()
+
+
+def arr(values):
+    a = Array1_double(1, len(values))
+    for k, x in enumerate(values):
+        a.SetValue(k + 1, x)
+    return a
+
+
+def iarr(values):
+    a = Array1_int(1, len(values))
+    for k, x in enumerate(values):
+        a.SetValue(k + 1, x)
+    return a
+
+
+def write(shape, path, unit="MM"):
+    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
+    Interface_Static.SetCVal_s("write.step.unit", unit)
+    w = STEPControl_Writer()
+    w.Transfer(shape, STEPControl_AsIs)
+    if w.Write(path) != IFSelect_RetDone:
+        raise RuntimeError("cannot write " + path)
+    # Drop the time stamp so that regenerating unchanged geometry gives the same bytes.
+    with open(path) as f:
+        text = f.read()
+    text = re.sub(r"FILE_NAME\('[^']*','[^']*'",
+                  "FILE_NAME('%s','2026-01-01T00:00:00'" % os.path.basename(path), text, count=1)
+    with open(path, "w") as f:
+        f.write(text)
+
+
+def reference(path):
+    r = STEPControl_Reader()
+    if r.ReadFile(path) != IFSelect_RetDone:
+        raise RuntimeError("cannot read " + path)
+    r.TransferRoots()
+    shape = r.OneShape()
+    faces = []
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        face = TopoDS.Face(ex.Current())
+        surf = BRep_Tool.Surface_s(face)
+        u0, u1, v0, v1 = surf.Bounds()
+        samples = []
+        for a in range(SAMPLES):
+            for b in range(SAMPLES):
+                # Irregular spacing, ends included: knots and interiors both get hit.
+                u = u0 + (u1 - u0) * (a / (SAMPLES - 1)) ** 1.3
+                v = v0 + (v1 - v0) * (b / (SAMPLES - 1)) ** 0.8
+                p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
+                surf.D1(u, v, p, du, dv)
+                samples.append([u, v, p.X(), p.Y(), p.Z(), du.X(), du.Y(), du.Z(), dv.X(), dv.Y(), dv.Z()])
+        faces.append({"u": [u0, u1], "v": [v0, v1], "samples": samples})
+        ex.Next()
+    return {"generator": "make_step_fixtures.py, OCCT via cadquery-ocp-novtk", "faces": faces}
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "fixtures")
+    os.makedirs(out, exist_ok=True)
+    cases = [
+        ("freeform_patch", freeform_patch(), "MM"),
+        ("freeform_patch_inch", freeform_patch(), "INCH"),
+        ("rational_sphere", rational_sphere(), "MM"),
+        ("twisted_blade", twisted_blade(), "MM"),
+    ]
+    for name, shape, unit in cases:
+        stp = os.path.join(out, name + ".stp")
+        write(shape, stp, unit)
+        with open(os.path.join(out, name + ".json"), "w") as f:
+            json.dump(reference(stp), f, separators=(",", ":"))
+            f.write("\n")
+        print(name, os.path.getsize(stp), "bytes")
+
+
+if __name__ == "__main__":
+    main()
