@@ -1,0 +1,365 @@
+//! STEP input: the thesis's STEP excerpt (reference 001, EK-A) with its golden boundary curve,
+//! hand-written files with closed-form answers (a plane face, units), and the exact error
+//! texts for unknown entities, dangling references, bad knot counts and units.
+
+use std::path::PathBuf;
+
+use tezgah_cam::step::{self, BoundKind, StepError, StepFile};
+use tezgah_geom::{Curve, Vec3};
+
+fn excerpt() -> String {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/001_surface_excerpt.stp");
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The excerpt with its elision lines (`.....`, `.`) blanked, so line numbers are kept.
+fn excerpt_without_elisions() -> String {
+    excerpt()
+        .lines()
+        .map(|l| {
+            if !l.trim().is_empty() && l.trim().chars().all(|c| c == '.') {
+                ""
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+const HEAD: &str = "ISO-10303-21;
+HEADER;
+FILE_DESCRIPTION(('test'),'2;1');
+FILE_NAME('t.stp','2026-01-01T00:00:00',(''),(''),'','','');
+FILE_SCHEMA(('AUTOMOTIVE_DESIGN'));
+ENDSEC;
+DATA;
+";
+
+fn file(data: &str) -> String {
+    format!("{HEAD}{data}\nENDSEC;\nEND-ISO-10303-21;\n")
+}
+
+/// A 20 × 10 rectangle in the plane z = 5 (origin (1, 2, 5)), as a face of a shell-based
+/// surface model bounded by four lines, in the length unit `unit` (line 8 on).
+fn plane_file(unit: &str, face_sense: &str) -> String {
+    file(&format!(
+        "#1 = SHELL_BASED_SURFACE_MODEL('',(#2));
+#2 = OPEN_SHELL('',(#3));
+#3 = ADVANCED_FACE('',(#4),#30,{face_sense});
+#4 = FACE_OUTER_BOUND('',#5,.T.);
+#5 = EDGE_LOOP('',(#6,#7,#8,#9));
+#6 = ORIENTED_EDGE('',*,*,#10,.T.);
+#7 = ORIENTED_EDGE('',*,*,#11,.T.);
+#8 = ORIENTED_EDGE('',*,*,#12,.T.);
+#9 = ORIENTED_EDGE('',*,*,#13,.F.);
+#10 = EDGE_CURVE('',#20,#21,#40,.T.);
+#11 = EDGE_CURVE('',#21,#22,#40,.T.);
+#12 = EDGE_CURVE('',#22,#23,#40,.T.);
+#13 = EDGE_CURVE('',#20,#23,#40,.T.);
+#20 = VERTEX_POINT('',#24);
+#21 = VERTEX_POINT('',#25);
+#22 = VERTEX_POINT('',#26);
+#23 = VERTEX_POINT('',#27);
+#24 = CARTESIAN_POINT('',(1.,2.,5.));
+#25 = CARTESIAN_POINT('',(21.,2.,5.));
+#26 = CARTESIAN_POINT('',(21.,12.,5.));
+#27 = CARTESIAN_POINT('',(1.,12.,5.));
+#30 = PLANE('',#31);
+#31 = AXIS2_PLACEMENT_3D('',#32,#33,#34);
+#32 = CARTESIAN_POINT('',(0.,0.,5.));
+#33 = DIRECTION('',(0.,0.,1.));
+#34 = DIRECTION('',(1.,0.,0.));
+#40 = LINE('',#32,#41);
+#41 = VECTOR('',#33,1.);
+#50 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#51,#52))
+  REPRESENTATION_CONTEXT('',''));
+#51 = {unit};
+#52 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );"
+    ))
+}
+
+const MM: &str = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )";
+
+#[test]
+fn excerpt_as_printed_is_a_syntax_error_at_the_elision() {
+    let e = step::read(&excerpt()).unwrap_err();
+    assert_eq!(e.to_string(), "line 69: a number needs digits");
+}
+
+#[test]
+fn excerpt_units_and_missing_shell() {
+    let text = excerpt_without_elisions();
+    let f = StepFile::parse(text.as_bytes()).unwrap();
+    assert_eq!(f.unit().name, "MILLI METRE");
+    assert_eq!(f.unit().mm, 1.0);
+    // 41 control points + 35 other instances survive the elisions (#1–#35, #105–#145).
+    assert_eq!(f.instance_count(), 35 + 41);
+    let e = f.model().unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "#116 SHELL_BASED_SURFACE_MODEL (line 91): refers to #162, which the file does not define"
+    );
+}
+
+#[test]
+fn excerpt_surface_reports_the_corrupted_multiplicities_then_the_elided_points() {
+    let text = excerpt_without_elisions();
+    let f = StepFile::parse(text.as_bytes()).unwrap();
+    assert_eq!(
+        f.surface(1).unwrap_err().to_string(),
+        "#1 B_SPLINE_SURFACE_WITH_KNOTS (line 15): v multiplicities list has 8 entries but v knots has 9"
+    );
+    // Reference 001 §5.1: the v list must be (4,1,1,1,1,1,1,1,4); with it repaired, the first
+    // control point the excerpt elided (row 2, column 8) is the error.
+    let repaired = text.replacen(
+        "( 4, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 0.0",
+        "( 4, 1, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 0.0",
+        1,
+    );
+    let repaired = repaired.replacen(
+        "( 4, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 4, 1, 1, 1, 1, 1, 1, 4 )",
+        "( 4, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 4, 1, 1, 1, 1, 1, 1, 1, 4 )",
+        1,
+    );
+    let f = StepFile::parse(repaired.as_bytes()).unwrap();
+    assert_eq!(
+        f.surface(1).unwrap_err().to_string(),
+        "#1 B_SPLINE_SURFACE_WITH_KNOTS (line 15): refers to #40, which the file does not define"
+    );
+}
+
+#[test]
+fn excerpt_boundary_curve_matches_the_golden_values() {
+    // #114 is the u = 0 boundary reversed: C(t) = S(0, 1 − t); reference 001 §5.2 gives
+    // S(0, v) to 9 decimals. #121 (the curve's first point) lost digits in transcription
+    // (≈ 2e-9 mm), hence 1e-8.
+    let f = StepFile::parse(excerpt_without_elisions().as_bytes()).unwrap();
+    let c = f.curve(114).unwrap();
+    assert_eq!(c.degree(), 3);
+    assert_eq!(c.domain(), (0.0, 1.0));
+    let golden = [
+        (0.0, 0.0, 160.0, -3.0e-15),
+        (0.1, 12.973465610, 160.0, 0.257625035),
+        (0.25, 32.400423760, 160.0, -0.194959050),
+        (0.5, 64.716606570, 160.0, -2.609006400),
+        (0.75, 97.127191700, 160.0, -1.961494260),
+        (0.9, 116.543372760, 160.0, -0.833556840),
+        (1.0, 129.475449392, 160.0, 0.0),
+    ];
+    for (v, x, y, z) in golden {
+        let p = c.point(1.0 - v);
+        assert!((p - Vec3::new(x, y, z)).amax() < 1e-8, "v = {v}: {p:?}");
+    }
+}
+
+#[test]
+fn plane_face_bounded_by_lines() {
+    let m = step::read(&plane_file(MM, ".T.")).unwrap();
+    assert_eq!(m.faces.len(), 1);
+    let f = &m.faces[0];
+    assert_eq!(f.id, 3);
+    assert!(f.same_sense);
+    // The bilinear patch over the loop's extent, with the plane's own parameters (mm from the
+    // plane's origin (0, 0, 5) along x and y).
+    assert_eq!(f.surface.degrees(), (1, 1));
+    assert_eq!(f.surface.domain_u(), (1.0, 21.0));
+    assert_eq!(f.surface.domain_v(), (2.0, 12.0));
+    assert!((f.surface.point(7.0, 4.5) - Vec3::new(7.0, 4.5, 5.0)).amax() < 1e-12);
+    let n = f.surface.derivs(7.0, 4.5);
+    assert_eq!(n.su.cross(&n.sv).normalize(), Vec3::z());
+    let b = &f.bounds[0];
+    assert!(b.outer && b.orientation);
+    let BoundKind::Edges(edges) = &b.kind else {
+        panic!("an edge loop")
+    };
+    // The loop runs (1,2) → (21,2) → (21,12) → (1,12) → (1,2); the last edge is used reversed.
+    let corners =
+        [(1.0, 2.0), (21.0, 2.0), (21.0, 12.0), (1.0, 12.0)].map(|(x, y)| Vec3::new(x, y, 5.0));
+    for (k, e) in edges.iter().enumerate() {
+        assert_eq!(e.start(), corners[k]);
+        assert_eq!(e.end(), corners[(k + 1) % 4]);
+    }
+    assert!(!edges[3].forward);
+    assert_eq!(edges[3].polyline(2)[1], Vec3::new(1.0, 7.0, 5.0));
+}
+
+#[test]
+fn face_sense_and_oriented_faces_combine() {
+    let m = step::read(&plane_file(MM, ".F.")).unwrap();
+    assert!(!m.faces[0].same_sense);
+    let flipped = plane_file(MM, ".F.").replace(
+        "#2 = OPEN_SHELL('',(#3));",
+        "#2 = OPEN_SHELL('',(#60));\n#60 = ORIENTED_FACE('',*,#3,.F.);",
+    );
+    assert!(step::read(&flipped).unwrap().faces[0].same_sense);
+}
+
+#[test]
+fn lengths_are_converted_to_mm() {
+    let metre = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.METRE.) )";
+    let m = step::read(&plane_file(metre, ".T.")).unwrap();
+    assert_eq!(m.unit.name, "METRE");
+    assert_eq!(m.unit.mm, 1000.0);
+    assert_eq!(m.faces[0].surface.domain_u(), (1000.0, 21000.0));
+    let p = m.faces[0].surface.point(1000.0, 2000.0);
+    assert!((p - Vec3::new(1000.0, 2000.0, 5000.0)).amax() < 1e-9);
+    let centi = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.CENTI.,.METRE.) )";
+    assert_eq!(step::read(&plane_file(centi, ".T.")).unwrap().unit.mm, 10.0);
+    let foot = "( CONVERSION_BASED_UNIT('FOOT',#53) LENGTH_UNIT() NAMED_UNIT(#54) );
+#53 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(12.),#55);
+#54 = DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);
+#55 = ( CONVERSION_BASED_UNIT('INCH',#56) LENGTH_UNIT() NAMED_UNIT(#54) );
+#56 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#57);
+#57 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) )";
+    let m = step::read(&plane_file(foot, ".T.")).unwrap();
+    assert_eq!(m.unit.name, "FOOT");
+    assert!((m.unit.mm - 304.8).abs() < 1e-12);
+    // Without any unit context, millimetres are assumed and said so.
+    let bare = plane_file(MM, ".T.").replace("GLOBAL_UNIT_ASSIGNED_CONTEXT((#51,#52))", "");
+    assert_eq!(step::read(&bare).unwrap().unit.name, "mm (assumed)");
+}
+
+#[test]
+fn unit_errors() {
+    let second = "( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.SECOND.) )";
+    assert_eq!(
+        step::read(&plane_file(second, ".T."))
+            .unwrap_err()
+            .to_string(),
+        "#51 LENGTH_UNIT+NAMED_UNIT+SI_UNIT (line 38): length unit .SECOND. is not a length"
+    );
+    let loop_unit = "( CONVERSION_BASED_UNIT('LOOP',#53) LENGTH_UNIT() NAMED_UNIT(*) );
+#53 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(2.),#51)";
+    assert_eq!(
+        step::read(&plane_file(loop_unit, ".T.")).unwrap_err().to_string(),
+        "#51 CONVERSION_BASED_UNIT+LENGTH_UNIT+NAMED_UNIT (line 38): unit conversions chained deeper than 8"
+    );
+    let two = plane_file(MM, ".T.").replace(
+        "#52 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );",
+        "#52 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );
+#60 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#61)) REPRESENTATION_CONTEXT('',''));
+#61 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT($,.METRE.) );",
+    );
+    assert_eq!(
+        step::read(&two).unwrap_err().to_string(),
+        "the file has several length units: MILLI METRE and METRE"
+    );
+}
+
+#[test]
+fn unsupported_entities_are_named() {
+    let cyl = plane_file(MM, ".T.").replace(
+        "#30 = PLANE('',#31);",
+        "#30 = CYLINDRICAL_SURFACE('',#31,4.);",
+    );
+    assert_eq!(
+        step::read(&cyl).unwrap_err().to_string(),
+        "#30 CYLINDRICAL_SURFACE (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
+    );
+    let circle = plane_file(MM, ".T.").replace(
+        "#11 = EDGE_CURVE('',#21,#22,#40,.T.);",
+        "#11 = EDGE_CURVE('',#21,#22,#42,.T.);\n#42 = CIRCLE('',#31,3.);",
+    );
+    assert_eq!(
+        step::read(&circle).unwrap_err().to_string(),
+        "#42 CIRCLE (line 19): unsupported entity, met as an edge curve"
+    );
+    let poly = plane_file(MM, ".T.").replace(
+        "#5 = EDGE_LOOP('',(#6,#7,#8,#9));",
+        "#5 = POLY_LOOP('',(#24,#25,#26));",
+    );
+    assert_eq!(
+        step::read(&poly).unwrap_err().to_string(),
+        "#5 POLY_LOOP (line 12): unsupported entity, met as the loop of #4 FACE_OUTER_BOUND (line 11)"
+    );
+    let nothing = file("#1 = CARTESIAN_POINT('',(0.,0.,0.));");
+    assert_eq!(step::read(&nothing).unwrap_err(), StepError::NoShape);
+}
+
+#[test]
+fn dangling_references_are_named() {
+    let text = plane_file(MM, ".T.").replace("#26 = CARTESIAN_POINT('',(21.,12.,5.));\n", "");
+    assert_eq!(
+        step::read(&text).unwrap_err().to_string(),
+        "#22 VERTEX_POINT (line 23): refers to #26, which the file does not define"
+    );
+}
+
+const SURFACE: &str = "#1 = SHELL_BASED_SURFACE_MODEL('',(#2));
+#2 = OPEN_SHELL('',(#3));
+#3 = ADVANCED_FACE('',(),#4,.T.);
+#4 = B_SPLINE_SURFACE_WITH_KNOTS('',1,1,((#10,#11),(#12,#13)),.UNSPECIFIED.,.F.,.F.,.F.,
+  (2,2),(2,2),(0.,1.),(0.,2.),.UNSPECIFIED.);
+#10 = CARTESIAN_POINT('',(0.,0.,0.));
+#11 = CARTESIAN_POINT('',(0.,10.,0.));
+#12 = CARTESIAN_POINT('',(10.,0.,0.));
+#13 = CARTESIAN_POINT('',(10.,10.,3.));";
+
+#[test]
+fn bilinear_b_spline_face() {
+    let m = step::read(&file(SURFACE)).unwrap();
+    let s = &m.faces[0].surface;
+    assert_eq!(s.domain_v(), (0.0, 2.0));
+    // The bilinear interpolant of the corners: z = 3·u·(v/2) at (u, v).
+    assert!((s.point(0.5, 1.0) - Vec3::new(5.0, 5.0, 0.75)).amax() < 1e-12);
+    assert!(m.faces[0].bounds.is_empty());
+}
+
+#[test]
+fn knot_errors() {
+    let bad_sum =
+        file(SURFACE).replace("(2,2),(2,2),(0.,1.),(0.,2.)", "(2,2),(2,1),(0.,1.),(0.,2.)");
+    assert_eq!(
+        step::read(&bad_sum).unwrap_err().to_string(),
+        "#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): v multiplicities sum to 3, but 2 control points of degree 1 need 4"
+    );
+    let decreasing = file(SURFACE).replace("(0.,1.),(0.,2.)", "(0.,1.),(2.,0.)");
+    assert!(step::read(&decreasing)
+        .unwrap_err()
+        .to_string()
+        .starts_with("#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): v direction: "));
+    let degree = file(SURFACE).replace(
+        "B_SPLINE_SURFACE_WITH_KNOTS('',1,1,",
+        "B_SPLINE_SURFACE_WITH_KNOTS('',1,99,",
+    );
+    assert_eq!(
+        step::read(&degree).unwrap_err().to_string(),
+        "#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): v_degree is 99; tezgah reads degrees 1 to 15"
+    );
+    let ragged = file(SURFACE).replace("((#10,#11),(#12,#13))", "((#10,#11),(#12))");
+    assert_eq!(
+        step::read(&ragged).unwrap_err().to_string(),
+        "#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): control point row 2 has 1 points, row 1 has 2"
+    );
+    let short = file(SURFACE)
+        .replace(",.UNSPECIFIED.);\n#10", ");\n#10")
+        .replace("(2,2),(2,2),(0.,1.),(0.,2.)", "(2,2),(2,2),(0.,1.)");
+    assert_eq!(
+        step::read(&short).unwrap_err().to_string(),
+        "#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): B_SPLINE_SURFACE_WITH_KNOTS has 11 attributes, v_knots (attribute 12) is missing"
+    );
+}
+
+#[test]
+fn read_file_names_the_file() {
+    let dir = std::env::temp_dir().join(format!("tezgah-step-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.stp");
+    std::fs::write(&path, file("#1 = A(;")).unwrap();
+    let e = step::read_file(&path).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        format!(
+            "{}: line 8: expected a parameter, found `;`",
+            path.display()
+        )
+    );
+    let missing = dir.join("missing.stp");
+    assert!(step::read_file(&missing)
+        .unwrap_err()
+        .to_string()
+        .starts_with(&format!("{}: ", missing.display())));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
