@@ -258,13 +258,13 @@ fn unsupported_entities_are_named() {
         step::read(&cyl).unwrap_err().to_string(),
         "#30 CYLINDRICAL_SURFACE (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
     );
-    let circle = plane_file(MM, ".T.").replace(
+    let hyperbola = plane_file(MM, ".T.").replace(
         "#11 = EDGE_CURVE('',#21,#22,#40,.T.);",
-        "#11 = EDGE_CURVE('',#21,#22,#42,.T.);\n#42 = CIRCLE('',#31,3.);",
+        "#11 = EDGE_CURVE('',#21,#22,#42,.T.);\n#42 = HYPERBOLA('',#31,3.,2.);",
     );
     assert_eq!(
-        step::read(&circle).unwrap_err().to_string(),
-        "#42 CIRCLE (line 19): unsupported entity, met as an edge curve"
+        step::read(&hyperbola).unwrap_err().to_string(),
+        "#42 HYPERBOLA (line 19): unsupported entity, met as an edge curve"
     );
     let poly = plane_file(MM, ".T.").replace(
         "#5 = EDGE_LOOP('',(#6,#7,#8,#9));",

@@ -41,6 +41,12 @@ fn check(name: &str) -> (StepModel, f64, f64) {
                 "{name} face {k}: domain {got} vs {want}"
             );
         }
+        // OCCT reverses a face in its shell where the file says same_sense = .F.
+        assert_eq!(
+            face.same_sense,
+            !reference["reversed"].as_bool().unwrap(),
+            "{name} face {k}: orientation"
+        );
         for s in reference["samples"].as_array().unwrap() {
             let s: Vec<f64> = s.as_array().unwrap().iter().map(num).collect();
             let d = face.surface.derivs(s[0], s[1]);
@@ -166,4 +172,50 @@ fn twisted_blade_matches_occt() {
         }
     }
     assert!(uses.values().all(|&n| n == 2), "{uses:?}");
+}
+
+#[test]
+fn ap203_file_reads_like_ap214() {
+    let (m, _, _) = check("freeform_patch_ap203");
+    assert_eq!(m.schemas, vec!["CONFIG_CONTROL_DESIGN".to_string()]);
+    let ap214 = step::read_file(fixture("freeform_patch.stp")).unwrap();
+    assert_eq!(m.faces[0].surface, ap214.faces[0].surface);
+}
+
+#[test]
+fn plate_with_holes_matches_occt() {
+    let (m, _, _) = check("plate_with_holes");
+    let f = &m.faces[0];
+    assert_eq!(f.surface.degrees(), (1, 1));
+    assert_eq!(f.bounds.len(), 3);
+    let loops: Vec<_> = f
+        .bounds
+        .iter()
+        .map(|b| match &b.kind {
+            BoundKind::Edges(e) => (b.orientation, e),
+            BoundKind::Vertex(_) => panic!("edge loops"),
+        })
+        .collect();
+    assert_eq!(loops[0].1.len(), 4);
+    // The holes are single closed edges, used reversed by their bounds.
+    let (circle_sense, circle) = (loops[1].0, &loops[1].1[0]);
+    let (ellipse_sense, ellipse) = (loops[2].0, &loops[2].1[0]);
+    assert!(!circle_sense && !ellipse_sense);
+    let centre = tezgah_geom::Vec3::new(25.0, 30.0, 5.0);
+    assert!((circle.start() - circle.end()).norm() < 1e-12);
+    for p in circle.polyline(97) {
+        assert!(((p - centre).norm() - 10.0).abs() < 1e-12, "{p:?}");
+    }
+    let (c, s) = (0.5f64.cos(), 0.5f64.sin());
+    for p in ellipse.polyline(97) {
+        let d = p - tezgah_geom::Vec3::new(58.0, 30.0, 5.0);
+        let (x, y) = (d.x * c + d.y * s, -d.x * s + d.y * c);
+        assert!(
+            ((x / 12.0).powi(2) + (y / 6.0).powi(2) - 1.0).abs() < 1e-12,
+            "{p:?}"
+        );
+        assert!(d.z.abs() < 1e-12);
+    }
+    // The closed conics are whole: their length is the circumference.
+    assert!((tezgah_geom::Curve::length(&circle.curve) - 20.0 * std::f64::consts::PI).abs() < 1e-9);
 }

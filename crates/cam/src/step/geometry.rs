@@ -126,6 +126,21 @@ impl<'a> Geometry<'a> {
         NurbsSurface::new(p, q, &points, &weights, ku, kv).map_err(|e| s.invalid(e.to_string()))
     }
 
+    /// The 3-D curve behind `SURFACE_CURVE`/`SEAM_CURVE`/`INTERSECTION_CURVE` wrappers (the
+    /// curve itself otherwise).
+    pub fn basis_curve(&self, mut c: Entity<'a>) -> Result<Entity<'a>, StepError> {
+        for _ in 0..4 {
+            if !matches!(
+                c.name(),
+                "SURFACE_CURVE" | "SEAM_CURVE" | "INTERSECTION_CURVE"
+            ) {
+                break;
+            }
+            c = self.ex.get(c.reference(1, "curve_3d")?, &c)?;
+        }
+        Ok(c)
+    }
+
     /// A 3-D edge curve: a B-spline (plain or rational), or the 3-D curve of a
     /// `SURFACE_CURVE`/`SEAM_CURVE`. `LINE`s are handled by the caller (an edge on a line is
     /// the segment between its vertices). `depth` bounds surface-curve chains.

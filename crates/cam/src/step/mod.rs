@@ -4,6 +4,7 @@
 //! `lexer` → `exchange` (schema-free instances by `#id`) → `entity` (typed attribute access
 //! with errors naming `#id`, type and line) → `units`, `geometry`, `topology` → `model`.
 
+mod conic;
 mod entity;
 mod error;
 mod exchange;

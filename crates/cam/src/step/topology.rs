@@ -8,9 +8,9 @@ use std::collections::HashSet;
 use tezgah_geom::deviation::closest_point;
 use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
 
+use super::conic;
 use super::entity::{Entity, Resolve};
 use super::error::StepError;
-use super::exchange::Param;
 use super::geometry::Geometry;
 use super::model::{Bound, BoundEdge, BoundKind, Face};
 
@@ -213,13 +213,19 @@ fn read_edge(g: &Geometry<'_>, oe: &Entity<'_>) -> Result<BoundEdge, StepError> 
     }
     let v0 = g.vertex(e.reference(1, "edge_start")?, &e)?;
     let v1 = g.vertex(e.reference(2, "edge_end")?, &e)?;
-    let c = g.ex.get(e.reference(3, "edge_geometry")?, &e)?;
+    let c = g.basis_curve(g.ex.get(e.reference(3, "edge_geometry")?, &e)?)?;
     let same_sense = e.boolean(4, "same_sense")?;
-    let (curve, t0, t1) = if is_line(g, &c) {
+    let simple = |name: &str| c.name() == name && !c.instance.complex;
+    let (curve, forward) = if simple("LINE") {
         // An edge on a (infinite) line is the segment between its vertices.
         let seg = Nurbs::bspline(1, &[v0, v1], vec![0.0, 0.0, 1.0, 1.0])
             .map_err(|err| e.invalid(err.to_string()))?;
-        (seg, 0.0, 1.0)
+        (seg, orientation)
+    } else if simple("CIRCLE") || simple("ELLIPSE") {
+        (
+            conic::arc(g, &c, v0, v1, same_sense)?,
+            orientation == same_sense,
+        )
     } else {
         let curve = g.curve(&c, 0)?;
         let (lo_pt, hi_pt) = if same_sense { (v0, v1) } else { (v1, v0) };
@@ -230,32 +236,22 @@ fn read_edge(g: &Geometry<'_>, oe: &Entity<'_>) -> Result<BoundEdge, StepError> 
                 "its vertices do not bound a piece of its curve in the curve's direction",
             ));
         }
-        (curve, lo, hi)
+        let piece = Trimmed::new(curve, lo, hi).map_err(|err| e.invalid(err.to_string()))?;
+        return Ok(BoundEdge {
+            id: oe.id,
+            edge: e.id,
+            curve: piece,
+            forward: orientation == same_sense,
+        });
     };
-    let forward = if is_line(g, &c) {
-        orientation
-    } else {
-        orientation == same_sense
-    };
-    let curve = Trimmed::new(curve, t0, t1).map_err(|err| e.invalid(err.to_string()))?;
+    let (a, b) = curve.domain();
+    let curve = Trimmed::new(curve, a, b).map_err(|err| e.invalid(err.to_string()))?;
     Ok(BoundEdge {
         id: oe.id,
         edge: e.id,
         curve,
         forward,
     })
-}
-
-/// A `LINE`, directly or as the 3-D curve of a surface/seam curve.
-fn is_line(g: &Geometry<'_>, c: &Entity<'_>) -> bool {
-    match c.name() {
-        "LINE" => !c.instance.complex,
-        "SURFACE_CURVE" | "SEAM_CURVE" => match c.record.params.get(1) {
-            Some(Param::Ref(id)) => g.ex.entity(*id).is_some_and(|e| e.name() == "LINE"),
-            _ => false,
-        },
-        _ => false,
-    }
 }
 
 /// The parameter of `q` on `curve`: a domain end when `q` is there (`prefer_start` says which
@@ -273,29 +269,20 @@ fn locate(curve: &Nurbs, q: &Vec3, prefer_start: bool) -> f64 {
     closest_point(curve, q, a, b, LOCATE_SAMPLES_PER_SPAN * spans).u
 }
 
-/// A `PLANE` face as the bilinear patch over its bounds' extent in the plane's axes.
+/// A `PLANE` face as the bilinear patch over a rectangle, in the plane's axes, that holds
+/// its bounds (their edge curves' control points).
 fn plane(g: &Geometry<'_>, s: &Entity<'_>, bounds: &[Bound]) -> Result<NurbsSurface, StepError> {
-    let a = g.ex.get(s.reference(1, "position")?, s)?;
-    if a.name() != "AXIS2_PLACEMENT_3D" {
-        return Err(StepError::Unsupported {
-            at: a.at(),
-            role: format!("the position of {}", s.at()),
-        });
-    }
-    let origin = g.point(a.reference(1, "location")?, &a)?;
-    let z = direction(g, &a, 2)?.unwrap_or_else(Vec3::z);
-    let r = direction(g, &a, 3)?.unwrap_or_else(Vec3::x);
-    let x = r - z * r.dot(&z);
-    if x.norm() < 1e-12 {
-        return Err(a.invalid("ref_direction is parallel to axis"));
-    }
-    let x = x.normalize();
-    let y = z.cross(&x);
+    let (origin, x, y) = g.placement(s.reference(1, "position")?, s)?;
     let (mut u0, mut u1, mut v0, mut v1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
     for b in bounds {
         let pts = match &b.kind {
             BoundKind::Vertex(p) => vec![*p],
-            BoundKind::Edges(edges) => edges.iter().flat_map(|e| e.polyline(32)).collect(),
+            // Control points bound their curve (positive weights: convex hull property),
+            // so the rectangle holds the whole face; it is exact for straight edges.
+            BoundKind::Edges(edges) => edges
+                .iter()
+                .flat_map(|e| e.curve.inner().control_points())
+                .collect(),
         };
         for p in pts {
             let d = p - origin;
@@ -318,28 +305,4 @@ fn plane(g: &Geometry<'_>, s: &Entity<'_>, bounds: &[Bound]) -> Result<NurbsSurf
     ];
     NurbsSurface::bspline(1, 1, &pts, vec![u0, u0, u1, u1], vec![v0, v0, v1, v1])
         .map_err(|e| s.invalid(e.to_string()))
-}
-
-/// An optional `DIRECTION` attribute, normalised.
-fn direction(g: &Geometry<'_>, a: &Entity<'_>, i: usize) -> Result<Option<Vec3>, StepError> {
-    if matches!(a.param(i, "direction")?, Param::Unset) {
-        return Ok(None);
-    }
-    let d = g.ex.get(a.reference(i, "direction")?, a)?;
-    if d.name() != "DIRECTION" {
-        return Err(StepError::Unsupported {
-            at: d.at(),
-            role: format!("a direction of {}", a.at()),
-        });
-    }
-    let c = d.reals(1, "direction_ratios")?;
-    let v = match c.as_slice() {
-        [x, y, z] => Vec3::new(*x, *y, *z),
-        _ => return Err(d.invalid("a 3-D direction needs 3 ratios")),
-    };
-    let n = v.norm();
-    if !(n.is_finite() && n > 0.0) {
-        return Err(d.invalid("direction has zero length"));
-    }
-    Ok(Some(v / n))
 }

@@ -20,8 +20,13 @@ Fixtures:
                        MANIFOLD_SOLID_BREP / CLOSED_SHELL)
   twisted_blade.stp    a solid lofted through 5 elliptic sections twisted by 15 degrees each,
                        converted to NURBS (rational B-spline sides, B-spline caps)
-Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "samples": [[u, v, x, y, z,
-dxdu, dydu, dzdu, dxdv, dydv, dzdv], ...]}, ...]} with faces in the order of the re-read shape.
+  freeform_patch_ap203.stp  the patch in AP203 (CONFIG_CONTROL_DESIGN)
+  plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
+                       LINE, CIRCLE, ELLIPSE edges; three face bounds)
+Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
+[[u, v, x, y, z, dxdu, dydu, dzdu, dxdv, dydv, dzdv], ...]}, ...]} with faces in the order of the
+re-read shape; (u, v) ranges are the face's UV bounds (BRepTools::UVBounds), "reversed" its
+orientation in the shell.
 """
 import json
 import math
@@ -40,7 +45,8 @@ from OCP.gp import gp_Ax2, gp_Dir, gp_Pnt, gp_Vec
 from OCP.IFSelect import IFSelect_RetDone
 from OCP.Interface import Interface_Static
 from OCP.STEPControl import STEPControl_AsIs, STEPControl_Reader, STEPControl_Writer
-from OCP.TopAbs import TopAbs_FACE
+from OCP.BRepTools import BRepTools
+from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
@@ -82,6 +88,23 @@ def twisted_blade():
     return BRepBuilderAPI_NurbsConvert(loft.Shape()).Shape()
 
 
+def plate_with_holes():
+    from OCP.gp import gp_Pln, gp_Circ, gp_Elips, gp_Ax3
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+    plane = gp_Pln(gp_Ax3(gp_Pnt(0.0, 0.0, 5.0), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0)))
+    outer = BRepBuilderAPI_MakePolygon(gp_Pnt(0, 0, 5), gp_Pnt(80, 0, 5), gp_Pnt(80, 60, 5), gp_Pnt(0, 60, 5), True).Wire()
+    make = BRepBuilderAPI_MakeFace(plane, outer)
+    circle = gp_Circ(gp_Ax2(gp_Pnt(25, 30, 5), gp_Dir(0, 0, 1)), 10.0)
+    hole = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle).Edge()).Wire()
+    hole.Reverse()
+    make.Add(hole)
+    ellipse = gp_Elips(gp_Ax2(gp_Pnt(58, 30, 5), gp_Dir(0, 0, 1), gp_Dir(math.cos(0.5), math.sin(0.5), 0)), 12.0, 6.0)
+    hole2 = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(ellipse).Edge()).Wire()
+    hole2.Reverse()
+    make.Add(hole2)
+    return make.Face()
+
+
 def arr(values):
     a = Array1_double(1, len(values))
     for k, x in enumerate(values):
@@ -96,8 +119,8 @@ def iarr(values):
     return a
 
 
-def write(shape, path, unit="MM"):
-    Interface_Static.SetCVal_s("write.step.schema", "AP214IS")
+def write(shape, path, unit="MM", schema="AP214IS"):
+    Interface_Static.SetCVal_s("write.step.schema", schema)
     Interface_Static.SetCVal_s("write.step.unit", unit)
     w = STEPControl_Writer()
     w.Transfer(shape, STEPControl_AsIs)
@@ -123,7 +146,7 @@ def reference(path):
     while ex.More():
         face = TopoDS.Face(ex.Current())
         surf = BRep_Tool.Surface_s(face)
-        u0, u1, v0, v1 = surf.Bounds()
+        u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         samples = []
         for a in range(SAMPLES):
             for b in range(SAMPLES):
@@ -133,7 +156,8 @@ def reference(path):
                 p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
                 surf.D1(u, v, p, du, dv)
                 samples.append([u, v, p.X(), p.Y(), p.Z(), du.X(), du.Y(), du.Z(), dv.X(), dv.Y(), dv.Z()])
-        faces.append({"u": [u0, u1], "v": [v0, v1], "samples": samples})
+        reversed_ = face.Orientation() == TopAbs_REVERSED
+        faces.append({"u": [u0, u1], "v": [v0, v1], "reversed": reversed_, "samples": samples})
         ex.Next()
     return {"generator": "make_step_fixtures.py, OCCT via cadquery-ocp-novtk", "faces": faces}
 
@@ -146,10 +170,12 @@ def main():
         ("freeform_patch_inch", freeform_patch(), "INCH"),
         ("rational_sphere", rational_sphere(), "MM"),
         ("twisted_blade", twisted_blade(), "MM"),
+        ("freeform_patch_ap203", freeform_patch(), "MM"),
+        ("plate_with_holes", plate_with_holes(), "MM"),
     ]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")
-        write(shape, stp, unit)
+        write(shape, stp, unit, "AP203" if name.endswith("ap203") else "AP214IS")
         with open(os.path.join(out, name + ".json"), "w") as f:
             json.dump(reference(stp), f, separators=(",", ":"))
             f.write("\n")
