@@ -169,6 +169,7 @@ fn plane_face_bounded_by_lines() {
     assert!((f.surface.point(7.0, 4.5) - Vec3::new(7.0, 4.5, 5.0)).amax() < 1e-12);
     let n = f.surface.derivs(7.0, 4.5);
     assert_eq!(n.su.cross(&n.sv).normalize(), Vec3::z());
+    assert!(f.is_untrimmed(1e-9));
     let b = &f.bounds[0];
     assert!(b.outer && b.orientation);
     let BoundKind::Edges(edges) = &b.kind else {
@@ -362,4 +363,18 @@ fn read_file_names_the_file() {
         .to_string()
         .starts_with(&format!("{}: ", missing.display())));
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn crlf_line_ends_and_comments_read_the_same() {
+    let lf = plane_file(MM, ".T.");
+    let crlf = lf
+        .replace('\n', "\r\n")
+        .replace("DATA;", "DATA; /* a comment\r\n over two lines */");
+    assert_eq!(step::read(&crlf).unwrap(), step::read(&lf).unwrap());
+    let e = step::read(&crlf.replace("#26 = CARTESIAN_POINT('',(21.,12.,5.));", "")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "#22 VERTEX_POINT (line 24): refers to #26, which the file does not define"
+    );
 }

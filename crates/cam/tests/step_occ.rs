@@ -87,6 +87,7 @@ fn check(name: &str) -> (StepModel, f64, f64) {
 fn freeform_patch_matches_occt() {
     let (m, _, _) = check("freeform_patch");
     assert_eq!(m.unit.mm, 1.0);
+    assert!(m.faces[0].is_untrimmed(1e-7));
     assert_eq!(
         m.schemas,
         vec!["AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }".to_string()]
@@ -140,6 +141,7 @@ fn inch_file_is_read_in_mm() {
 fn rational_sphere_matches_occt() {
     let (m, _, _) = check("rational_sphere");
     let f = &m.faces[0];
+    assert!(f.is_untrimmed(1e-7));
     assert_eq!(f.bounds.len(), 1);
     assert!(matches!(f.bounds[0].kind, BoundKind::Vertex(p) if (p.z + 40.0).abs() < 1e-9));
     // A sphere of radius 40 about the origin, everywhere (a closed form beside OCCT).
@@ -160,6 +162,9 @@ fn rational_sphere_matches_occt() {
 fn twisted_blade_matches_occt() {
     let (m, _, _) = check("twisted_blade");
     assert_eq!(m.faces.len(), 7);
+    // The five lofted sides are whole surfaces; the caps are ellipses on rectangles.
+    let untrimmed: Vec<bool> = m.faces.iter().map(|f| f.is_untrimmed(1e-7)).collect();
+    assert_eq!(untrimmed, [true, true, true, true, true, false, false]);
     // A closed solid: every edge curve is used by exactly two face loops.
     let mut uses = std::collections::HashMap::new();
     for f in &m.faces {
@@ -188,6 +193,7 @@ fn plate_with_holes_matches_occt() {
     let f = &m.faces[0];
     assert_eq!(f.surface.degrees(), (1, 1));
     assert_eq!(f.bounds.len(), 3);
+    assert!(!f.is_untrimmed(1e-7));
     let loops: Vec<_> = f
         .bounds
         .iter()

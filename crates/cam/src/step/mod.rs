@@ -19,7 +19,9 @@ use std::path::Path;
 use tezgah_geom::{Nurbs, NurbsSurface};
 
 pub use error::{At, StepError};
-pub use model::{Bound, BoundEdge, BoundKind, Face, LengthUnit, StepModel};
+pub use model::{
+    Bound, BoundEdge, BoundKind, Face, LengthUnit, StepModel, UNTRIMMED_SAMPLES_PER_EDGE,
+};
 
 use entity::Resolve;
 use exchange::Exchange;

@@ -2,6 +2,7 @@
 //! and its boundary loops as 3-D edge curves, plus the file's length unit. Everything is in
 //! mm, whatever unit the file used.
 
+use tezgah_geom::deviation::closest_point;
 use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
 
 pub use super::units::LengthUnit;
@@ -33,6 +34,40 @@ pub struct Face {
     /// The face's boundary loops. The surface's own domain is always a bound too: the face
     /// is the part of `S(domain)` inside these loops.
     pub bounds: Vec<Bound>,
+}
+
+/// Points per edge that [`Face::is_untrimmed`] checks.
+pub const UNTRIMMED_SAMPLES_PER_EDGE: usize = 32;
+
+impl Face {
+    /// True when the face is its whole surface: every loop runs along the boundary of the
+    /// surface's domain (each edge, sampled at [`UNTRIMMED_SAMPLES_PER_EDGE`]` + 1` points, lies
+    /// within `tolerance` mm of one of the four boundary iso-curves; a vertex loop, such as a
+    /// sphere's pole, on one of them). A strategy can then work on the domain alone; otherwise
+    /// it must keep to the loops. A face without bounds is its whole surface.
+    pub fn is_untrimmed(&self, tolerance: f64) -> bool {
+        let (u0, u1) = self.surface.domain_u();
+        let (v0, v1) = self.surface.domain_v();
+        let sides = [
+            self.surface.u_iso(v0),
+            self.surface.u_iso(v1),
+            self.surface.v_iso(u0),
+            self.surface.v_iso(u1),
+        ];
+        let on_side = |p: &Vec3| {
+            sides.iter().any(|c| {
+                let (a, b) = c.domain();
+                let spans = c.breakpoints().len().max(2) - 1;
+                closest_point(c, p, a, b, 8 * spans).distance <= tolerance
+            })
+        };
+        self.bounds.iter().all(|b| match &b.kind {
+            BoundKind::Vertex(p) => on_side(p),
+            BoundKind::Edges(edges) => edges
+                .iter()
+                .all(|e| e.polyline(UNTRIMMED_SAMPLES_PER_EDGE).iter().all(on_side)),
+        })
+    }
 }
 
 /// A `FACE_BOUND` or `FACE_OUTER_BOUND`.
