@@ -183,6 +183,9 @@ fn plane_face_bounded_by_lines() {
         assert_eq!(e.end(), corners[(k + 1) % 4]);
     }
     assert!(!edges[3].forward);
+    // Plain LINE edges, no surface curves: no pcurves, so no (u, v) polygon.
+    assert!(edges.iter().all(|e| e.pcurve.is_none()));
+    assert_eq!(b.uv_polygon(4), None);
     assert_eq!(edges[3].polyline(2)[1], Vec3::new(1.0, 7.0, 5.0));
 }
 
@@ -377,4 +380,32 @@ fn crlf_line_ends_and_comments_read_the_same() {
         e.to_string(),
         "#22 VERTEX_POINT (line 24): refers to #26, which the file does not define"
     );
+}
+
+#[test]
+fn a_pcurve_off_its_edge_is_dropped() {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/plate_with_holes.stp");
+    let text = std::fs::read_to_string(path).unwrap();
+    let hole_pcurves = |text: &str| -> Vec<bool> {
+        let m = step::read(text).unwrap();
+        m.faces[0]
+            .bounds
+            .iter()
+            .map(|b| match &b.kind {
+                BoundKind::Edges(e) => e.iter().all(|e| e.pcurve.is_some()),
+                BoundKind::Vertex(_) => false,
+            })
+            .collect()
+    };
+    assert_eq!(hole_pcurves(&text), [true, true, true]);
+    // The circular hole's 2-D circle (#103) given radius 10.001 instead of 10: mapped through
+    // the plane it misses the 3-D edge by 1e-3 mm > PCURVE_TOLERANCE_MM.
+    assert!(text.contains("#103 = CIRCLE('',#104,10.);"));
+    let off = text.replace(
+        "#103 = CIRCLE('',#104,10.);",
+        "#103 = CIRCLE('',#104,10.001);",
+    );
+    assert_eq!(hole_pcurves(&off), [true, false, true]);
+    assert!(step::PCURVE_TOLERANCE_MM < 1e-3);
 }

@@ -161,6 +161,16 @@ impl<'a> Geometry<'a> {
     }
 
     fn bspline_curve(&self, c: &Entity<'_>) -> Result<Nurbs, StepError> {
+        self.bspline_curve_with(c, |id, from| self.point(id, from))
+    }
+
+    /// A B-spline curve whose control points `point(id, referrer)` reads (3-D points in mm,
+    /// or a pcurve's 2-D parameters).
+    pub fn bspline_curve_with(
+        &self,
+        c: &Entity<'_>,
+        point: impl Fn(u64, &Entity<'_>) -> Result<Vec3, StepError>,
+    ) -> Result<Nurbs, StepError> {
         let (base, first) = if c.instance.complex {
             (c.part("B_SPLINE_CURVE")?, 0)
         } else {
@@ -191,7 +201,7 @@ impl<'a> Geometry<'a> {
         };
         let points = ids
             .iter()
-            .map(|id| self.point(*id, &base))
+            .map(|id| point(*id, &base))
             .collect::<Result<Vec<_>, _>>()?;
         Nurbs::new(p, &points, &weights, kv).map_err(|e| c.invalid(e.to_string()))
     }

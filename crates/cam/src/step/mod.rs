@@ -11,6 +11,7 @@ mod exchange;
 mod geometry;
 mod lexer;
 mod model;
+mod pcurve;
 mod topology;
 mod units;
 
@@ -20,8 +21,10 @@ use tezgah_geom::{Nurbs, NurbsSurface};
 
 pub use error::{At, StepError};
 pub use model::{
-    Bound, BoundEdge, BoundKind, Face, LengthUnit, StepModel, UNTRIMMED_SAMPLES_PER_EDGE,
+    Bound, BoundEdge, BoundKind, Face, LengthUnit, PCurve, StepModel, Uv,
+    UNTRIMMED_SAMPLES_PER_EDGE,
 };
+pub use pcurve::PCURVE_TOLERANCE_MM;
 
 use entity::Resolve;
 use exchange::Exchange;

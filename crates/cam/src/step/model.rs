@@ -103,6 +103,68 @@ pub struct BoundEdge {
     /// True when the loop runs along increasing curve parameter (the oriented edge's
     /// orientation agreeing with the edge curve's `same_sense`).
     pub forward: bool,
+    /// The same piece in the face's parameter plane, when the file gives it (a `PCURVE` on
+    /// this face's surface that agrees with the 3-D edge; see [`PCurve`]).
+    pub pcurve: Option<PCurve>,
+}
+
+/// A point of a surface's parameter plane.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Uv {
+    pub u: f64,
+    pub v: f64,
+}
+
+/// An edge in the face's (u, v) plane: `curve` holds u in x and v in y (z = 0), over the same
+/// piece as the 3-D edge, run in loop order when `forward`. It was checked on reading: mapped
+/// through the surface it meets the 3-D edge at both ends and in the middle within
+/// `PCURVE_TOLERANCE_MM`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PCurve {
+    pub curve: Trimmed<Nurbs>,
+    pub forward: bool,
+}
+
+impl PCurve {
+    /// `segments + 1` points along the edge in loop order, at equal parameter steps.
+    pub fn polyline(&self, segments: usize) -> Vec<Uv> {
+        sample(&self.curve, self.forward, segments)
+            .into_iter()
+            .map(|p| Uv { u: p.x, v: p.y })
+            .collect()
+    }
+}
+
+fn sample(curve: &Trimmed<Nurbs>, forward: bool, segments: usize) -> Vec<Vec3> {
+    let n = segments.max(1);
+    let (a, b) = curve.domain();
+    (0..=n)
+        .map(|k| {
+            let s = k as f64 / n as f64;
+            let s = if forward { s } else { 1.0 - s };
+            curve.point(a + (b - a) * s)
+        })
+        .collect()
+}
+
+impl Bound {
+    /// The loop as a closed polygon in the face's (u, v) plane, `segments_per_edge` pieces per
+    /// edge, without repeating each edge's first point; `None` for a vertex loop or when an
+    /// edge has no pcurve. The bound's `orientation` is applied (false: reversed).
+    pub fn uv_polygon(&self, segments_per_edge: usize) -> Option<Vec<Uv>> {
+        let BoundKind::Edges(edges) = &self.kind else {
+            return None;
+        };
+        let mut out = Vec::new();
+        for e in edges {
+            let pts = e.pcurve.as_ref()?.polyline(segments_per_edge);
+            out.extend_from_slice(&pts[..pts.len() - 1]);
+        }
+        if !self.orientation {
+            out.reverse();
+        }
+        Some(out)
+    }
 }
 
 impl BoundEdge {
@@ -121,14 +183,6 @@ impl BoundEdge {
     /// `segments + 1` points along the edge in loop order, at equal parameter steps
     /// (a polyline of the boundary for classification or display).
     pub fn polyline(&self, segments: usize) -> Vec<Vec3> {
-        let n = segments.max(1);
-        let (a, b) = self.curve.domain();
-        (0..=n)
-            .map(|k| {
-                let s = k as f64 / n as f64;
-                let s = if self.forward { s } else { 1.0 - s };
-                self.curve.point(a + (b - a) * s)
-            })
-            .collect()
+        sample(&self.curve, self.forward, segments)
     }
 }

@@ -13,6 +13,7 @@ use super::entity::{Entity, Resolve};
 use super::error::StepError;
 use super::geometry::Geometry;
 use super::model::{Bound, BoundEdge, BoundKind, Face};
+use super::pcurve::{self, EdgeRange};
 
 /// The entities that hold a shape; their shells' faces are the model's faces.
 const BODIES: [&str; 3] = [
@@ -133,21 +134,33 @@ impl Walker<'_, '_> {
 fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, StepError> {
     let same_sense = f.boolean(3, "same_sense")?;
     let mut bounds = Vec::new();
+    // One entry per edge of the loops, in order.
+    let mut ranges = Vec::new();
     for id in f.refs(1, "bounds")? {
         let b = g.ex.get(id, f)?;
-        bounds.push(read_bound(g, &b)?);
+        bounds.push(read_bound(g, &b, &mut ranges)?);
     }
     let s = g.ex.get(f.reference(2, "face_geometry")?, f)?;
-    let surface = if s.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
-        g.bspline_surface(&s)?
+    // (surface, mm per unit of the pcurves' coordinates: a plane's parameters are lengths)
+    let (surface, pcurve_scale) = if s.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
+        (g.bspline_surface(&s)?, 1.0)
     } else if s.name() == "PLANE" && !s.instance.complex {
-        plane(g, &s, &bounds)?
+        (plane(g, &s, &bounds)?, g.mm)
     } else {
         return Err(StepError::Unsupported {
             at: s.at(),
             role: format!("the surface of {}", f.at()),
         });
     };
+    let edges = bounds.iter_mut().flat_map(|b| match &mut b.kind {
+        BoundKind::Edges(edges) => edges.as_mut_slice(),
+        BoundKind::Vertex(_) => &mut [],
+    });
+    for (edge, range) in edges.zip(&ranges) {
+        if let Some(range) = range {
+            pcurve::attach(g, s.id, pcurve_scale, &surface, edge, range);
+        }
+    }
     Ok(Face {
         id: f.id,
         surface,
@@ -156,7 +169,11 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
     })
 }
 
-fn read_bound(g: &Geometry<'_>, b: &Entity<'_>) -> Result<Bound, StepError> {
+fn read_bound(
+    g: &Geometry<'_>,
+    b: &Entity<'_>,
+    ranges: &mut Vec<Option<EdgeRange>>,
+) -> Result<Bound, StepError> {
     let outer = match b.name() {
         "FACE_OUTER_BOUND" => true,
         "FACE_BOUND" => false,
@@ -175,7 +192,9 @@ fn read_bound(g: &Geometry<'_>, b: &Entity<'_>) -> Result<Bound, StepError> {
             let mut edges = Vec::new();
             for id in l.refs(1, "edge_list")? {
                 let oe = g.ex.get(id, &l)?;
-                edges.push(read_edge(g, &oe)?);
+                let (edge, range) = read_edge(g, &oe)?;
+                edges.push(edge);
+                ranges.push(range);
             }
             BoundKind::Edges(edges)
         }
@@ -195,8 +214,12 @@ fn read_bound(g: &Geometry<'_>, b: &Entity<'_>) -> Result<Bound, StepError> {
 }
 
 /// `ORIENTED_EDGE('', *, *, #edge_curve, orientation)` → the edge curve's piece between its
-/// vertices and the loop's direction along it.
-fn read_edge(g: &Geometry<'_>, oe: &Entity<'_>) -> Result<BoundEdge, StepError> {
+/// vertices (in the curve's parameter direction) and the loop's direction along it, plus the
+/// piece's range on the curve's own parameter for the pcurve.
+fn read_edge(
+    g: &Geometry<'_>,
+    oe: &Entity<'_>,
+) -> Result<(BoundEdge, Option<EdgeRange>), StepError> {
     if oe.name() != "ORIENTED_EDGE" {
         return Err(StepError::Unsupported {
             at: oe.at(),
@@ -213,45 +236,67 @@ fn read_edge(g: &Geometry<'_>, oe: &Entity<'_>) -> Result<BoundEdge, StepError> 
     }
     let v0 = g.vertex(e.reference(1, "edge_start")?, &e)?;
     let v1 = g.vertex(e.reference(2, "edge_end")?, &e)?;
-    let c = g.basis_curve(g.ex.get(e.reference(3, "edge_geometry")?, &e)?)?;
+    let geometry = e.reference(3, "edge_geometry")?;
+    let c = g.basis_curve(g.ex.get(geometry, &e)?)?;
     let same_sense = e.boolean(4, "same_sense")?;
+    // The edge runs from `from` to `to` along the curve's parameter.
+    let (from, to) = if same_sense { (v0, v1) } else { (v1, v0) };
     let simple = |name: &str| c.name() == name && !c.instance.complex;
-    let (curve, forward) = if simple("LINE") {
-        // An edge on a (infinite) line is the segment between its vertices.
-        let seg = Nurbs::bspline(1, &[v0, v1], vec![0.0, 0.0, 1.0, 1.0])
+    let (curve, lo, hi) = if simple("LINE") {
+        // An edge on a (infinite) line is the segment between its vertices; the line's own
+        // parameter (pnt + t·vector) is kept for the pcurve.
+        let seg = Nurbs::bspline(1, &[from, to], vec![0.0, 0.0, 1.0, 1.0])
             .map_err(|err| e.invalid(err.to_string()))?;
-        (seg, orientation)
+        let (lo, hi) = line_params(g, &c, from, to).unwrap_or((f64::NAN, f64::NAN));
+        let (a, b) = seg.domain();
+        (Trimmed::new(seg, a, b), lo, hi)
     } else if simple("CIRCLE") || simple("ELLIPSE") {
-        (
-            conic::arc(g, &c, v0, v1, same_sense)?,
-            orientation == same_sense,
-        )
+        let (arc, start, sweep) = conic::arc(g, &c, v0, v1, same_sense)?;
+        let (a, b) = arc.domain();
+        (Trimmed::new(arc, a, b), start, start + sweep)
     } else {
         let curve = g.curve(&c, 0)?;
-        let (lo_pt, hi_pt) = if same_sense { (v0, v1) } else { (v1, v0) };
-        let lo = locate(&curve, &lo_pt, true);
-        let hi = locate(&curve, &hi_pt, false);
+        let lo = locate(&curve, &from, true);
+        let hi = locate(&curve, &to, false);
         if hi <= lo {
             return Err(e.invalid(
                 "its vertices do not bound a piece of its curve in the curve's direction",
             ));
         }
-        let piece = Trimmed::new(curve, lo, hi).map_err(|err| e.invalid(err.to_string()))?;
-        return Ok(BoundEdge {
-            id: oe.id,
-            edge: e.id,
-            curve: piece,
-            forward: orientation == same_sense,
-        });
+        (Trimmed::new(curve, lo, hi), lo, hi)
     };
-    let (a, b) = curve.domain();
-    let curve = Trimmed::new(curve, a, b).map_err(|err| e.invalid(err.to_string()))?;
-    Ok(BoundEdge {
+    let curve = curve.map_err(|err| e.invalid(err.to_string()))?;
+    let forward = orientation == same_sense;
+    let range = (lo < hi).then_some(EdgeRange {
+        geometry,
+        lo,
+        hi,
+        forward,
+        orientation,
+    });
+    let edge = BoundEdge {
         id: oe.id,
         edge: e.id,
         curve,
         forward,
-    })
+        pcurve: None,
+    };
+    Ok((edge, range))
+}
+
+/// The parameters of `from` and `to` on `LINE('', pnt, VECTOR('', dir, magnitude))`,
+/// `λ(t) = pnt + t·magnitude·dir`.
+fn line_params(g: &Geometry<'_>, c: &Entity<'_>, from: Vec3, to: Vec3) -> Option<(f64, f64)> {
+    let p = g.point(c.reference(1, "pnt").ok()?, c).ok()?;
+    let v = g.ex.entity(c.reference(2, "dir").ok()?)?;
+    let d = g.ex.entity(v.reference(1, "orientation").ok()?)?;
+    let r = d.reals(1, "direction_ratios").ok()?;
+    let [x, y, z] = r.as_slice() else { return None };
+    let dir = Vec3::new(*x, *y, *z);
+    let step = dir.normalize() * (v.real(2, "magnitude").ok()? * g.mm);
+    let t = |q: Vec3| (q - p).dot(&step) / step.norm_squared();
+    let (lo, hi) = (t(from), t(to));
+    (lo.is_finite() && hi.is_finite()).then_some((lo, hi))
 }
 
 /// The parameter of `q` on `curve`: a domain end when `q` is there (`prefer_start` says which

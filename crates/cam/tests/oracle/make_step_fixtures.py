@@ -21,6 +21,8 @@ Fixtures:
   twisted_blade.stp    a solid lofted through 5 elliptic sections twisted by 15 degrees each,
                        converted to NURBS (rational B-spline sides, B-spline caps)
   freeform_patch_ap203.stp  the patch in AP203 (CONFIG_CONTROL_DESIGN)
+  nurbs_cylinder.stp   a cylinder r = 20, h = 50 converted to NURBS: its side has a seam edge
+                       (SEAM_CURVE with two pcurves on one surface)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
 Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
@@ -73,6 +75,11 @@ def freeform_patch():
 
 def rational_sphere():
     return BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeSphere(40.0).Shape()).Shape()
+
+
+def nurbs_cylinder():
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
+    return BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeCylinder(20.0, 50.0).Shape()).Shape()
 
 
 def twisted_blade():
@@ -131,6 +138,8 @@ def write(shape, path, unit="MM", schema="AP214IS"):
         text = f.read()
     text = re.sub(r"FILE_NAME\('[^']*','[^']*'",
                   "FILE_NAME('%s','2026-01-01T00:00:00'" % os.path.basename(path), text, count=1)
+    text = re.sub(r"CALENDAR_DATE\(\d+,\d+,\d+\)", "CALENDAR_DATE(2026,1,1)", text)
+    text = re.sub(r"LOCAL_TIME\(\d+,\d+,", "LOCAL_TIME(0,0,", text)
     with open(path, "w") as f:
         f.write(text)
 
@@ -172,6 +181,7 @@ def main():
         ("twisted_blade", twisted_blade(), "MM"),
         ("freeform_patch_ap203", freeform_patch(), "MM"),
         ("plate_with_holes", plate_with_holes(), "MM"),
+        ("nurbs_cylinder", nurbs_cylinder(), "MM"),
     ]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")
