@@ -409,3 +409,65 @@ fn a_pcurve_off_its_edge_is_dropped() {
     assert_eq!(hole_pcurves(&off), [true, false, true]);
     const { assert!(step::PCURVE_TOLERANCE_MM < 1e-3) };
 }
+
+/// A face whose one loop runs along pieces of a B-spline polyline (0,0)→(10,0)→(10,10)→(0,10)
+/// and back along a line: the edge's vertices sit inside the curve's domain.
+fn interior_vertices_file(same_sense: &str, start: &str, end: &str) -> String {
+    file(&format!(
+        "#1 = SHELL_BASED_SURFACE_MODEL('',(#2));
+#2 = OPEN_SHELL('',(#3));
+#3 = ADVANCED_FACE('',(#4),#30,.T.);
+#4 = FACE_BOUND('',#5,.T.);
+#5 = EDGE_LOOP('',(#6,#7));
+#6 = ORIENTED_EDGE('',*,*,#10,.T.);
+#7 = ORIENTED_EDGE('',*,*,#11,.T.);
+#10 = EDGE_CURVE('',{start},{end},#40,{same_sense});
+#11 = EDGE_CURVE('',{end},{start},#41,.T.);
+#20 = VERTEX_POINT('',#24);
+#21 = VERTEX_POINT('',#25);
+#24 = CARTESIAN_POINT('',(5.,0.,0.));
+#25 = CARTESIAN_POINT('',(5.,10.,0.));
+#30 = PLANE('',#31);
+#31 = AXIS2_PLACEMENT_3D('',#32,$,$);
+#32 = CARTESIAN_POINT('',(0.,0.,0.));
+#40 = B_SPLINE_CURVE_WITH_KNOTS('',1,(#42,#43,#44,#45),.POLYLINE_FORM.,.F.,.F.,(2,1,1,2),
+  (0.,1.,2.,3.),.UNSPECIFIED.);
+#41 = LINE('',#24,#46);
+#42 = CARTESIAN_POINT('',(0.,0.,0.));
+#43 = CARTESIAN_POINT('',(10.,0.,0.));
+#44 = CARTESIAN_POINT('',(10.,10.,0.));
+#45 = CARTESIAN_POINT('',(0.,10.,0.));
+#46 = VECTOR('',#47,1.);
+#47 = DIRECTION('',(0.,1.,0.));"
+    ))
+}
+
+#[test]
+fn b_spline_edges_are_cut_at_their_vertices() {
+    let m = step::read(&interior_vertices_file(".T.", "#20", "#21")).unwrap();
+    let f = &m.faces[0];
+    let BoundKind::Edges(edges) = &f.bounds[0].kind else { panic!("an edge loop") };
+    // (5,0) is t = 0.5 on the polyline, (5,10) is t = 2.5.
+    assert!((edges[0].curve.domain().0 - 0.5).abs() < 1e-12);
+    assert!((edges[0].curve.domain().1 - 2.5).abs() < 1e-12);
+    assert!(edges[0].forward);
+    assert!((edges[0].start() - Vec3::new(5.0, 0.0, 0.0)).norm() < 1e-12);
+    assert!((edges[0].end() - Vec3::new(5.0, 10.0, 0.0)).norm() < 1e-12);
+    assert!((Curve::length(&edges[0].curve) - 20.0).abs() < 1e-9);
+    // The plane's rectangle holds the whole polyline's control points: [0, 10] × [0, 10].
+    assert_eq!(f.surface.domain_u(), (0.0, 10.0));
+    // same_sense .F.: the edge runs from its start vertex against the curve, so the vertices
+    // swap ends of the same piece and the loop runs backwards along it.
+    let m = step::read(&interior_vertices_file(".F.", "#21", "#20")).unwrap();
+    let BoundKind::Edges(edges) = &m.faces[0].bounds[0].kind else { panic!("an edge loop") };
+    assert!((edges[0].curve.domain().0 - 0.5).abs() < 1e-12);
+    assert!((edges[0].curve.domain().1 - 2.5).abs() < 1e-12);
+    assert!(!edges[0].forward);
+    assert!((edges[0].start() - Vec3::new(5.0, 10.0, 0.0)).norm() < 1e-12);
+    // Vertices in the wrong order for the curve's direction do not bound a piece.
+    let e = step::read(&interior_vertices_file(".T.", "#21", "#20")).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "#10 EDGE_CURVE (line 15): its vertices do not bound a piece of its curve in the curve's direction"
+    );
+}
