@@ -446,7 +446,9 @@ fn interior_vertices_file(same_sense: &str, start: &str, end: &str) -> String {
 fn b_spline_edges_are_cut_at_their_vertices() {
     let m = step::read(&interior_vertices_file(".T.", "#20", "#21")).unwrap();
     let f = &m.faces[0];
-    let BoundKind::Edges(edges) = &f.bounds[0].kind else { panic!("an edge loop") };
+    let BoundKind::Edges(edges) = &f.bounds[0].kind else {
+        panic!("an edge loop")
+    };
     // (5,0) is t = 0.5 on the polyline, (5,10) is t = 2.5.
     assert!((edges[0].curve.domain().0 - 0.5).abs() < 1e-12);
     assert!((edges[0].curve.domain().1 - 2.5).abs() < 1e-12);
@@ -459,7 +461,9 @@ fn b_spline_edges_are_cut_at_their_vertices() {
     // same_sense .F.: the edge runs from its start vertex against the curve, so the vertices
     // swap ends of the same piece and the loop runs backwards along it.
     let m = step::read(&interior_vertices_file(".F.", "#21", "#20")).unwrap();
-    let BoundKind::Edges(edges) = &m.faces[0].bounds[0].kind else { panic!("an edge loop") };
+    let BoundKind::Edges(edges) = &m.faces[0].bounds[0].kind else {
+        panic!("an edge loop")
+    };
     assert!((edges[0].curve.domain().0 - 0.5).abs() < 1e-12);
     assert!((edges[0].curve.domain().1 - 2.5).abs() < 1e-12);
     assert!(!edges[0].forward);
@@ -470,4 +474,33 @@ fn b_spline_edges_are_cut_at_their_vertices() {
         e.to_string(),
         "#10 EDGE_CURVE (line 15): its vertices do not bound a piece of its curve in the curve's direction"
     );
+}
+
+#[test]
+fn unsupported_faces_can_be_skipped() {
+    // Two faces in one shell, the second on a cylinder.
+    let text = plane_file(MM, ".T.")
+        .replace("#2 = OPEN_SHELL('',(#3));", "#2 = OPEN_SHELL('',(#3,#60));")
+        .replace(
+            "#40 = LINE('',#32,#41);",
+            "#40 = LINE('',#32,#41);\n#60 = ADVANCED_FACE('',(),#61,.T.);\n#61 = CYLINDRICAL_SURFACE('',#31,4.);",
+        );
+    let strict = step::read(&text).unwrap_err();
+    assert_eq!(
+        strict.to_string(),
+        "#61 CYLINDRICAL_SURFACE (line 36): unsupported entity, met as the surface of #60 ADVANCED_FACE (line 35)"
+    );
+    let lenient = step::ReadOptions {
+        skip_unsupported_faces: true,
+    };
+    let m = step::read_with(&text, &lenient).unwrap();
+    assert_eq!(m.faces.len(), 1);
+    assert_eq!(m.faces[0].id, 3);
+    assert_eq!(m.skipped, vec![strict]);
+    // A malformed file is refused all the same.
+    let dangling = text.replace("#61 = CYLINDRICAL_SURFACE('',#31,4.);", "");
+    assert!(matches!(
+        step::read_with(&dangling, &lenient),
+        Err(StepError::Dangling { .. })
+    ));
 }

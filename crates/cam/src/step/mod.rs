@@ -21,7 +21,7 @@ use tezgah_geom::{Nurbs, NurbsSurface};
 
 pub use error::{At, StepError};
 pub use model::{
-    Bound, BoundEdge, BoundKind, Face, LengthUnit, PCurve, StepModel, Uv,
+    Bound, BoundEdge, BoundKind, Face, LengthUnit, PCurve, ReadOptions, StepModel, Uv,
     UNTRIMMED_SAMPLES_PER_EDGE,
 };
 pub use pcurve::PCURVE_TOLERANCE_MM;
@@ -36,9 +36,22 @@ pub fn read(text: &str) -> Result<StepModel, StepError> {
     StepFile::parse(text.as_bytes())?.model()
 }
 
+/// [`read`] with options (e.g. leaving out faces on unsupported surfaces).
+pub fn read_with(text: &str, options: &ReadOptions) -> Result<StepModel, StepError> {
+    StepFile::parse(text.as_bytes())?.model_with(options)
+}
+
 /// [`read`] on a file; errors name the file. The bytes need not be UTF-8 (STEP strings may be
 /// ISO 8859-1); only names are text, and they are read lossily.
 pub fn read_file(path: impl AsRef<Path>) -> Result<StepModel, StepError> {
+    read_file_with(path, &ReadOptions::default())
+}
+
+/// [`read_file`] with options.
+pub fn read_file_with(
+    path: impl AsRef<Path>,
+    options: &ReadOptions,
+) -> Result<StepModel, StepError> {
     let path = path.as_ref();
     let wrap = |e: StepError| StepError::File {
         path: path.display().to_string(),
@@ -80,11 +93,17 @@ impl StepFile {
 
     /// The faces of the file's bodies (see [`read`]).
     pub fn model(&self) -> Result<StepModel, StepError> {
-        let faces = topology::faces(&self.geometry())?;
+        self.model_with(&ReadOptions::default())
+    }
+
+    /// The faces of the file's bodies, with options.
+    pub fn model_with(&self, options: &ReadOptions) -> Result<StepModel, StepError> {
+        let (faces, skipped) = topology::faces(&self.geometry(), options.skip_unsupported_faces)?;
         Ok(StepModel {
             faces,
             unit: self.unit.clone(),
             schemas: self.ex.schemas.clone(),
+            skipped,
         })
     }
 
@@ -120,6 +139,9 @@ impl StepFile {
 pub fn fuzz(bytes: &[u8]) {
     if let Ok(file) = StepFile::parse(bytes) {
         let _ = file.model();
+        let _ = file.model_with(&ReadOptions {
+            skip_unsupported_faces: true,
+        });
         for id in file.ex.ids().into_iter().take(64) {
             let _ = file.surface(id);
             let _ = file.curve(id);

@@ -5,6 +5,7 @@
 use tezgah_geom::deviation::closest_point;
 use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
 
+use super::error::StepError;
 pub use super::units::LengthUnit;
 
 /// A STEP file's free-form faces, in the order of the file's shells (solids and
@@ -16,6 +17,18 @@ pub struct StepModel {
     /// `FILE_SCHEMA` of the header (`AUTOMOTIVE_DESIGN` for AP214, `CONFIG_CONTROL_DESIGN` for
     /// AP203), as written.
     pub schemas: Vec<String>,
+    /// Faces left out by [`ReadOptions::skip_unsupported_faces`], each with the error that
+    /// names what tezgah does not map (always empty otherwise).
+    pub skipped: Vec<StepError>,
+}
+
+/// How lenient reading is.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Leave out faces whose surface, loop or edge curves use entities tezgah does not map
+    /// (a cylinder, a hyperbola …) instead of refusing the file; a malformed file (syntax,
+    /// dangling references, bad attributes) is still refused.
+    pub skip_unsupported_faces: bool,
 }
 
 /// One `ADVANCED_FACE` (or `FACE_SURFACE`).

@@ -29,8 +29,12 @@ const VERTEX_AT_END_MM: f64 = 1e-6;
 const LOCATE_SAMPLES_PER_SPAN: usize = 16;
 
 /// Faces of every body in the file (in `#id` order), or of every shell when the file has no
-/// body entity; a face reached twice is read once.
-pub(crate) fn faces(g: &Geometry<'_>) -> Result<Vec<Face>, StepError> {
+/// body entity; a face reached twice is read once. With `skip_unsupported`, a face that needs
+/// an entity tezgah does not map is left out and its error returned beside the faces read.
+pub(crate) fn faces(
+    g: &Geometry<'_>,
+    skip_unsupported: bool,
+) -> Result<(Vec<Face>, Vec<StepError>), StepError> {
     let ids = g.ex.ids();
     let is = |id: &u64, names: &[&str]| {
         g.ex.entity(*id)
@@ -40,6 +44,8 @@ pub(crate) fn faces(g: &Geometry<'_>) -> Result<Vec<Face>, StepError> {
         g,
         seen: HashSet::new(),
         out: Vec::new(),
+        skip_unsupported,
+        skipped: Vec::new(),
     };
     let bodies: Vec<u64> = ids.iter().copied().filter(|id| is(id, &BODIES)).collect();
     if bodies.is_empty() {
@@ -59,13 +65,15 @@ pub(crate) fn faces(g: &Geometry<'_>) -> Result<Vec<Face>, StepError> {
             }
         }
     }
-    Ok(walker.out)
+    Ok((walker.out, walker.skipped))
 }
 
 struct Walker<'g, 'a> {
     g: &'g Geometry<'a>,
     seen: HashSet<u64>,
     out: Vec<Face>,
+    skip_unsupported: bool,
+    skipped: Vec<StepError>,
 }
 
 impl Walker<'_, '_> {
@@ -114,8 +122,13 @@ impl Walker<'_, '_> {
                 if !self.seen.insert(f.id) {
                     return Ok(());
                 }
-                let face = read_face(self.g, f, sense)?;
-                self.out.push(face);
+                match read_face(self.g, f, sense) {
+                    Ok(face) => self.out.push(face),
+                    Err(e @ StepError::Unsupported { .. }) if self.skip_unsupported => {
+                        self.skipped.push(e)
+                    }
+                    Err(e) => return Err(e),
+                }
                 Ok(())
             }
             "ORIENTED_FACE" if depth < 4 => {
