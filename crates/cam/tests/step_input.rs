@@ -497,6 +497,14 @@ fn unsupported_faces_can_be_skipped() {
     assert_eq!(m.faces.len(), 1);
     assert_eq!(m.faces[0].id, 3);
     assert_eq!(m.skipped, vec![strict]);
+    // The same through a file.
+    let dir = std::env::temp_dir().join(format!("tezgah-step-skip-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("two_faces.stp");
+    std::fs::write(&path, &text).unwrap();
+    assert_eq!(step::read_file_with(&path, &lenient).unwrap(), m);
+    assert!(step::read_file(&path).is_err());
+    std::fs::remove_dir_all(&dir).unwrap();
     // A malformed file is refused all the same.
     let dangling = text.replace("#61 = CYLINDRICAL_SURFACE('',#31,4.);", "");
     assert!(matches!(

@@ -62,7 +62,7 @@ pub fn read_file_with(
         message: e.to_string(),
     })?;
     StepFile::parse(&bytes)
-        .and_then(|f| f.model())
+        .and_then(|f| f.model_with(options))
         .map_err(wrap)
 }
 
