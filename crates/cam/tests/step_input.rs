@@ -254,13 +254,22 @@ fn unit_errors() {
 
 #[test]
 fn unsupported_entities_are_named() {
+    let extrusion = plane_file(MM, ".T.").replace(
+        "#30 = PLANE('',#31);",
+        "#30 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);",
+    );
+    assert_eq!(
+        step::read(&extrusion).unwrap_err().to_string(),
+        "#30 SURFACE_OF_LINEAR_EXTRUSION (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
+    );
+    // A cylinder is read, but its extent comes from pcurves, which these edges lack.
     let cyl = plane_file(MM, ".T.").replace(
         "#30 = PLANE('',#31);",
         "#30 = CYLINDRICAL_SURFACE('',#31,4.);",
     );
     assert_eq!(
         step::read(&cyl).unwrap_err().to_string(),
-        "#30 CYLINDRICAL_SURFACE (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
+        "#30 CYLINDRICAL_SURFACE (line 29): a face on an unbounded surface needs pcurves for its extent"
     );
     let hyperbola = plane_file(MM, ".T.").replace(
         "#11 = EDGE_CURVE('',#21,#22,#40,.T.);",
@@ -483,12 +492,12 @@ fn unsupported_faces_can_be_skipped() {
         .replace("#2 = OPEN_SHELL('',(#3));", "#2 = OPEN_SHELL('',(#3,#60));")
         .replace(
             "#40 = LINE('',#32,#41);",
-            "#40 = LINE('',#32,#41);\n#60 = ADVANCED_FACE('',(),#61,.T.);\n#61 = CYLINDRICAL_SURFACE('',#31,4.);",
+            "#40 = LINE('',#32,#41);\n#60 = ADVANCED_FACE('',(),#61,.T.);\n#61 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);",
         );
     let strict = step::read(&text).unwrap_err();
     assert_eq!(
         strict.to_string(),
-        "#61 CYLINDRICAL_SURFACE (line 36): unsupported entity, met as the surface of #60 ADVANCED_FACE (line 35)"
+        "#61 SURFACE_OF_LINEAR_EXTRUSION (line 36): unsupported entity, met as the surface of #60 ADVANCED_FACE (line 35)"
     );
     let lenient = step::ReadOptions {
         skip_unsupported_faces: true,
@@ -506,7 +515,7 @@ fn unsupported_faces_can_be_skipped() {
     assert!(step::read_file(&path).is_err());
     std::fs::remove_dir_all(&dir).unwrap();
     // A malformed file is refused all the same.
-    let dangling = text.replace("#61 = CYLINDRICAL_SURFACE('',#31,4.);", "");
+    let dangling = text.replace("#61 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);", "");
     assert!(matches!(
         step::read_with(&dangling, &lenient),
         Err(StepError::Dangling { .. })

@@ -354,3 +354,73 @@ fn uv_polygons_enclose_the_faces() {
     assert!((caps[0] / (pi * 30.0 * 6.0) - 1.0).abs() < 1e-3, "{caps:?}");
     assert!((caps[1] / (pi * 22.0 * 8.0) + 1.0).abs() < 1e-3, "{caps:?}");
 }
+
+/// Analytic faces become NURBS with other parameters than OCCT's, so the check is geometric:
+/// every OCCT sample (at OCCT's parameters, over the face's UV bounds) lies on tezgah's
+/// surface, whose own corners and grid lie on the analytic shape (closed forms), and the
+/// orientations agree.
+#[test]
+fn analytic_solids_become_exact_nurbs() {
+    let m = step::read_file(fixture("analytic_solids.stp")).unwrap();
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(fixture("analytic_solids.json")).unwrap())
+            .unwrap();
+    let faces = json["faces"].as_array().unwrap();
+    assert_eq!(m.faces.len(), faces.len());
+    assert_eq!(m.faces.len(), 8);
+    let mut worst = 0.0f64;
+    for (k, (face, reference)) in m.faces.iter().zip(faces).enumerate() {
+        assert_eq!(
+            face.same_sense,
+            !reference["reversed"].as_bool().unwrap(),
+            "face {k}"
+        );
+        for s in reference["samples"].as_array().unwrap() {
+            let s: Vec<f64> = s
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            let q = tezgah_geom::Vec3::new(s[2], s[3], s[4]);
+            let cp = face.surface.closest_point(&q, 1e-12).unwrap();
+            worst = worst.max(cp.distance);
+        }
+    }
+    println!("analytic solids: OCCT samples off tezgah's surfaces by at most {worst:e} mm");
+    assert!(worst < POINT_TOL_MM, "{worst}");
+    // Closed forms on a 9 × 9 grid of each curved face's domain.
+    let shapes: [(usize, &dyn Fn(tezgah_geom::Vec3) -> f64); 4] = [
+        (0, &|p| p.x.hypot(p.y) - 20.0),
+        (3, &|p| (p.x - 60.0).hypot(p.y) - (20.0 - 12.0 * p.z / 30.0)),
+        (6, &|p| {
+            (p - tezgah_geom::Vec3::new(120.0, 0.0, 0.0)).norm() - 15.0
+        }),
+        (7, &|p| ((p.x - 180.0).hypot(p.y) - 20.0).hypot(p.z) - 5.0),
+    ];
+    for (k, off) in shapes {
+        let s = &m.faces[k].surface;
+        let (u0, u1) = s.domain_u();
+        let (v0, v1) = s.domain_v();
+        for a in 0..=8 {
+            for b in 0..=8 {
+                let p = s.point(
+                    u0 + (u1 - u0) * a as f64 / 8.0,
+                    v0 + (v1 - v0) * b as f64 / 8.0,
+                );
+                assert!(
+                    off(p).abs() < 1e-12 * 200.0,
+                    "face {k}: {p:?} off by {}",
+                    off(p)
+                );
+            }
+        }
+    }
+    // The cylinder's side spans the full turn and exactly its height.
+    let side = &m.faces[0].surface;
+    let (u0, _) = side.domain_u();
+    let (v0, v1) = side.domain_v();
+    assert!((side.point(u0, v0) - tezgah_geom::Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-12);
+    assert!((side.point(u0, v1) - tezgah_geom::Vec3::new(20.0, 0.0, 50.0)).norm() < 1e-12);
+    assert!(m.faces[0].is_untrimmed(1e-7));
+}

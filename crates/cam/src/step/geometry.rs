@@ -10,10 +10,12 @@ use super::entity::{real_of, Entity, Resolve};
 use super::error::StepError;
 use super::exchange::{Exchange, Param};
 
-/// What geometry is read against: the exchange and the length unit's mm.
+/// What geometry is read against: the exchange, the length unit's mm and the plane angle
+/// unit's radians.
 pub(crate) struct Geometry<'a> {
     pub ex: &'a Exchange,
     pub mm: f64,
+    pub angle: f64,
 }
 
 impl<'a> Geometry<'a> {

@@ -12,6 +12,7 @@ mod geometry;
 mod lexer;
 mod model;
 mod pcurve;
+mod revolved;
 mod topology;
 mod units;
 
@@ -72,6 +73,8 @@ pub fn read_file_with(
 pub struct StepFile {
     ex: Exchange,
     unit: LengthUnit,
+    /// Radians per plane angle unit.
+    angle: f64,
 }
 
 impl StepFile {
@@ -79,7 +82,8 @@ impl StepFile {
     pub fn parse(bytes: &[u8]) -> Result<Self, StepError> {
         let ex = exchange::parse(bytes)?;
         let unit = units::length_unit(&ex)?;
-        Ok(StepFile { ex, unit })
+        let angle = units::plane_angle(&ex)?;
+        Ok(StepFile { ex, unit, angle })
     }
 
     pub fn unit(&self) -> &LengthUnit {
@@ -129,6 +133,7 @@ impl StepFile {
         Geometry {
             ex: &self.ex,
             mm: self.unit.mm,
+            angle: self.angle,
         }
     }
 }

@@ -54,7 +54,7 @@ pub(crate) fn attach(
 
 /// The pcurve on `surface_id` cut to `range`. A seam lies twice on one surface; OpenCascade
 /// lists first the pcurve the edge follows in its forward use.
-fn find(
+pub(crate) fn find(
     g: &Geometry<'_>,
     surface_id: u64,
     scale: f64,
@@ -121,13 +121,17 @@ fn curve_2d(
             x: x * r1,
             y: y * r2,
         };
-        let arc = frame.arc(lo, (hi - lo).min(TAU)).ok()?;
+        // The range is in the file's plane angle unit.
+        let arc = frame
+            .arc(lo * g.angle, ((hi - lo) * g.angle).min(TAU))
+            .ok()?;
         return Trimmed::new(arc, 0.0, 1.0).ok();
     }
     if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
         let flat = Geometry {
             ex: g.ex,
             mm: scale,
+            angle: g.angle,
         };
         let curve = flat.bspline_curve_2d(c).ok()?;
         return Trimmed::new(curve, lo, hi).ok();

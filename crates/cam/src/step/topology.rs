@@ -14,6 +14,7 @@ use super::error::StepError;
 use super::geometry::Geometry;
 use super::model::{Bound, BoundEdge, BoundKind, Face};
 use super::pcurve::{self, EdgeRange};
+use super::revolved;
 
 /// The entities that hold a shape; their shells' faces are the model's faces.
 const BODIES: [&str; 3] = [
@@ -159,6 +160,8 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
         (g.bspline_surface(&s)?, 1.0)
     } else if s.name() == "PLANE" && !s.instance.complex {
         (plane(g, &s, &bounds)?, g.mm)
+    } else if revolved::REVOLVED.contains(&s.name()) && !s.instance.complex {
+        (revolved::surface(g, &s, &ranges)?, 1.0)
     } else {
         return Err(StepError::Unsupported {
             at: s.at(),
@@ -266,7 +269,12 @@ fn read_edge(
     } else if simple("CIRCLE") || simple("ELLIPSE") {
         let (arc, start, sweep) = conic::arc(g, &c, v0, v1, same_sense)?;
         let (a, b) = arc.domain();
-        (Trimmed::new(arc, a, b), start, start + sweep)
+        // A conic's parameter is its angle in the file's plane angle unit.
+        (
+            Trimmed::new(arc, a, b),
+            start / g.angle,
+            (start + sweep) / g.angle,
+        )
     } else {
         let curve = g.curve(&c, 0)?;
         let lo = locate(&curve, &from, true);

@@ -29,9 +29,41 @@ impl LengthUnit {
     }
 }
 
+/// What a unit measures: the partial type that marks it, the SI base unit's name and its size
+/// in tezgah's unit (mm, rad).
+#[derive(Clone, Copy)]
+struct Kind {
+    marker: &'static str,
+    si_name: &'static str,
+    base: f64,
+}
+
+const LENGTH: Kind = Kind {
+    marker: "LENGTH_UNIT",
+    si_name: "METRE",
+    base: 1000.0,
+};
+const PLANE_ANGLE: Kind = Kind {
+    marker: "PLANE_ANGLE_UNIT",
+    si_name: "RADIAN",
+    base: 1.0,
+};
+
+/// Radians per unit of the file's plane angles (cone semi-angles, angle parameters): the
+/// `PLANE_ANGLE_UNIT` of the unit contexts (radian when none; OpenCascade and most writers
+/// use radians).
+pub(crate) fn plane_angle(ex: &Exchange) -> Result<f64, StepError> {
+    Ok(unit_of(ex, PLANE_ANGLE)?.map_or(1.0, |u| u.mm))
+}
+
 /// The length unit of every `GLOBAL_UNIT_ASSIGNED_CONTEXT` in the file; several contexts
 /// must agree (tezgah reads one part, not an assembly with parts in different units).
 pub(crate) fn length_unit(ex: &Exchange) -> Result<LengthUnit, StepError> {
+    Ok(unit_of(ex, LENGTH)?.unwrap_or_else(LengthUnit::millimetre_assumed))
+}
+
+/// The unit of `kind` the contexts assign, as a `LengthUnit` (name and size in mm or rad).
+fn unit_of(ex: &Exchange, kind: Kind) -> Result<Option<LengthUnit>, StepError> {
     let mut found: Option<LengthUnit> = None;
     for id in ex.ids() {
         let Some(context) = ex.entity(id) else {
@@ -43,10 +75,10 @@ pub(crate) fn length_unit(ex: &Exchange) -> Result<LengthUnit, StepError> {
         let units = context.part("GLOBAL_UNIT_ASSIGNED_CONTEXT")?;
         for unit in units.refs(0, "units")? {
             let u = ex.get(unit, &units)?;
-            if !u.instance.has("LENGTH_UNIT") {
+            if !u.instance.has(kind.marker) {
                 continue;
             }
-            let this = unit_mm(ex, &u, 0)?;
+            let this = unit_mm(ex, &u, kind, 0)?;
             match &found {
                 Some(f) if (f.mm - this.mm).abs() > 1e-12 * f.mm => {
                     return Err(StepError::MixedUnits {
@@ -59,11 +91,17 @@ pub(crate) fn length_unit(ex: &Exchange) -> Result<LengthUnit, StepError> {
             }
         }
     }
-    Ok(found.unwrap_or_else(LengthUnit::millimetre_assumed))
+    Ok(found)
 }
 
-/// Millimetres per `unit` (an instance with a `LENGTH_UNIT` part).
-fn unit_mm(ex: &Exchange, unit: &Entity<'_>, depth: usize) -> Result<LengthUnit, StepError> {
+/// Millimetres (radians) per `unit`, an instance with a `LENGTH_UNIT` (`PLANE_ANGLE_UNIT`)
+/// part.
+fn unit_mm(
+    ex: &Exchange,
+    unit: &Entity<'_>,
+    kind: Kind,
+    depth: usize,
+) -> Result<LengthUnit, StepError> {
     if depth > MAX_CHAIN {
         return Err(unit.invalid(format!("unit conversions chained deeper than {MAX_CHAIN}")));
     }
@@ -79,8 +117,13 @@ fn unit_mm(ex: &Exchange, unit: &Entity<'_>, depth: usize) -> Result<LengthUnit,
             Param::Enum(e) => e.as_str(),
             _ => return Err(si.invalid("SI unit name must be an enumeration")),
         };
-        if name != "METRE" {
-            return Err(si.invalid(format!("length unit .{name}. is not a length")));
+        if name != kind.si_name {
+            let what = if kind.si_name == "METRE" {
+                "length"
+            } else {
+                "plane angle"
+            };
+            return Err(si.invalid(format!("{what} unit .{name}. is not a {what}")));
         }
         let (prefix_name, scale) = match prefix {
             Param::Unset => ("", 1.0),
@@ -91,13 +134,13 @@ fn unit_mm(ex: &Exchange, unit: &Entity<'_>, depth: usize) -> Result<LengthUnit,
             _ => return Err(si.invalid("SI prefix must be an enumeration or $")),
         };
         let label = if prefix_name.is_empty() {
-            "METRE".to_string()
+            kind.si_name.to_string()
         } else {
-            format!("{prefix_name} METRE")
+            format!("{prefix_name} {}", kind.si_name)
         };
         return Ok(LengthUnit {
             name: label,
-            mm: 1000.0 * scale,
+            mm: kind.base * scale,
         });
     }
     if unit.instance.has("CONVERSION_BASED_UNIT") {
@@ -116,7 +159,7 @@ fn unit_mm(ex: &Exchange, unit: &Entity<'_>, depth: usize) -> Result<LengthUnit,
         };
         let value = m.real(0, "value component")?;
         let base = ex.get(m.reference(1, "unit component")?, &m)?;
-        let base_mm = unit_mm(ex, &base, depth + 1)?.mm;
+        let base_mm = unit_mm(ex, &base, kind, depth + 1)?.mm;
         let mm = value * base_mm;
         if !(mm.is_finite() && mm > 0.0) {
             return Err(cbu.invalid(format!("conversion factor gives {mm} mm per unit")));
@@ -125,7 +168,7 @@ fn unit_mm(ex: &Exchange, unit: &Entity<'_>, depth: usize) -> Result<LengthUnit,
     }
     Err(StepError::Unsupported {
         at: unit.at(),
-        role: "a length unit".to_string(),
+        role: format!("a {}", kind.marker.to_ascii_lowercase().replace('_', " ")),
     })
 }
 

@@ -23,6 +23,10 @@ Fixtures:
   freeform_patch_ap203.stp  the patch in AP203 (CONFIG_CONTROL_DESIGN)
   nurbs_cylinder.stp   a cylinder r = 20, h = 50 converted to NURBS: its side has a seam edge
                        (SEAM_CURVE with two pcurves on one surface)
+  analytic_solids.stp  four solids on analytic surfaces as OCCT writes them (not converted): a
+                       cylinder r 20 h 50, a cone r 20 -> 8 h 30 at x = 60, a sphere r 15 at
+                       x = 120, a torus R 20 r 5 at x = 180 (CYLINDRICAL_, CONICAL_,
+                       SPHERICAL_, TOROIDAL_SURFACE with their planes)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
 Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
@@ -80,6 +84,20 @@ def rational_sphere():
 def nurbs_cylinder():
     from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder
     return BRepBuilderAPI_NurbsConvert(BRepPrimAPI_MakeCylinder(20.0, 50.0).Shape()).Shape()
+
+
+def analytic_solids():
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeCylinder, BRepPrimAPI_MakeCone, BRepPrimAPI_MakeTorus
+    from OCP.TopoDS import TopoDS_Compound
+    from OCP.BRep import BRep_Builder
+    b = BRep_Builder()
+    c = TopoDS_Compound()
+    b.MakeCompound(c)
+    b.Add(c, BRepPrimAPI_MakeCylinder(20.0, 50.0).Shape())
+    b.Add(c, BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(60, 0, 0), gp_Dir(0, 0, 1)), 20.0, 8.0, 30.0).Shape())
+    b.Add(c, BRepPrimAPI_MakeSphere(gp_Pnt(120, 0, 0), 15.0).Shape())
+    b.Add(c, BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(180, 0, 0), gp_Dir(0, 0, 1)), 20.0, 5.0).Shape())
+    return c
 
 
 def twisted_blade():
@@ -182,6 +200,7 @@ def main():
         ("freeform_patch_ap203", freeform_patch(), "MM"),
         ("plate_with_holes", plate_with_holes(), "MM"),
         ("nurbs_cylinder", nurbs_cylinder(), "MM"),
+        ("analytic_solids", analytic_solids(), "MM"),
     ]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")

@@ -1,0 +1,171 @@
+//! Surfaces of revolution about an axis — `CYLINDRICAL_SURFACE`, `CONICAL_SURFACE`,
+//! `SPHERICAL_SURFACE`, `TOROIDAL_SURFACE` (ISO 10303-42 §4.4.25–28) — as exact NURBS: the
+//! profile (a line or a circular arc in the (radius, height) half-plane) swept by a circular
+//! arc (Piegl & Tiller §8.5, A8.1). These surfaces are unbounded or periodic; the face's
+//! extent in the surface's own (u, v) comes from its pcurves.
+//!
+//! The NURBS keeps the directions of ISO's (u, v) — u the angle about the axis, v along the
+//! profile — and so the face's orientation, but not the angle parameterisation itself (a
+//! rational arc is not uniform in angle): parameters of the file do not carry over, and the
+//! face's pcurves, checked against the new surface, are dropped.
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+
+use tezgah_geom::{NurbsSurface, Vec3};
+
+use super::conic::Frame;
+use super::entity::Entity;
+use super::error::StepError;
+use super::geometry::Geometry;
+use super::pcurve::{self, EdgeRange};
+
+/// The surface types read here.
+pub(crate) const REVOLVED: [&str; 4] = [
+    "CYLINDRICAL_SURFACE",
+    "CONICAL_SURFACE",
+    "SPHERICAL_SURFACE",
+    "TOROIDAL_SURFACE",
+];
+
+/// The profile in the (ρ, ζ) half-plane as a function of ISO's v.
+enum Profile {
+    /// ρ = r0 + v·slope, ζ = v (cylinder: slope 0; cone: tan of the semi-angle).
+    Line { r0: f64, slope: f64 },
+    /// ρ = rho0 + r cos v, ζ = r sin v (sphere: rho0 = 0; torus: the major radius).
+    Arc { rho0: f64, r: f64 },
+}
+
+/// The face on surface `s` whose edges' ranges are `ranges`, as a NURBS surface over the
+/// extent of the face's pcurves on `s`.
+pub(crate) fn surface(
+    g: &Geometry<'_>,
+    s: &Entity<'_>,
+    ranges: &[Option<EdgeRange>],
+) -> Result<NurbsSurface, StepError> {
+    let (centre, x, y) = g.placement(s.reference(1, "position")?, s)?;
+    let z = x.cross(&y);
+    let length = |i: usize, what: &str| -> Result<f64, StepError> {
+        let v = s.real(i, what)? * g.mm;
+        if v.is_finite() && v > 0.0 {
+            Ok(v)
+        } else {
+            Err(s.invalid(format!("{what} must be > 0")))
+        }
+    };
+    let sphere = s.name() == "SPHERICAL_SURFACE";
+    let profile = match s.name() {
+        "CYLINDRICAL_SURFACE" => Profile::Line {
+            r0: length(2, "radius")?,
+            slope: 0.0,
+        },
+        "CONICAL_SURFACE" => {
+            let r0 = s.real(2, "radius")? * g.mm;
+            let angle = s.real(3, "semi_angle")? * g.angle;
+            if !(r0.is_finite() && r0 >= 0.0 && angle.abs() < FRAC_PI_2 && angle != 0.0) {
+                return Err(s.invalid("a cone needs radius ≥ 0 and 0 < |semi_angle| < 90°"));
+            }
+            Profile::Line {
+                r0,
+                slope: angle.tan(),
+            }
+        }
+        "SPHERICAL_SURFACE" => Profile::Arc {
+            rho0: 0.0,
+            r: length(2, "radius")?,
+        },
+        _ => Profile::Arc {
+            rho0: length(2, "major_radius")?,
+            r: length(3, "minor_radius")?,
+        },
+    };
+    // The face's extent in ISO's (u, v): the box of its pcurves' control points (the pcurves
+    // are in the file's angle unit and length unit).
+    let (mut u0, mut u1, mut v0, mut v1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    let v_scale = match profile {
+        Profile::Line { .. } => g.mm,
+        Profile::Arc { .. } => g.angle,
+    };
+    for range in ranges.iter().flatten() {
+        let Some(pc) = pcurve::find(g, s.id, 1.0, range) else {
+            continue;
+        };
+        for p in pc.inner().control_points() {
+            let (u, v) = (p.x * g.angle, p.y * v_scale);
+            u0 = u0.min(u);
+            u1 = u1.max(u);
+            v0 = v0.min(v);
+            v1 = v1.max(v);
+        }
+    }
+    if u0 > u1 {
+        // No pcurves: only a closed surface has a natural extent.
+        match profile {
+            Profile::Arc { .. } => {
+                (u0, u1) = (0.0, TAU);
+                (v0, v1) = if sphere {
+                    (-FRAC_PI_2, FRAC_PI_2)
+                } else {
+                    (0.0, TAU)
+                };
+            }
+            Profile::Line { .. } => {
+                return Err(s.invalid("a face on an unbounded surface needs pcurves for its extent"))
+            }
+        }
+    }
+    let u1 = u1.min(u0 + TAU);
+    let (v0, v1) = match profile {
+        Profile::Arc { .. } if sphere => (v0.max(-FRAC_PI_2), v1.min(FRAC_PI_2)),
+        Profile::Arc { .. } => (v0, v1.min(v0 + TAU)),
+        Profile::Line { .. } => (v0, v1),
+    };
+    if !(u0 < u1 && v0 < v1) {
+        return Err(s.invalid("the face's pcurves do not span an area"));
+    }
+    // The profile as (ρ, ζ) control points with weights, and its knots.
+    let (rz, knots_v) = match profile {
+        Profile::Line { r0, slope } => (
+            vec![
+                (Vec3::new(r0 + v0 * slope, v0, 0.0), 1.0),
+                (Vec3::new(r0 + v1 * slope, v1, 0.0), 1.0),
+            ],
+            vec![0.0, 0.0, 1.0, 1.0],
+        ),
+        Profile::Arc { rho0, r } => {
+            let arc = Frame {
+                centre: Vec3::new(rho0, 0.0, 0.0),
+                x: Vec3::new(r, 0.0, 0.0),
+                y: Vec3::new(0.0, r, 0.0),
+            }
+            .arc(v0, v1 - v0)
+            .map_err(|e| s.invalid(e.to_string()))?;
+            let pts = arc
+                .control_points()
+                .into_iter()
+                .zip(arc.weights())
+                .collect();
+            (pts, arc.knots().to_vec())
+        }
+    };
+    let sweep = Frame {
+        centre: Vec3::zeros(),
+        x: Vec3::x(),
+        y: Vec3::y(),
+    }
+    .arc(u0, u1 - u0)
+    .map_err(|e| s.invalid(e.to_string()))?;
+    // P_ij = C + ρ_j·(a_i.x·x + a_i.y·y) + ζ_j·z, w_ij = w_i·w_j: the product of the two
+    // rational curves is the revolved surface exactly (P&T A8.1).
+    let (a, wa) = (sweep.control_points(), sweep.weights());
+    let (mut points, mut weights) = (Vec::new(), Vec::new());
+    for (ai, wi) in a.iter().zip(&wa) {
+        for (p, wj) in &rz {
+            points.push(centre + (x * ai.x + y * ai.y) * p.x + z * p.y);
+            weights.push(wi * wj);
+        }
+    }
+    let degree_v = if rz.len() == 2 { 1 } else { 2 };
+    let knots_u = sweep.knots().to_vec();
+    NurbsSurface::new(2, degree_v, &points, &weights, knots_u, knots_v)
+        .map_err(|e| s.invalid(e.to_string()))
+}
