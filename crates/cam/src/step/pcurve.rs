@@ -175,8 +175,8 @@ fn agrees(surface: &NurbsSurface, edge: &BoundEdge, uv: &Trimmed<Nurbs>) -> bool
         <= PCURVE_TOLERANCE_MM
 }
 
-/// 2-D control points of a B-spline pcurve: `CARTESIAN_POINT`s with two coordinates.
 impl Geometry<'_> {
+    /// A B-spline pcurve: its control points are `CARTESIAN_POINT`s with two coordinates.
     fn bspline_curve_2d(&self, c: &Entity<'_>) -> Result<Nurbs, super::error::StepError> {
         self.bspline_curve_with(c, |id, from| {
             point_2d(self, id, self.mm).ok_or_else(|| from.invalid("a pcurve point must be 2-D"))

@@ -85,9 +85,12 @@ pub(crate) fn surface(
         Profile::Line { .. } => g.mm,
         Profile::Arc { .. } => g.angle,
     };
-    for range in ranges.iter().flatten() {
-        let Some(pc) = pcurve::find(g, s.id, 1.0, range) else {
-            continue;
+    // Every edge must give its pcurve, or the box could miss part of the face.
+    let mut complete = !ranges.is_empty();
+    for range in ranges {
+        let Some(pc) = range.as_ref().and_then(|r| pcurve::find(g, s.id, 1.0, r)) else {
+            complete = false;
+            break;
         };
         for p in pc.inner().control_points() {
             let (u, v) = (p.x * g.angle, p.y * v_scale);
@@ -97,8 +100,8 @@ pub(crate) fn surface(
             v1 = v1.max(v);
         }
     }
-    if u0 > u1 {
-        // No pcurves: only a closed surface has a natural extent.
+    if !complete {
+        // No (or not all) pcurves: only a closed surface has a natural extent, the whole one.
         match profile {
             Profile::Arc { .. } => {
                 (u0, u1) = (0.0, TAU);
