@@ -521,3 +521,115 @@ fn unsupported_faces_can_be_skipped() {
         Err(StepError::Dangling { .. })
     ));
 }
+
+/// Half a cylinder (r = 10 about z, 0° to 180°, z from 0 to 20) bounded by two arcs and two
+/// lines with their pcurves, angles in the unit `angle_unit`, in which a half turn is `half`.
+fn half_cylinder_file(angle_unit: &str, half: &str) -> String {
+    file(&format!(
+        "#1 = SHELL_BASED_SURFACE_MODEL('',(#2));
+#2 = OPEN_SHELL('',(#3));
+#3 = ADVANCED_FACE('',(#4),#10,.T.);
+#4 = FACE_OUTER_BOUND('',#5,.T.);
+#5 = EDGE_LOOP('',(#6,#7,#8,#9));
+#6 = ORIENTED_EDGE('',*,*,#20,.T.);
+#7 = ORIENTED_EDGE('',*,*,#21,.T.);
+#8 = ORIENTED_EDGE('',*,*,#22,.F.);
+#9 = ORIENTED_EDGE('',*,*,#23,.F.);
+#10 = CYLINDRICAL_SURFACE('',#11,10.);
+#11 = AXIS2_PLACEMENT_3D('',#12,#13,#14);
+#12 = CARTESIAN_POINT('',(0.,0.,0.));
+#13 = DIRECTION('',(0.,0.,1.));
+#14 = DIRECTION('',(1.,0.,0.));
+#15 = AXIS2_PLACEMENT_3D('',#16,#13,#14);
+#16 = CARTESIAN_POINT('',(0.,0.,20.));
+#20 = EDGE_CURVE('',#30,#31,#40,.T.);
+#21 = EDGE_CURVE('',#31,#32,#41,.T.);
+#22 = EDGE_CURVE('',#33,#32,#42,.T.);
+#23 = EDGE_CURVE('',#30,#33,#43,.T.);
+#30 = VERTEX_POINT('',#34);
+#31 = VERTEX_POINT('',#35);
+#32 = VERTEX_POINT('',#36);
+#33 = VERTEX_POINT('',#37);
+#34 = CARTESIAN_POINT('',(10.,0.,0.));
+#35 = CARTESIAN_POINT('',(-10.,0.,0.));
+#36 = CARTESIAN_POINT('',(-10.,0.,20.));
+#37 = CARTESIAN_POINT('',(10.,0.,20.));
+#40 = SURFACE_CURVE('',#44,(#50),.PCURVE_S1.);
+#41 = SURFACE_CURVE('',#45,(#51),.PCURVE_S1.);
+#42 = SURFACE_CURVE('',#46,(#52),.PCURVE_S1.);
+#43 = SURFACE_CURVE('',#47,(#53),.PCURVE_S1.);
+#44 = CIRCLE('',#11,10.);
+#45 = LINE('',#35,#48);
+#46 = CIRCLE('',#15,10.);
+#47 = LINE('',#34,#48);
+#48 = VECTOR('',#13,1.);
+#50 = PCURVE('',#10,#54);
+#51 = PCURVE('',#10,#55);
+#52 = PCURVE('',#10,#56);
+#53 = PCURVE('',#10,#57);
+#54 = DEFINITIONAL_REPRESENTATION('',(#60),#70);
+#55 = DEFINITIONAL_REPRESENTATION('',(#61),#70);
+#56 = DEFINITIONAL_REPRESENTATION('',(#62),#70);
+#57 = DEFINITIONAL_REPRESENTATION('',(#63),#70);
+#60 = LINE('',#64,#68);
+#61 = LINE('',#65,#69);
+#62 = LINE('',#66,#68);
+#63 = LINE('',#67,#69);
+#64 = CARTESIAN_POINT('',(0.,0.));
+#65 = CARTESIAN_POINT('',({half},0.));
+#66 = CARTESIAN_POINT('',(0.,20.));
+#67 = CARTESIAN_POINT('',(0.,0.));
+#68 = VECTOR('',#71,1.);
+#69 = VECTOR('',#72,1.);
+#70 = ( GEOMETRIC_REPRESENTATION_CONTEXT(2) PARAMETRIC_REPRESENTATION_CONTEXT()
+  REPRESENTATION_CONTEXT('2D SPACE',''));
+#71 = DIRECTION('',(1.,0.));
+#72 = DIRECTION('',(0.,1.));
+#80 = ( GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#81,#82))
+  REPRESENTATION_CONTEXT('',''));
+#81 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );
+#82 = {angle_unit};
+#83 = PLANE_ANGLE_MEASURE_WITH_UNIT(PLANE_ANGLE_MEASURE(0.0174532925199433),#84);
+#84 = ( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) );
+#85 = DIMENSIONAL_EXPONENTS(0.,0.,0.,0.,0.,0.,0.);"
+    ))
+}
+
+#[test]
+fn half_cylinder_in_radians_and_degrees() {
+    let radian = "( NAMED_UNIT(*) PLANE_ANGLE_UNIT() SI_UNIT($,.RADIAN.) )";
+    let degree = "( CONVERSION_BASED_UNIT('DEGREE',#83) NAMED_UNIT(#85) PLANE_ANGLE_UNIT() )";
+    let a = step::read(&half_cylinder_file(radian, "3.141592653589793")).unwrap();
+    let b = step::read(&half_cylinder_file(degree, "180.")).unwrap();
+    for m in [&a, &b] {
+        let f = &m.faces[0];
+        let s = &f.surface;
+        let (u0, u1) = s.domain_u();
+        let (v0, v1) = s.domain_v();
+        // u runs counter-clockwise from +x through +y to −x, v up the axis.
+        assert!((s.point(u0, v0) - Vec3::new(10.0, 0.0, 0.0)).norm() < 1e-12);
+        assert!((s.point(u1, v1) - Vec3::new(-10.0, 0.0, 20.0)).norm() < 1e-12);
+        assert!((s.point(0.5 * (u0 + u1), v0) - Vec3::new(0.0, 10.0, 0.0)).norm() < 1e-12);
+        for k in 0..=10 {
+            let p = s.point(u0 + (u1 - u0) * k as f64 / 10.0, 0.5 * (v0 + v1));
+            assert!(
+                (p.x.hypot(p.y) - 10.0).abs() < 1e-12
+                    && p.y >= -1e-12
+                    && (p.z - 10.0).abs() < 1e-12
+            );
+        }
+        let n = s.derivs(0.5 * (u0 + u1), v0);
+        assert!(
+            n.su.cross(&n.sv).y > 0.0,
+            "the normal points out of the axis"
+        );
+        assert!(f.is_untrimmed(1e-9));
+    }
+    let (fa, fb) = (&a.faces[0].surface, &b.faces[0].surface);
+    let (u0, u1) = fa.domain_u();
+    assert_eq!(fb.domain_u(), (u0, u1));
+    for k in 0..=10 {
+        let u = u0 + (u1 - u0) * k as f64 / 10.0;
+        assert!((fa.point(u, 7.0) - fb.point(u, 7.0)).norm() < 1e-12);
+    }
+}
