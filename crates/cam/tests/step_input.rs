@@ -262,14 +262,15 @@ fn unsupported_entities_are_named() {
         step::read(&extrusion).unwrap_err().to_string(),
         "#30 SURFACE_OF_LINEAR_EXTRUSION (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
     );
-    // A cylinder is read, but its extent comes from pcurves, which these edges lack.
+    // A cylinder is read, its extent taken from the loop — which here lies in one plane
+    // across the axis and so spans no area of the cylinder.
     let cyl = plane_file(MM, ".T.").replace(
         "#30 = PLANE('',#31);",
         "#30 = CYLINDRICAL_SURFACE('',#31,4.);",
     );
     assert_eq!(
         step::read(&cyl).unwrap_err().to_string(),
-        "#30 CYLINDRICAL_SURFACE (line 29): a face on an unbounded surface needs pcurves for its extent"
+        "#30 CYLINDRICAL_SURFACE (line 29): the face's bounds do not span an area on it"
     );
     let hyperbola = plane_file(MM, ".T.").replace(
         "#11 = EDGE_CURVE('',#21,#22,#40,.T.);",

@@ -357,23 +357,20 @@ fn uv_polygons_enclose_the_faces() {
 
 /// Analytic faces become NURBS with other parameters than OCCT's, so the check is geometric:
 /// every OCCT sample (at OCCT's parameters, over the face's UV bounds) lies on tezgah's
-/// surface, whose own corners and grid lie on the analytic shape (closed forms), and the
-/// orientations agree.
-#[test]
-fn analytic_solids_become_exact_nurbs() {
-    let m = step::read_file(fixture("analytic_solids.stp")).unwrap();
+/// surface within 1e-9 mm, and the orientations agree. Returns the model.
+fn check_geometric(name: &str) -> StepModel {
+    let m = step::read_file(fixture(&format!("{name}.stp"))).unwrap();
     let json: Value =
-        serde_json::from_str(&std::fs::read_to_string(fixture("analytic_solids.json")).unwrap())
+        serde_json::from_str(&std::fs::read_to_string(fixture(&format!("{name}.json"))).unwrap())
             .unwrap();
     let faces = json["faces"].as_array().unwrap();
-    assert_eq!(m.faces.len(), faces.len());
-    assert_eq!(m.faces.len(), 8);
+    assert_eq!(m.faces.len(), faces.len(), "{name}: face count");
     let mut worst = 0.0f64;
     for (k, (face, reference)) in m.faces.iter().zip(faces).enumerate() {
         assert_eq!(
             face.same_sense,
             !reference["reversed"].as_bool().unwrap(),
-            "face {k}"
+            "{name} face {k}"
         );
         for s in reference["samples"].as_array().unwrap() {
             let s: Vec<f64> = s
@@ -384,11 +381,30 @@ fn analytic_solids_become_exact_nurbs() {
                 .collect();
             let q = tezgah_geom::Vec3::new(s[2], s[3], s[4]);
             let cp = face.surface.closest_point(&q, 1e-12).unwrap();
+            assert!(
+                cp.distance < POINT_TOL_MM,
+                "{name} face {k}: {q:?} off by {}",
+                cp.distance
+            );
             worst = worst.max(cp.distance);
         }
     }
-    println!("analytic solids: OCCT samples off tezgah's surfaces by at most {worst:e} mm");
-    assert!(worst < POINT_TOL_MM, "{worst}");
+    println!("{name}: OCCT samples off tezgah's surfaces by at most {worst:e} mm");
+    m
+}
+
+/// The analytic solids, with pcurves (extent from them) and without (extent from the 3-D
+/// loops), give surfaces holding OCCT's samples and lying on the closed forms.
+#[test]
+fn analytic_solids_become_exact_nurbs() {
+    for name in ["analytic_solids", "analytic_solids_no_pcurves"] {
+        let m = check_geometric(name);
+        assert_eq!(m.faces.len(), 8);
+        analytic_closed_forms(&m);
+    }
+}
+
+fn analytic_closed_forms(m: &StepModel) {
     // Closed forms on a 9 × 9 grid of each curved face's domain.
     let shapes: [(usize, &dyn Fn(tezgah_geom::Vec3) -> f64); 4] = [
         (0, &|p| p.x.hypot(p.y) - 20.0),
@@ -423,4 +439,24 @@ fn analytic_solids_become_exact_nurbs() {
     assert!((side.point(u0, v0) - tezgah_geom::Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-12);
     assert!((side.point(u0, v1) - tezgah_geom::Vec3::new(20.0, 0.0, 50.0)).norm() < 1e-12);
     assert!(m.faces[0].is_untrimmed(1e-7));
+}
+
+/// A block with filleted vertical edges and a through hole, written without pcurves: the
+/// quarter-cylinder fillets get exactly their quarter turn (their loops lie on the domain's
+/// boundary), the hole its full turn; only the top and bottom (rounded, holed) are trimmed.
+#[test]
+fn filleted_block_without_pcurves() {
+    let m = check_geometric("filleted_block");
+    let trimmed = m.faces.iter().filter(|f| !f.is_untrimmed(1e-7)).count();
+    assert_eq!((m.faces.len(), trimmed), (11, 2));
+    for f in m.faces.iter().filter(|f| f.surface.degrees() == (2, 1)) {
+        // Cylinders (degree 2 round, 1 along): rulings parallel to the vertical axis.
+        let n = f
+            .surface
+            .derivs(f.surface.domain_u().0, f.surface.domain_v().0);
+        assert!(
+            n.sv.x.abs() < 1e-12 && n.sv.y.abs() < 1e-12,
+            "vertical rulings"
+        );
+    }
 }

@@ -17,6 +17,7 @@ use super::conic::Frame;
 use super::entity::Entity;
 use super::error::StepError;
 use super::geometry::Geometry;
+use super::model::{Bound, BoundKind};
 use super::pcurve::{self, EdgeRange};
 
 /// The surface types read here.
@@ -41,6 +42,7 @@ pub(crate) fn surface(
     g: &Geometry<'_>,
     s: &Entity<'_>,
     ranges: &[Option<EdgeRange>],
+    bounds: &[Bound],
 ) -> Result<NurbsSurface, StepError> {
     let (centre, x, y) = g.placement(s.reference(1, "position")?, s)?;
     let z = x.cross(&y);
@@ -101,19 +103,24 @@ pub(crate) fn surface(
         }
     }
     if !complete {
-        // No (or not all) pcurves: only a closed surface has a natural extent, the whole one.
-        match profile {
-            Profile::Arc { .. } => {
-                (u0, u1) = (0.0, TAU);
-                (v0, v1) = if sphere {
-                    (-FRAC_PI_2, FRAC_PI_2)
-                } else {
-                    (0.0, TAU)
-                };
-            }
-            Profile::Line { .. } => {
-                return Err(s.invalid("a face on an unbounded surface needs pcurves for its extent"))
-            }
+        // Without (all) pcurves, the extent comes from the 3-D loops (writers such as
+        // Parasolid give none); a closed surface without loops is whole.
+        let frame = Axes { centre, x, y, z };
+        match loop_extent(&frame, &profile, sphere, bounds) {
+            Some(e) => (u0, u1, v0, v1) = e,
+            None => match profile {
+                Profile::Arc { .. } => {
+                    (u0, u1) = (0.0, TAU);
+                    (v0, v1) = if sphere {
+                        (-FRAC_PI_2, FRAC_PI_2)
+                    } else {
+                        (0.0, TAU)
+                    };
+                }
+                Profile::Line { .. } => {
+                    return Err(s.invalid("a face on an unbounded surface needs bounds"))
+                }
+            },
         }
     }
     let u1 = u1.min(u0 + TAU);
@@ -123,7 +130,7 @@ pub(crate) fn surface(
         Profile::Line { .. } => (v0, v1),
     };
     if !(u0 < u1 && v0 < v1) {
-        return Err(s.invalid("the face's pcurves do not span an area"));
+        return Err(s.invalid("the face's bounds do not span an area on it"));
     }
     // The profile as (ρ, ζ) control points with weights, and its knots.
     let (rz, knots_v) = match profile {
@@ -171,4 +178,112 @@ pub(crate) fn surface(
     let knots_u = sweep.knots().to_vec();
     NurbsSurface::new(2, degree_v, &points, &weights, knots_u, knots_v)
         .map_err(|e| s.invalid(e.to_string()))
+}
+
+/// The surface's frame: origin and axes (z the axis of revolution).
+struct Axes {
+    centre: Vec3,
+    x: Vec3,
+    y: Vec3,
+    z: Vec3,
+}
+
+/// Angles closer than this on either side of the loops' largest angular gap make the face a
+/// full turn (the extent then holds the face all the same: a superset is always safe).
+const FULL_TURN_GAP: f64 = 0.5;
+/// Points per edge, beside its control points, that the loop extent looks at.
+const EXTENT_SAMPLES_PER_EDGE: usize = 32;
+
+/// The ISO (u, v) box of the face's 3-D loops: u the angle about the axis and (torus) v the
+/// angle about the tube, each the circle minus its largest gap between loop points; v the
+/// height (cylinder, cone) or latitude (sphere). Control points join the samples so that the
+/// box holds curved edges (convex hull), not only their samples. `None` without edge loops.
+fn loop_extent(
+    f: &Axes,
+    profile: &Profile,
+    sphere: bool,
+    bounds: &[Bound],
+) -> Option<(f64, f64, f64, f64)> {
+    let mut pts: Vec<Vec3> = Vec::new();
+    for b in bounds {
+        match &b.kind {
+            BoundKind::Vertex(p) => pts.push(*p),
+            BoundKind::Edges(edges) => {
+                for e in edges {
+                    pts.extend(e.polyline(EXTENT_SAMPLES_PER_EDGE));
+                    pts.extend(e.curve.inner().control_points());
+                }
+            }
+        }
+    }
+    if !bounds.iter().any(|b| matches!(b.kind, BoundKind::Edges(_))) {
+        return None;
+    }
+    let local: Vec<(f64, f64, f64)> = pts
+        .iter()
+        .map(|p| {
+            let d = p - f.centre;
+            (d.dot(&f.x), d.dot(&f.y), d.dot(&f.z))
+        })
+        .collect();
+    // Points on the axis (a sphere's pole) have no angle about it.
+    let around: Vec<f64> = local
+        .iter()
+        .filter(|(a, b, _)| a.hypot(*b) > 1e-9)
+        .map(|(a, b, _)| b.atan2(*a))
+        .collect();
+    let (u0, u1) = arc_extent(&around)?;
+    let (v0, v1) = match *profile {
+        Profile::Line { .. } => {
+            let h = local.iter().map(|l| l.2);
+            (
+                h.clone().fold(f64::MAX, f64::min),
+                h.fold(f64::MIN, f64::max),
+            )
+        }
+        Profile::Arc { .. } if sphere => {
+            let lat = local.iter().map(|(a, b, c)| c.atan2(a.hypot(*b)));
+            (
+                lat.clone().fold(f64::MAX, f64::min),
+                lat.fold(f64::MIN, f64::max),
+            )
+        }
+        Profile::Arc { rho0, .. } => {
+            let tube: Vec<f64> = local
+                .iter()
+                .map(|(a, b, c)| c.atan2(a.hypot(*b) - rho0))
+                .collect();
+            arc_extent(&tube)?
+        }
+    };
+    Some((u0, u1, v0, v1))
+}
+
+/// The smallest arc `[a, b]` (b − a ≤ 2π) of the circle holding all `angles`: the circle minus
+/// the largest gap between neighbours, or the full turn when no gap reaches `FULL_TURN_GAP`.
+fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
+    let mut a: Vec<f64> = angles
+        .iter()
+        .map(|t| t.rem_euclid(TAU))
+        .filter(|t| t.is_finite())
+        .collect();
+    a.sort_by(f64::total_cmp);
+    let (first, last) = (*a.first()?, *a.last()?);
+    // The gap after each angle, the last one wrapping round to the first.
+    let mut best = (first + TAU - last, last, first + TAU);
+    for w in a.windows(2) {
+        if w[1] - w[0] > best.0 {
+            best = (w[1] - w[0], w[0], w[1]);
+        }
+    }
+    if best.0 < FULL_TURN_GAP {
+        return Some((0.0, TAU));
+    }
+    // The face runs from the gap's end round to its start.
+    let start = best.2.rem_euclid(TAU);
+    let mut end = best.1;
+    while end <= start {
+        end += TAU;
+    }
+    Some((start, end))
 }

@@ -161,7 +161,7 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
     } else if s.name() == "PLANE" && !s.instance.complex {
         (plane(g, &s, &bounds)?, g.mm)
     } else if revolved::REVOLVED.contains(&s.name()) && !s.instance.complex {
-        (revolved::surface(g, &s, &ranges)?, 1.0)
+        (revolved::surface(g, &s, &ranges, &bounds)?, 1.0)
     } else {
         return Err(StepError::Unsupported {
             at: s.at(),

@@ -27,6 +27,10 @@ Fixtures:
                        cylinder r 20 h 50, a cone r 20 -> 8 h 30 at x = 60, a sphere r 15 at
                        x = 120, a torus R 20 r 5 at x = 180 (CYLINDRICAL_, CONICAL_,
                        SPHERICAL_, TOROIDAL_SURFACE with their planes)
+  analytic_solids_no_pcurves.stp  the same written without pcurves (write.surfacecurve.mode
+                       0, as Parasolid-based writers do): extents from the 3-D loops
+  filleted_block.stp   a 60 x 40 x 20 block, vertical edges filleted r 6, a through hole r 8,
+                       without pcurves (quarter cylinders, a plane with a circular hole)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
 Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
@@ -100,6 +104,26 @@ def analytic_solids():
     return c
 
 
+def filleted_block():
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakeBox, BRepPrimAPI_MakeCylinder
+    from OCP.BRepFilletAPI import BRepFilletAPI_MakeFillet
+    from OCP.BRepAlgoAPI import BRepAlgoAPI_Cut
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    box = BRepPrimAPI_MakeBox(60.0, 40.0, 20.0).Shape()
+    fillet = BRepFilletAPI_MakeFillet(box)
+    ex = TopExp_Explorer(box, TopAbs_EDGE)
+    while ex.More():
+        edge = TopoDS.Edge(ex.Current())
+        c = BRepAdaptor_Curve(edge)
+        d = c.Value(c.LastParameter()).XYZ() - c.Value(c.FirstParameter()).XYZ()
+        if abs(d.X()) < 1e-9 and abs(d.Y()) < 1e-9:
+            fillet.Add(6.0, edge)
+        ex.Next()
+    hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(30, 20, -1), gp_Dir(0, 0, 1)), 8.0, 22.0).Shape()
+    return BRepAlgoAPI_Cut(fillet.Shape(), hole).Shape()
+
+
 def twisted_blade():
     loft = BRepOffsetAPI_ThruSections(True, False, 1e-6)
     for k in range(5):
@@ -144,8 +168,9 @@ def iarr(values):
     return a
 
 
-def write(shape, path, unit="MM", schema="AP214IS"):
+def write(shape, path, unit="MM", schema="AP214IS", pcurves=True):
     Interface_Static.SetCVal_s("write.step.schema", schema)
+    Interface_Static.SetIVal_s("write.surfacecurve.mode", 1 if pcurves else 0)
     Interface_Static.SetCVal_s("write.step.unit", unit)
     w = STEPControl_Writer()
     w.Transfer(shape, STEPControl_AsIs)
@@ -201,10 +226,13 @@ def main():
         ("plate_with_holes", plate_with_holes(), "MM"),
         ("nurbs_cylinder", nurbs_cylinder(), "MM"),
         ("analytic_solids", analytic_solids(), "MM"),
+        ("analytic_solids_no_pcurves", analytic_solids(), "MM"),
+        ("filleted_block", filleted_block(), "MM"),
     ]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")
-        write(shape, stp, unit, "AP203" if name.endswith("ap203") else "AP214IS")
+        write(shape, stp, unit, "AP203" if name.endswith("ap203") else "AP214IS",
+              pcurves=not (name.endswith("no_pcurves") or name == "filleted_block"))
         with open(os.path.join(out, name + ".json"), "w") as f:
             json.dump(reference(stp), f, separators=(",", ":"))
             f.write("\n")
