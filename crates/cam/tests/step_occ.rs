@@ -1,7 +1,7 @@
 //! STEP geometry against OpenCascade: the fixtures in `tests/fixtures` were written by OCCT and
-//! read back by OCCT's own STEP reader, which evaluated every face at 144 (u, v) each
-//! (`tests/oracle/make_step_fixtures.py`). tezgah's reader must give the same faces, domains,
-//! points (within 1e-9 mm) and first derivatives.
+//! read back by OCCT's own STEP reader, which evaluated every face at 144 (u, v) (49 in files
+//! of more than three faces; `tests/oracle/make_step_fixtures.py`). tezgah's reader must give
+//! the same faces, domains, points (within 1e-9 mm) and first derivatives.
 
 use std::path::PathBuf;
 

@@ -60,7 +60,10 @@ from OCP.TopAbs import TopAbs_FACE, TopAbs_REVERSED
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-SAMPLES = 12  # per direction: 144 per face
+# Samples per direction and face: 12 (144 per face) for files of up to three faces, 7 (49 per
+# face, still a few hundred per file) for the larger ones, to keep the fixtures small.
+SAMPLES_FEW_FACES = 12
+SAMPLES_MANY_FACES = 7
 
 
 def freeform_patch():
@@ -194,17 +197,23 @@ def reference(path):
     r.TransferRoots()
     shape = r.OneShape()
     faces = []
+    count = 0
+    ex = TopExp_Explorer(shape, TopAbs_FACE)
+    while ex.More():
+        count += 1
+        ex.Next()
+    n = SAMPLES_FEW_FACES if count <= 3 else SAMPLES_MANY_FACES
     ex = TopExp_Explorer(shape, TopAbs_FACE)
     while ex.More():
         face = TopoDS.Face(ex.Current())
         surf = BRep_Tool.Surface_s(face)
         u0, u1, v0, v1 = BRepTools.UVBounds_s(face)
         samples = []
-        for a in range(SAMPLES):
-            for b in range(SAMPLES):
+        for a in range(n):
+            for b in range(n):
                 # Irregular spacing, ends included: knots and interiors both get hit.
-                u = u0 + (u1 - u0) * (a / (SAMPLES - 1)) ** 1.3
-                v = v0 + (v1 - v0) * (b / (SAMPLES - 1)) ** 0.8
+                u = u0 + (u1 - u0) * (a / (n - 1)) ** 1.3
+                v = v0 + (v1 - v0) * (b / (n - 1)) ** 0.8
                 p, du, dv = gp_Pnt(), gp_Vec(), gp_Vec()
                 surf.D1(u, v, p, du, dv)
                 samples.append([u, v, p.X(), p.Y(), p.Z(), du.X(), du.Y(), du.Z(), dv.X(), dv.Y(), dv.Z()])
