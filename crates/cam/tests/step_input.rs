@@ -254,13 +254,13 @@ fn unit_errors() {
 
 #[test]
 fn unsupported_entities_are_named() {
-    let extrusion = plane_file(MM, ".T.").replace(
+    let offset = plane_file(MM, ".T.").replace(
         "#30 = PLANE('',#31);",
-        "#30 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);",
+        "#30 = OFFSET_SURFACE('',#40,2.,.F.);",
     );
     assert_eq!(
-        step::read(&extrusion).unwrap_err().to_string(),
-        "#30 SURFACE_OF_LINEAR_EXTRUSION (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
+        step::read(&offset).unwrap_err().to_string(),
+        "#30 OFFSET_SURFACE (line 29): unsupported entity, met as the surface of #3 ADVANCED_FACE (line 10)"
     );
     // A cylinder is read, its extent taken from the loop — which here lies in one plane
     // across the axis and so spans no area of the cylinder.
@@ -493,12 +493,12 @@ fn unsupported_faces_can_be_skipped() {
         .replace("#2 = OPEN_SHELL('',(#3));", "#2 = OPEN_SHELL('',(#3,#60));")
         .replace(
             "#40 = LINE('',#32,#41);",
-            "#40 = LINE('',#32,#41);\n#60 = ADVANCED_FACE('',(),#61,.T.);\n#61 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);",
+            "#40 = LINE('',#32,#41);\n#60 = ADVANCED_FACE('',(),#61,.T.);\n#61 = OFFSET_SURFACE('',#40,2.,.F.);",
         );
     let strict = step::read(&text).unwrap_err();
     assert_eq!(
         strict.to_string(),
-        "#61 SURFACE_OF_LINEAR_EXTRUSION (line 36): unsupported entity, met as the surface of #60 ADVANCED_FACE (line 35)"
+        "#61 OFFSET_SURFACE (line 36): unsupported entity, met as the surface of #60 ADVANCED_FACE (line 35)"
     );
     let lenient = step::ReadOptions {
         skip_unsupported_faces: true,
@@ -516,7 +516,7 @@ fn unsupported_faces_can_be_skipped() {
     assert!(step::read_file(&path).is_err());
     std::fs::remove_dir_all(&dir).unwrap();
     // A malformed file is refused all the same.
-    let dangling = text.replace("#61 = SURFACE_OF_LINEAR_EXTRUSION('',#40,#41);", "");
+    let dangling = text.replace("#61 = OFFSET_SURFACE('',#40,2.,.F.);", "");
     assert!(matches!(
         step::read_with(&dangling, &lenient),
         Err(StepError::Dangling { .. })

@@ -460,3 +460,33 @@ fn filleted_block_without_pcurves() {
         );
     }
 }
+
+/// An extruded B-spline S-curve and a B-spline profile revolved 270°: swept surfaces as exact
+/// NURBS over their loops' extent; their edges lie on them and the faces are whole.
+#[test]
+fn swept_surfaces_become_exact_nurbs() {
+    let m = check_geometric("swept_surfaces");
+    assert_eq!(m.faces.len(), 2);
+    for f in &m.faces {
+        assert!(f.is_untrimmed(1e-7), "face {} is its whole surface", f.id);
+    }
+    // The extrusion spans exactly the 30 mm height (OCCT writes its vector downwards); the
+    // revolution turns exactly 270°.
+    let e = &m.faces[0].surface;
+    let (v0, v1) = e.domain_v();
+    let (u0, _) = e.domain_u();
+    let rise = e.point(u0, v1) - e.point(u0, v0);
+    assert!(
+        (rise - tezgah_geom::Vec3::new(0.0, 0.0, -30.0)).norm() < 1e-9,
+        "{rise:?}"
+    );
+    let r = &m.faces[1].surface;
+    let (u0, u1) = r.domain_u();
+    let (v0, _) = r.domain_v();
+    let (a, b) = (r.point(u0, v0), r.point(u1, v0));
+    let turn = b.y.atan2(b.x) - a.y.atan2(a.x);
+    assert!(
+        (turn.rem_euclid(std::f64::consts::TAU) - 1.5 * std::f64::consts::PI).abs() < 1e-12,
+        "{turn}"
+    );
+}

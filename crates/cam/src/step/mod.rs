@@ -13,6 +13,7 @@ mod lexer;
 mod model;
 mod pcurve;
 mod revolved;
+mod swept;
 mod topology;
 mod units;
 

@@ -192,7 +192,7 @@ struct Axes {
 /// full turn (the extent then holds the face all the same: a superset is always safe).
 const FULL_TURN_GAP: f64 = 0.5;
 /// Points per edge, beside its control points, that the loop extent looks at.
-const EXTENT_SAMPLES_PER_EDGE: usize = 32;
+pub(crate) const EXTENT_SAMPLES_PER_EDGE: usize = 32;
 
 /// The ISO (u, v) box of the face's 3-D loops: u the angle about the axis and (torus) v the
 /// angle about the tube, each the circle minus its largest gap between loop points; v the
@@ -261,7 +261,7 @@ fn loop_extent(
 
 /// The smallest arc `[a, b]` (b − a ≤ 2π) of the circle holding all `angles`: the circle minus
 /// the largest gap between neighbours, or the full turn when no gap reaches `FULL_TURN_GAP`.
-fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
+pub(crate) fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
     let mut a: Vec<f64> = angles
         .iter()
         .map(|t| t.rem_euclid(TAU))

@@ -15,6 +15,7 @@ use super::geometry::Geometry;
 use super::model::{Bound, BoundEdge, BoundKind, Face};
 use super::pcurve::{self, EdgeRange};
 use super::revolved;
+use super::swept;
 
 /// The entities that hold a shape; their shells' faces are the model's faces.
 const BODIES: [&str; 3] = [
@@ -162,6 +163,8 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
         (plane(g, &s, &bounds)?, g.mm)
     } else if revolved::REVOLVED.contains(&s.name()) && !s.instance.complex {
         (revolved::surface(g, &s, &ranges, &bounds)?, 1.0)
+    } else if swept::SWEPT.contains(&s.name()) && !s.instance.complex {
+        (swept::surface(g, &s, &bounds)?, 1.0)
     } else {
         return Err(StepError::Unsupported {
             at: s.at(),

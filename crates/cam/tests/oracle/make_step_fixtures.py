@@ -31,6 +31,8 @@ Fixtures:
                        0, as Parasolid-based writers do): extents from the 3-D loops
   filleted_block.stp   a 60 x 40 x 20 block, vertical edges filleted r 6, a through hole r 8,
                        without pcurves (quarter cylinders, a plane with a circular hole)
+  swept_surfaces.stp   a B-spline S-curve extruded 30 mm (SURFACE_OF_LINEAR_EXTRUSION) and a
+                       B-spline profile revolved 270 degrees about z (SURFACE_OF_REVOLUTION)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
 Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
@@ -125,6 +127,36 @@ def filleted_block():
         ex.Next()
     hole = BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(30, 20, -1), gp_Dir(0, 0, 1)), 8.0, 22.0).Shape()
     return BRepAlgoAPI_Cut(fillet.Shape(), hole).Shape()
+
+
+def swept_surfaces():
+    from OCP.BRepPrimAPI import BRepPrimAPI_MakePrism, BRepPrimAPI_MakeRevol
+    from OCP.Geom import Geom_BSplineCurve
+    from OCP.collections import Array1_gp_Pnt
+    from OCP.gp import gp_Ax1
+    from OCP.TopoDS import TopoDS_Compound
+    from OCP.BRep import BRep_Builder
+
+    def bspline(points):
+        poles = Array1_gp_Pnt(1, len(points))
+        for k, p in enumerate(points):
+            poles.SetValue(k + 1, gp_Pnt(*p))
+        n = len(points)
+        knots = [0.0] + [k / (n - 3) for k in range(1, n - 3)] + [1.0]
+        mults = [4] + [1] * (n - 4) + [4]
+        return Geom_BSplineCurve(poles, arr(knots), iarr(mults), 3)
+
+    s_curve = bspline([(0, 0, 0), (15, 10, 0), (30, -10, 0), (45, 12, 0), (60, 0, 0), (75, 5, 0)])
+    prism = BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeEdge(s_curve).Edge(), gp_Vec(0, 0, 30)).Shape()
+    profile = bspline([(10, 0, 0), (18, 0, 8), (12, 0, 16), (20, 0, 26), (14, 0, 34)])
+    profile_edge = BRepBuilderAPI_MakeEdge(profile).Edge()
+    revol = BRepPrimAPI_MakeRevol(profile_edge, gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), math.radians(270)).Shape()
+    b = BRep_Builder()
+    c = TopoDS_Compound()
+    b.MakeCompound(c)
+    b.Add(c, prism)
+    b.Add(c, revol)
+    return c
 
 
 def twisted_blade():
@@ -237,6 +269,7 @@ def main():
         ("analytic_solids", analytic_solids(), "MM"),
         ("analytic_solids_no_pcurves", analytic_solids(), "MM"),
         ("filleted_block", filleted_block(), "MM"),
+        ("swept_surfaces", swept_surfaces(), "MM"),
     ]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")
