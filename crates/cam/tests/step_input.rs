@@ -634,3 +634,68 @@ fn half_cylinder_in_radians_and_degrees() {
         assert!((fa.point(u, 7.0) - fb.point(u, 7.0)).norm() < 1e-12);
     }
 }
+
+/// The same surface or curve with knots written out and with knots implied by its subtype.
+#[test]
+fn implied_knots_equal_the_explicit_ones() {
+    let pts = "#10 = CARTESIAN_POINT('',(0.,0.,0.));
+#11 = CARTESIAN_POINT('',(0.,10.,1.));
+#12 = CARTESIAN_POINT('',(10.,0.,2.));
+#13 = CARTESIAN_POINT('',(10.,10.,3.));
+#14 = CARTESIAN_POINT('',(20.,0.,5.));
+#15 = CARTESIAN_POINT('',(20.,10.,4.));
+#16 = CARTESIAN_POINT('',(30.,0.,1.));
+#17 = CARTESIAN_POINT('',(30.,10.,0.));";
+    let head = "B_SPLINE_SURFACE_WITH_KNOTS";
+    let grid = "((#10,#11),(#12,#13),(#14,#15),(#16,#17)),.UNSPECIFIED.,.F.,.F.,.F.";
+    let surface = |entity: &str, degree_u: usize, tail: &str| {
+        let text = file(&format!(
+            "#1 = {entity}('',{degree_u},1,{grid}{tail});\n{pts}"
+        ));
+        StepFile::parse(text.as_bytes())
+            .unwrap()
+            .surface(1)
+            .unwrap()
+    };
+    // Quasi-uniform, degree 2 in u over 4 points: 0 0 0 1 2 2 2; v: 0 0 1 1.
+    assert_eq!(
+        surface("QUASI_UNIFORM_SURFACE", 2, ""),
+        surface(head, 2, ",(3,1,3),(2,2),(0.,1.,2.),(0.,1.),.UNSPECIFIED.")
+    );
+    // Bézier, degree 3 in u: one piece, 0 0 0 0 1 1 1 1.
+    assert_eq!(
+        surface("BEZIER_SURFACE", 3, ""),
+        surface(head, 3, ",(4,4),(2,2),(0.,1.),(0.,1.),.UNSPECIFIED.")
+    );
+    // Uniform, degree 2 in u: −2 … 4; v (degree 1, 2 points): −1 0 1 2.
+    assert_eq!(
+        surface("UNIFORM_SURFACE", 2, ""),
+        surface(
+            head,
+            2,
+            ",(1,1,1,1,1,1,1),(1,1,1,1),(-2.,-1.,0.,1.,2.,3.,4.),(-1.,0.,1.,2.),.UNSPECIFIED."
+        )
+    );
+    // A Bézier curve of degree 3 over 7 points: two pieces, 0⁴ 1³ 2⁴.
+    let curve = |entity: &str, tail: &str| {
+        let text = file(&format!(
+            "#1 = {entity}('',3,(#10,#11,#12,#13,#14,#15,#16),.UNSPECIFIED.,.F.,.F.{tail});\n{pts}"
+        ));
+        StepFile::parse(text.as_bytes()).unwrap().curve(1).unwrap()
+    };
+    assert_eq!(
+        curve("BEZIER_CURVE", ""),
+        curve(
+            "B_SPLINE_CURVE_WITH_KNOTS",
+            ",(4,3,4),(0.,1.,2.),.UNSPECIFIED."
+        )
+    );
+    // Six points do not make Bézier pieces of degree 3.
+    let text = file(&format!(
+        "#1 = BEZIER_CURVE('',3,(#10,#11,#12,#13,#14,#15),.UNSPECIFIED.,.F.,.F.);\n{pts}"
+    ));
+    assert_eq!(
+        StepFile::parse(text.as_bytes()).unwrap().curve(1).unwrap_err().to_string(),
+        "#1 BEZIER_CURVE (line 8): a Bézier direction of degree 3 needs degree·k + 1 control points, not 6"
+    );
+}

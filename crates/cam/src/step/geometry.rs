@@ -8,7 +8,7 @@ use tezgah_geom::{Nurbs, NurbsSurface, Vec3};
 
 use super::entity::{real_of, Entity, Resolve};
 use super::error::StepError;
-use super::exchange::{Exchange, Param};
+use super::exchange::{Exchange, Instance, Param};
 
 /// What geometry is read against: the exchange, the length unit's mm and the plane angle
 /// unit's radians.
@@ -58,12 +58,6 @@ impl<'a> Geometry<'a> {
         } else {
             (*s, 1)
         };
-        let knots = if s.instance.complex {
-            s.part("B_SPLINE_SURFACE_WITH_KNOTS")?
-        } else {
-            *s
-        };
-        let k0 = if s.instance.complex { 0 } else { first + 7 };
         let p = base.count(first, "u_degree")?;
         let q = base.count(first + 1, "v_degree")?;
         let rows = base.list(first + 2, "control_points_list")?;
@@ -91,8 +85,24 @@ impl<'a> Geometry<'a> {
                 grid[bad].len()
             )));
         }
-        let ku = expand_knots(&knots, k0, k0 + 2, "u", n_rows, p)?;
-        let kv = expand_knots(&knots, k0 + 1, k0 + 3, "v", n_cols, q)?;
+        let (ku, kv) = if s.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
+            let knots = if s.instance.complex {
+                s.part("B_SPLINE_SURFACE_WITH_KNOTS")?
+            } else {
+                *s
+            };
+            let k0 = if s.instance.complex { 0 } else { first + 7 };
+            (
+                expand_knots(&knots, k0, k0 + 2, "u", n_rows, p)?,
+                expand_knots(&knots, k0 + 1, k0 + 3, "v", n_cols, q)?,
+            )
+        } else {
+            let form = implied_form(s, &BSPLINE_SURFACES)?;
+            (
+                implied_knots(s, form, "u", n_rows, p)?,
+                implied_knots(s, form, "v", n_cols, q)?,
+            )
+        };
         let weights = if s.instance.has("RATIONAL_B_SPLINE_SURFACE") {
             let r = s.part("RATIONAL_B_SPLINE_SURFACE")?;
             let w = r.list(0, "weights_data")?;
@@ -147,7 +157,7 @@ impl<'a> Geometry<'a> {
     /// `SURFACE_CURVE`/`SEAM_CURVE`. `LINE`s are handled by the caller (an edge on a line is
     /// the segment between its vertices). `depth` bounds surface-curve chains.
     pub fn curve(&self, c: &Entity<'_>, depth: usize) -> Result<Nurbs, StepError> {
-        if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
+        if is_bspline(c.instance, &BSPLINE_CURVES) {
             return self.bspline_curve(c);
         }
         match c.name() {
@@ -178,15 +188,20 @@ impl<'a> Geometry<'a> {
         } else {
             (*c, 1)
         };
-        let knots = if c.instance.complex {
-            c.part("B_SPLINE_CURVE_WITH_KNOTS")?
-        } else {
-            *c
-        };
-        let k0 = if c.instance.complex { 0 } else { first + 5 };
         let p = base.count(first, "degree")?;
         let ids = base.refs(first + 1, "control_points_list")?;
-        let kv = expand_knots(&knots, k0, k0 + 1, "", ids.len(), p)?;
+        let kv = if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
+            let knots = if c.instance.complex {
+                c.part("B_SPLINE_CURVE_WITH_KNOTS")?
+            } else {
+                *c
+            };
+            let k0 = if c.instance.complex { 0 } else { first + 5 };
+            expand_knots(&knots, k0, k0 + 1, "", ids.len(), p)?
+        } else {
+            let form = implied_form(c, &BSPLINE_CURVES)?;
+            implied_knots(c, form, "", ids.len(), p)?
+        };
         let weights = if c.instance.has("RATIONAL_B_SPLINE_CURVE") {
             let r = c.part("RATIONAL_B_SPLINE_CURVE")?;
             let w = r.reals(0, "weights_data")?;
@@ -207,6 +222,101 @@ impl<'a> Geometry<'a> {
             .collect::<Result<Vec<_>, _>>()?;
         Nurbs::new(p, &points, &weights, kv).map_err(|e| c.invalid(e.to_string()))
     }
+}
+
+/// B-spline surface forms: explicit knots, or knots implied by the subtype (ISO 10303-42
+/// `uniform_surface`, `quasi_uniform_surface`, `bezier_surface`).
+pub(crate) const BSPLINE_SURFACES: [&str; 4] = [
+    "B_SPLINE_SURFACE_WITH_KNOTS",
+    "UNIFORM_SURFACE",
+    "QUASI_UNIFORM_SURFACE",
+    "BEZIER_SURFACE",
+];
+/// The same for curves.
+pub(crate) const BSPLINE_CURVES: [&str; 4] = [
+    "B_SPLINE_CURVE_WITH_KNOTS",
+    "UNIFORM_CURVE",
+    "QUASI_UNIFORM_CURVE",
+    "BEZIER_CURVE",
+];
+
+/// Whether the instance is one of the B-spline `forms` (as itself or a partial record).
+pub(crate) fn is_bspline(instance: &Instance, forms: &[&str; 4]) -> bool {
+    forms.iter().any(|f| instance.has(f))
+}
+
+#[derive(Clone, Copy)]
+enum Implied {
+    Uniform,
+    QuasiUniform,
+    Bezier,
+}
+
+fn implied_form(e: &Entity<'_>, forms: &[&str; 4]) -> Result<Implied, StepError> {
+    let has = |name: &str| e.instance.has(name);
+    Ok(if has(forms[1]) {
+        Implied::Uniform
+    } else if has(forms[2]) {
+        Implied::QuasiUniform
+    } else if has(forms[3]) {
+        Implied::Bezier
+    } else {
+        return Err(e.invalid("a B-spline needs knots or a uniform, quasi-uniform or Bézier form"));
+    })
+}
+
+/// The knots ISO 10303-42 implies for `points` control points of `degree`: uniform
+/// `−degree, …, points`; quasi-uniform `0` and `points − degree` repeated `degree + 1` times
+/// around `1, 2, …`; Bézier `0, 1, …, k` (k = (points − 1)/degree pieces), the ends repeated
+/// `degree + 1` times and the inner ones `degree` times.
+fn implied_knots(
+    e: &Entity<'_>,
+    form: Implied,
+    dir: &str,
+    points: usize,
+    degree: usize,
+) -> Result<Vec<f64>, StepError> {
+    let d = if dir.is_empty() {
+        String::new()
+    } else {
+        format!("{dir} ")
+    };
+    if degree == 0 || degree > MAX_DEGREE {
+        return Err(e.invalid(format!(
+            "{d}degree is {degree}; tezgah reads degrees 1 to {MAX_DEGREE}"
+        )));
+    }
+    if points < degree + 1 {
+        return Err(e.invalid(format!(
+            "{d}direction has {points} control points, degree {degree} needs {}",
+            degree + 1
+        )));
+    }
+    let (n, p) = (points, degree);
+    Ok(match form {
+        Implied::Uniform => (0..n + p + 1).map(|i| i as f64 - p as f64).collect(),
+        Implied::QuasiUniform => {
+            let last = (n - p) as f64;
+            let mut k = vec![0.0; p + 1];
+            k.extend((1..n - p).map(|i| i as f64));
+            k.extend(std::iter::repeat_n(last, p + 1));
+            k
+        }
+        Implied::Bezier => {
+            if (n - 1) % p != 0 {
+                return Err(e.invalid(format!(
+                    "a Bézier {d}direction of degree {p} needs degree·k + 1 control points, not {n}"
+                )));
+            }
+            let pieces = (n - 1) / p;
+            let mut k = vec![0.0; p + 1];
+            for i in 1..pieces {
+                k.extend(std::iter::repeat_n(i as f64, p));
+            }
+            k.extend(std::iter::repeat_n(pieces as f64, p + 1));
+            k
+        }
+    })
 }
 
 /// The full knot vector from distinct knots and their multiplicities (ISO 10303-42

@@ -115,7 +115,7 @@ impl StepFile {
     /// The B-spline surface `#id` (plain or rational), in mm.
     pub fn surface(&self, id: u64) -> Result<NurbsSurface, StepError> {
         let e = self.ex.entity(id).ok_or(StepError::Missing { id })?;
-        if !e.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
+        if !geometry::is_bspline(e.instance, &geometry::BSPLINE_SURFACES) {
             return Err(StepError::Unsupported {
                 at: e.at(),
                 role: "a B-spline surface".to_string(),

@@ -16,7 +16,7 @@ use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
 use super::conic::{radii, Frame};
 use super::entity::{Entity, Resolve};
 use super::exchange::Param;
-use super::geometry::Geometry;
+use super::geometry::{is_bspline, Geometry, BSPLINE_CURVES};
 use super::model::{BoundEdge, PCurve};
 
 /// How far (mm) the pcurve mapped through the surface may be from the 3-D edge.
@@ -127,7 +127,7 @@ fn curve_2d(
             .ok()?;
         return Trimmed::new(arc, 0.0, 1.0).ok();
     }
-    if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
+    if is_bspline(c.instance, &BSPLINE_CURVES) {
         let flat = Geometry {
             ex: g.ex,
             mm: scale,

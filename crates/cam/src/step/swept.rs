@@ -11,7 +11,7 @@ use tezgah_geom::{Nurbs, NurbsSurface, Vec3};
 use super::conic::{radii, Frame};
 use super::entity::{Entity, Resolve};
 use super::error::StepError;
-use super::geometry::Geometry;
+use super::geometry::{is_bspline, Geometry, BSPLINE_CURVES};
 use super::model::{Bound, BoundKind};
 use super::revolved::{arc_extent, EXTENT_SAMPLES_PER_EDGE};
 
@@ -50,7 +50,7 @@ fn swept_curve(g: &Geometry<'_>, c: &Entity<'_>, s: &Entity<'_>) -> Result<Nurbs
         };
         return frame.arc(0.0, TAU).map_err(|e| c.invalid(e.to_string()));
     }
-    if c.instance.has("B_SPLINE_CURVE_WITH_KNOTS") {
+    if is_bspline(c.instance, &BSPLINE_CURVES) {
         return g.curve(c, 0);
     }
     Err(StepError::Unsupported {

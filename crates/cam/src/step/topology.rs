@@ -11,7 +11,7 @@ use tezgah_geom::{Curve, Nurbs, NurbsSurface, Trimmed, Vec3};
 use super::conic;
 use super::entity::{Entity, Resolve};
 use super::error::StepError;
-use super::geometry::Geometry;
+use super::geometry::{is_bspline, Geometry, BSPLINE_SURFACES};
 use super::model::{Bound, BoundEdge, BoundKind, Face};
 use super::pcurve::{self, EdgeRange};
 use super::revolved;
@@ -157,7 +157,7 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
     }
     let s = g.ex.get(f.reference(2, "face_geometry")?, f)?;
     // (surface, mm per unit of the pcurves' coordinates: a plane's parameters are lengths)
-    let (surface, pcurve_scale) = if s.instance.has("B_SPLINE_SURFACE_WITH_KNOTS") {
+    let (surface, pcurve_scale) = if is_bspline(s.instance, &BSPLINE_SURFACES) {
         (g.bspline_surface(&s)?, 1.0)
     } else if s.name() == "PLANE" && !s.instance.complex {
         (plane(g, &s, &bounds)?, g.mm)
