@@ -1,6 +1,6 @@
-//! Geometry entities (ISO 10303-42) to `tezgah-geom` types: `CARTESIAN_POINT`,
-//! `B_SPLINE_SURFACE_WITH_KNOTS` and the rational complex instance → [`NurbsSurface`];
-//! `B_SPLINE_CURVE_WITH_KNOTS` (plain or rational), `LINE`, `SURFACE_CURVE`/`SEAM_CURVE` →
+//! Geometry entities (ISO 10303-42) to `tezgah-geom` types: `CARTESIAN_POINT`; B-spline
+//! surfaces (with knots or an implied-knot form, plain or the rational complex instance) →
+//! [`NurbsSurface`]; B-spline curves the same way and `SURFACE_CURVE`/`SEAM_CURVE` wrappers →
 //! [`Nurbs`] edge curves. Coordinates are scaled to mm here; knots are parameters and kept.
 
 use tezgah_geom::basis::MAX_DEGREE;

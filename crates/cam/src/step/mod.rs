@@ -2,7 +2,9 @@
 //! reading the free-form faces to machine as `tezgah-geom` NURBS surfaces in mm.
 //!
 //! `lexer` → `exchange` (schema-free instances by `#id`) → `entity` (typed attribute access
-//! with errors naming `#id`, type and line) → `units`, `geometry`, `topology` → `model`.
+//! with errors naming `#id`, type and line) → `units`, `geometry` (+ `conic`) → `topology`
+//! (faces, loops, edges; surfaces by kind: B-spline, plane, `revolved`, `swept`) → `pcurve`
+//! (trimming curves in (u, v)) → `model`.
 
 mod conic;
 mod entity;
