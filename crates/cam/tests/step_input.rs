@@ -699,3 +699,53 @@ fn implied_knots_equal_the_explicit_ones() {
         "#1 BEZIER_CURVE (line 8): a Bézier direction of degree 3 needs degree·k + 1 control points, not 6"
     );
 }
+
+#[test]
+fn attribute_errors_name_the_attribute() {
+    let two_d = file(SURFACE).replace(
+        "#12 = CARTESIAN_POINT('',(10.,0.,0.));",
+        "#12 = CARTESIAN_POINT('',(10.,0.));",
+    );
+    assert_eq!(
+        step::read(&two_d).unwrap_err().to_string(),
+        "#12 CARTESIAN_POINT (line 15): has 2 coordinates, a 3-D point needs 3"
+    );
+    let text_degree = file(SURFACE).replace(
+        "B_SPLINE_SURFACE_WITH_KNOTS('',1,1,",
+        "B_SPLINE_SURFACE_WITH_KNOTS('',1,'one',",
+    );
+    assert_eq!(
+        step::read(&text_degree).unwrap_err().to_string(),
+        "#4 B_SPLINE_SURFACE_WITH_KNOTS (line 11): v_degree (attribute 3) must be an integer"
+    );
+    let unknown_sense = file(SURFACE).replace(
+        "#3 = ADVANCED_FACE('',(),#4,.T.);",
+        "#3 = ADVANCED_FACE('',(),#4,.U.);",
+    );
+    assert_eq!(
+        step::read(&unknown_sense).unwrap_err().to_string(),
+        "#3 ADVANCED_FACE (line 10): same_sense (attribute 4) must be .T. or .F."
+    );
+    let not_a_point = file(SURFACE).replace("((#10,#11),(#12,#13))", "((#10,#11),(#12,#3))");
+    assert_eq!(
+        step::read(&not_a_point).unwrap_err().to_string(),
+        "#3 ADVANCED_FACE (line 10): unsupported entity, met as a point of #4 B_SPLINE_SURFACE_WITH_KNOTS (line 11)"
+    );
+    let rational = file(&SURFACE.replace(
+        "#4 = B_SPLINE_SURFACE_WITH_KNOTS('',1,1,((#10,#11),(#12,#13)),.UNSPECIFIED.,.F.,.F.,.F.,\n  (2,2),(2,2),(0.,1.),(0.,2.),.UNSPECIFIED.);",
+        "#4 = ( BOUNDED_SURFACE() B_SPLINE_SURFACE(1,1,((#10,#11),(#12,#13)),.UNSPECIFIED.,.F.,.F.,.F.)
+  B_SPLINE_SURFACE_WITH_KNOTS((2,2),(2,2),(0.,1.),(0.,2.),.UNSPECIFIED.) GEOMETRIC_REPRESENTATION_ITEM()
+  RATIONAL_B_SPLINE_SURFACE(((1.,2.),(1.,0.))) REPRESENTATION_ITEM('') SURFACE() );",
+    ));
+    assert_eq!(
+        step::read(&rational).unwrap_err().to_string(),
+        "#4 BOUNDED_SURFACE+B_SPLINE_SURFACE+B_SPLINE_SURFACE_WITH_KNOTS+GEOMETRIC_REPRESENTATION_ITEM+RATIONAL_B_SPLINE_SURFACE+REPRESENTATION_ITEM+SURFACE (line 11): weight 3 is 0; weights must be finite and > 0"
+    );
+    // With valid weights the complex instance reads, and weights pull the surface: the
+    // corner (0, 10, 0) weighs 2.
+    let weighted = rational.replace("(((1.,2.),(1.,0.)))", "(((1.,2.),(1.,1.)))");
+    let m = step::read(&weighted).unwrap();
+    let p = m.faces[0].surface.point(0.5, 1.0);
+    // Bilinear basis ¼ each: (Σ w·P)/(Σ w) = ((0,0,0) + 2(0,10,0) + (10,0,0) + (10,10,3))/5.
+    assert!((p - Vec3::new(4.0, 6.0, 0.6)).norm() < 1e-12, "{p:?}");
+}
