@@ -490,3 +490,23 @@ fn swept_surfaces_become_exact_nurbs() {
         "{turn}"
     );
 }
+
+/// A full-turn face without pcurves starts its domain at its seam: with the cylinder's angle
+/// origin turned a quarter away from its seam (x → y), the side is still its whole surface and
+/// the surface still holds OCCT's samples.
+#[test]
+fn full_turn_starts_at_the_seam() {
+    let text = std::fs::read_to_string(fixture("analytic_solids_no_pcurves.stp")).unwrap();
+    let turned = text.replace(
+        "#79 = DIRECTION('',(1.,0.,0.));",
+        "#79 = DIRECTION('',(0.,1.,0.));",
+    );
+    assert_ne!(turned, text);
+    let m = step::read(&turned).unwrap();
+    let side = &m.faces[0];
+    assert!(side.is_untrimmed(1e-7));
+    let (u0, _) = side.surface.domain_u();
+    let (v0, _) = side.surface.domain_v();
+    // The seam is the line x = 20, y = 0.
+    assert!((side.surface.point(u0, v0) - tezgah_geom::Vec3::new(20.0, 0.0, 0.0)).norm() < 1e-9);
+}

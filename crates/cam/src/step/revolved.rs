@@ -232,7 +232,12 @@ fn loop_extent(
         .filter(|(a, b, _)| a.hypot(*b) > 1e-9)
         .map(|(a, b, _)| b.atan2(*a))
         .collect();
-    let (u0, u1) = arc_extent(&around)?;
+    let axial = |p: &Vec3| {
+        let d = p - f.centre;
+        let (a, b) = (d.dot(&f.x), d.dot(&f.y));
+        (a.hypot(b) > 1e-9).then(|| b.atan2(a))
+    };
+    let (u0, u1) = arc_extent(&around, seam_angle(bounds, axial))?;
     let (v0, v1) = match *profile {
         Profile::Line { .. } => {
             let h = local.iter().map(|l| l.2);
@@ -253,15 +258,21 @@ fn loop_extent(
                 .iter()
                 .map(|(a, b, c)| c.atan2(a.hypot(*b) - rho0))
                 .collect();
-            arc_extent(&tube)?
+            let tube_angle = |p: &Vec3| {
+                let d = p - f.centre;
+                let (a, b, c) = (d.dot(&f.x), d.dot(&f.y), d.dot(&f.z));
+                Some(c.atan2(a.hypot(b) - rho0))
+            };
+            arc_extent(&tube, seam_angle(bounds, tube_angle))?
         }
     };
     Some((u0, u1, v0, v1))
 }
 
 /// The smallest arc `[a, b]` (b − a ≤ 2π) of the circle holding all `angles`: the circle minus
-/// the largest gap between neighbours, or the full turn when no gap reaches `FULL_TURN_GAP`.
-pub(crate) fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
+/// the largest gap between neighbours, or the full turn — from `seam` when the face has one —
+/// when no gap reaches `FULL_TURN_GAP`.
+pub(crate) fn arc_extent(angles: &[f64], seam: Option<f64>) -> Option<(f64, f64)> {
     let mut a: Vec<f64> = angles
         .iter()
         .map(|t| t.rem_euclid(TAU))
@@ -277,7 +288,9 @@ pub(crate) fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
         }
     }
     if best.0 < FULL_TURN_GAP {
-        return Some((0.0, TAU));
+        // A full turn starts at the face's seam, so the loops lie on the domain's boundary.
+        let start = seam.unwrap_or(0.0);
+        return Some((start, start + TAU));
     }
     // The face runs from the gap's end round to its start.
     let start = best.2.rem_euclid(TAU);
@@ -286,4 +299,28 @@ pub(crate) fn arc_extent(angles: &[f64]) -> Option<(f64, f64)> {
         end += TAU;
     }
     Some((start, end))
+}
+
+/// The angle (by `angle_of`) of a seam of the face: an edge its loops use twice, along which
+/// that angle is constant (sampled at its ends and middle).
+fn seam_angle(bounds: &[Bound], angle_of: impl Fn(&Vec3) -> Option<f64>) -> Option<f64> {
+    let edges: Vec<_> = bounds
+        .iter()
+        .filter_map(|b| match &b.kind {
+            BoundKind::Edges(e) => Some(e.iter()),
+            BoundKind::Vertex(_) => None,
+        })
+        .flatten()
+        .collect();
+    edges.iter().enumerate().find_map(|(i, e)| {
+        if !edges[i + 1..].iter().any(|o| o.edge == e.edge) {
+            return None;
+        }
+        let pts = e.polyline(2);
+        let a: Vec<f64> = pts.iter().map(&angle_of).collect::<Option<_>>()?;
+        let same = |x: f64, y: f64| {
+            ((x - y + std::f64::consts::PI).rem_euclid(TAU) - std::f64::consts::PI).abs() < 1e-9
+        };
+        (same(a[0], a[1]) && same(a[1], a[2])).then(|| a[1].rem_euclid(TAU))
+    })
 }

@@ -177,7 +177,7 @@ fn revolution(
         .filter(|r| r.norm() > 1e-9)
         .map(|r| r.dot(&f0).atan2(r.dot(&e0)))
         .collect();
-    let Some((u0, u1)) = arc_extent(&angles) else {
+    let Some((u0, u1)) = arc_extent(&angles, None) else {
         return Ok(None);
     };
     let arc = Frame {
