@@ -254,8 +254,9 @@ fn plate_with_holes_matches_occt() {
     assert!((tezgah_geom::Curve::length(&circle.curve) - 20.0 * std::f64::consts::PI).abs() < 1e-9);
 }
 
-/// Every edge of the OCCT fixtures carries its pcurve, and the pcurve mapped through the face's
-/// surface runs on the 3-D edge (sampled at 33 points per edge).
+/// Every edge of the OCCT fixtures carries its pcurve (one writer inconsistency aside), and
+/// the pcurve mapped through the face's surface runs on the 3-D edge (33 points per edge) —
+/// also on analytic and swept faces, whose iso-parametric pcurves are mapped to the NURBS.
 #[test]
 fn pcurves_lie_on_their_edges() {
     for name in [
@@ -264,20 +265,23 @@ fn pcurves_lie_on_their_edges() {
         "twisted_blade",
         "plate_with_holes",
         "nurbs_cylinder",
+        "analytic_solids",
+        "swept_surfaces",
     ] {
         let m = step::read_file(fixture(&format!("{name}.stp"))).unwrap();
         let mut worst = 0.0f64;
         let mut count = 0;
+        let mut missing = Vec::new();
         for f in &m.faces {
             for b in &f.bounds {
                 let BoundKind::Edges(edges) = &b.kind else {
                     continue;
                 };
                 for e in edges {
-                    let pc = e
-                        .pcurve
-                        .as_ref()
-                        .unwrap_or_else(|| panic!("{name}: edge {} has no pcurve", e.id));
+                    let Some(pc) = e.pcurve.as_ref() else {
+                        missing.push(e.id);
+                        continue;
+                    };
                     assert_eq!(pc.forward, e.forward);
                     let uv = pc.polyline(32);
                     let xyz = e.polyline(32);
@@ -298,6 +302,14 @@ fn pcurves_lie_on_their_edges() {
         }
         println!("{name}: {count} pcurves, worst distance to the 3-D edge {worst:e} mm");
         assert!(worst < 1e-6, "{name}: {worst}");
+        // OCCT writes the cone's seam pcurves (both uses of edge #202) with its own slant-length
+        // parameter against the 3-D line's: they fail the check and are dropped, as they must.
+        let expected: &[u64] = if name == "analytic_solids" {
+            &[201, 251]
+        } else {
+            &[]
+        };
+        assert_eq!(missing, expected, "{name}: edges without pcurves");
     }
 }
 
@@ -317,9 +329,27 @@ fn area(poly: &[step::Uv]) -> f64 {
 fn uv_polygons_enclose_the_faces() {
     // Whole faces: the loop is the domain's boundary, so its polygon has the domain's area —
     // on the cylinder only if each use of the seam takes its own pcurve (u = 0 or u = 2π).
-    for name in ["freeform_patch", "twisted_blade", "nurbs_cylinder"] {
+    for name in [
+        "freeform_patch",
+        "twisted_blade",
+        "nurbs_cylinder",
+        "analytic_solids",
+        "swept_surfaces",
+    ] {
         let m = step::read_file(fixture(&format!("{name}.stp"))).unwrap();
-        for f in m.faces.iter().filter(|f| f.is_untrimmed(1e-7)) {
+        // (The analytic cone, face 3, lost its seam's pcurves, see `pcurves_lie_on_their_edges`;
+        // the sphere, face 6, is bounded by vertex loops only.)
+        let skip: &[usize] = if name == "analytic_solids" {
+            &[3, 6]
+        } else {
+            &[]
+        };
+        let whole = m
+            .faces
+            .iter()
+            .enumerate()
+            .filter(|(k, f)| f.is_untrimmed(1e-7) && !skip.contains(k));
+        for (_, f) in whole {
             let (u0, u1) = f.surface.domain_u();
             let (v0, v1) = f.surface.domain_v();
             let want = (u1 - u0) * (v1 - v0);

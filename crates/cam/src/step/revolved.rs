@@ -18,7 +18,7 @@ use super::entity::Entity;
 use super::error::StepError;
 use super::geometry::Geometry;
 use super::model::{Bound, BoundKind};
-use super::pcurve::{self, EdgeRange};
+use super::pcurve::{self, Axis, EdgeRange, ParamMap};
 
 /// The surface types read here.
 pub(crate) const REVOLVED: [&str; 4] = [
@@ -43,7 +43,7 @@ pub(crate) fn surface(
     s: &Entity<'_>,
     ranges: &[Option<EdgeRange>],
     bounds: &[Bound],
-) -> Result<NurbsSurface, StepError> {
+) -> Result<(NurbsSurface, ParamMap), StepError> {
     let (centre, x, y) = g.placement(s.reference(1, "position")?, s)?;
     let z = x.cross(&y);
     let length = |i: usize, what: &str| -> Result<f64, StepError> {
@@ -176,8 +176,24 @@ pub(crate) fn surface(
     }
     let degree_v = if rz.len() == 2 { 1 } else { 2 };
     let knots_u = sweep.knots().to_vec();
-    NurbsSurface::new(2, degree_v, &points, &weights, knots_u, knots_v)
-        .map_err(|e| s.invalid(e.to_string()))
+    let surface = NurbsSurface::new(2, degree_v, &points, &weights, knots_u, knots_v)
+        .map_err(|e| s.invalid(e.to_string()))?;
+    let map = ParamMap {
+        u: Axis::Arc {
+            start: u0,
+            sweep: u1 - u0,
+        },
+        v: match profile {
+            Profile::Line { .. } => Axis::Affine { from: v0, to: v1 },
+            Profile::Arc { .. } => Axis::Arc {
+                start: v0,
+                sweep: v1 - v0,
+            },
+        },
+        u_scale: g.angle,
+        v_scale,
+    };
+    Ok((surface, map))
 }
 
 /// The surface's frame: origin and axes (z the axis of revolution).

@@ -13,6 +13,7 @@ use super::entity::{Entity, Resolve};
 use super::error::StepError;
 use super::geometry::{is_bspline, Geometry, BSPLINE_CURVES};
 use super::model::{Bound, BoundKind};
+use super::pcurve::{Axis, ParamMap};
 use super::revolved::{arc_extent, EXTENT_SAMPLES_PER_EDGE};
 
 /// The swept surface types read here.
@@ -23,19 +24,49 @@ pub(crate) fn surface(
     g: &Geometry<'_>,
     s: &Entity<'_>,
     bounds: &[Bound],
-) -> Result<NurbsSurface, StepError> {
+) -> Result<(NurbsSurface, ParamMap), StepError> {
     let c = g.basis_curve(g.ex.get(s.reference(1, "swept_curve")?, s)?)?;
     let profile = swept_curve(g, &c, s)?;
     let pts = loop_points(bounds);
     if pts.is_empty() {
         return Err(s.invalid("a face on a swept surface needs edge loops for its extent"));
     }
-    let surface = if s.name() == "SURFACE_OF_LINEAR_EXTRUSION" {
-        extrusion(g, s, &profile, &pts)?
+    let no_area = || s.invalid("the face's bounds do not span an area on it");
+    // The swept curve's parameter: a B-spline's own; a conic's angle, which its NURBS maps.
+    let conic = matches!(c.name(), "CIRCLE" | "ELLIPSE") && !c.instance.complex;
+    let (curve_axis, curve_scale) = if conic {
+        (
+            Axis::Arc {
+                start: 0.0,
+                sweep: TAU,
+            },
+            g.angle,
+        )
     } else {
-        revolution(g, s, &profile, &pts)?
+        (Axis::Identity, 1.0)
     };
-    surface.ok_or_else(|| s.invalid("the face's bounds do not span an area on it"))
+    if s.name() == "SURFACE_OF_LINEAR_EXTRUSION" {
+        let surface = extrusion(g, s, &profile, &pts)?.ok_or_else(no_area)?;
+        let map = ParamMap {
+            u: curve_axis,
+            v: Axis::Identity,
+            u_scale: curve_scale,
+            v_scale: 1.0,
+        };
+        Ok((surface, map))
+    } else {
+        let (surface, u0, u1) = revolution(g, s, &profile, &pts)?.ok_or_else(no_area)?;
+        let map = ParamMap {
+            u: Axis::Arc {
+                start: u0,
+                sweep: u1 - u0,
+            },
+            v: curve_axis,
+            u_scale: g.angle,
+            v_scale: curve_scale,
+        };
+        Ok((surface, map))
+    }
 }
 
 /// The swept curve as a NURBS: a B-spline as written, a circle or ellipse as the whole conic.
@@ -132,7 +163,7 @@ fn revolution(
     s: &Entity<'_>,
     curve: &Nurbs,
     pts: &[Vec3],
-) -> Result<Option<NurbsSurface>, StepError> {
+) -> Result<Option<(NurbsSurface, f64, f64)>, StepError> {
     let a = g.ex.get(s.reference(2, "axis_position")?, s)?;
     if a.name() != "AXIS1_PLACEMENT" {
         return Err(StepError::Unsupported {
@@ -209,7 +240,7 @@ fn revolution(
         arc.knots().to_vec(),
         curve.knots().to_vec(),
     )
-    .map(Some)
+    .map(|surface| Some((surface, u0, u1)))
     .map_err(|e| s.invalid(e.to_string()))
 }
 

@@ -13,7 +13,7 @@ use super::entity::{Entity, Resolve};
 use super::error::StepError;
 use super::geometry::{is_bspline, Geometry, BSPLINE_SURFACES};
 use super::model::{Bound, BoundEdge, BoundKind, Face};
-use super::pcurve::{self, EdgeRange};
+use super::pcurve::{self, EdgeRange, ParamMap};
 use super::revolved;
 use super::swept;
 
@@ -156,29 +156,36 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
         bounds.push(read_bound(g, &b, &mut ranges)?);
     }
     let s = g.ex.get(f.reference(2, "face_geometry")?, f)?;
-    // (surface, mm per unit of the pcurves' coordinates: a plane's parameters are lengths)
-    let (surface, pcurve_scale) = if is_bspline(s.instance, &BSPLINE_SURFACES) {
-        (g.bspline_surface(&s)?, 1.0)
+    // The surface, and how the pcurves' coordinates become its parameters (a plane's are
+    // lengths: the unit's scale; revolved and swept surfaces: a map).
+    let (surface, map) = if is_bspline(s.instance, &BSPLINE_SURFACES) {
+        (g.bspline_surface(&s)?, ParamMap::scale(1.0))
     } else if s.name() == "PLANE" && !s.instance.complex {
-        (plane(g, &s, &bounds)?, g.mm)
+        (plane(g, &s, &bounds)?, ParamMap::scale(g.mm))
     } else if revolved::REVOLVED.contains(&s.name()) && !s.instance.complex {
-        (revolved::surface(g, &s, &ranges, &bounds)?, 1.0)
+        revolved::surface(g, &s, &ranges, &bounds)?
     } else if swept::SWEPT.contains(&s.name()) && !s.instance.complex {
-        (swept::surface(g, &s, &bounds)?, 1.0)
+        swept::surface(g, &s, &bounds)?
     } else {
         return Err(StepError::Unsupported {
             at: s.at(),
             role: format!("the surface of {}", f.at()),
         });
     };
-    let edges = bounds.iter_mut().flat_map(|b| match &mut b.kind {
-        BoundKind::Edges(edges) => edges.as_mut_slice(),
-        BoundKind::Vertex(_) => &mut [],
-    });
-    for (edge, range) in edges.zip(&ranges) {
-        if let Some(range) = range {
-            pcurve::attach(g, s.id, pcurve_scale, &surface, edge, range);
-        }
+    // The pcurves, loop by loop (`ranges` holds one entry per edge, in loop order).
+    let mut ranges = ranges.iter();
+    for b in &mut bounds {
+        let BoundKind::Edges(edges) = &mut b.kind else {
+            continue;
+        };
+        let candidates = edges
+            .iter()
+            .map(|_| match ranges.next() {
+                Some(Some(range)) => pcurve::candidates(g, s.id, &map, range),
+                _ => Vec::new(),
+            })
+            .collect();
+        pcurve::attach_loop(&surface, edges, candidates);
     }
     Ok(Face {
         id: f.id,
@@ -291,13 +298,7 @@ fn read_edge(
     };
     let curve = curve.map_err(|err| e.invalid(err.to_string()))?;
     let forward = orientation == same_sense;
-    let range = (lo < hi).then_some(EdgeRange {
-        geometry,
-        lo,
-        hi,
-        forward,
-        orientation,
-    });
+    let range = (lo < hi).then_some(EdgeRange { geometry, lo, hi });
     let edge = BoundEdge {
         id: oe.id,
         edge: e.id,
