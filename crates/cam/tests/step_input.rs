@@ -183,9 +183,14 @@ fn plane_face_bounded_by_lines() {
         assert_eq!(e.end(), corners[(k + 1) % 4]);
     }
     assert!(!edges[3].forward);
-    // Plain LINE edges, no surface curves: no pcurves, so no (u, v) polygon.
-    assert!(edges.iter().all(|e| e.pcurve.is_none()));
-    assert_eq!(b.uv_polygon(4), None);
+    // Plain LINE edges, no pcurves in the file: on a plane they are projected, exactly. The
+    // plane's parameters here are x and y (origin (0, 0, 5), x axis along x).
+    let uv = b.uv_polygon(1).unwrap();
+    let corners: Vec<(f64, f64)> = uv.iter().map(|p| (p.u, p.v)).collect();
+    assert_eq!(
+        corners,
+        [(1.0, 2.0), (21.0, 2.0), (21.0, 12.0), (1.0, 12.0)]
+    );
     assert_eq!(edges[3].polyline(2)[1], Vec3::new(1.0, 7.0, 5.0));
 }
 

@@ -479,6 +479,26 @@ fn filleted_block_without_pcurves() {
     let m = check_geometric("filleted_block");
     let trimmed = m.faces.iter().filter(|f| !f.is_untrimmed(1e-7)).count();
     assert_eq!((m.faces.len(), trimmed), (11, 2));
+    // The top and bottom get their (u, v) loops by projection (the file has no pcurves): the
+    // rounded rectangle 60 × 40 less four corners of r 6, and the hole of r 8, each edge
+    // inscribed by 64 pieces (the full-circle hole keeps ≈ 0.9984 of its area).
+    let pi = std::f64::consts::PI;
+    let rounded = 60.0 * 40.0 - 4.0 * (36.0 - pi * 36.0 / 4.0);
+    let trimmed: Vec<_> = m.faces.iter().filter(|f| !f.is_untrimmed(1e-7)).collect();
+    for f in trimmed {
+        let areas: Vec<f64> = f
+            .bounds
+            .iter()
+            .map(|b| area(&b.uv_polygon(64).unwrap()).abs())
+            .collect();
+        let (outer, hole) = if areas[0] > areas[1] {
+            (areas[0], areas[1])
+        } else {
+            (areas[1], areas[0])
+        };
+        assert!((outer / rounded - 1.0).abs() < 1e-3, "{areas:?}");
+        assert!((hole / (pi * 64.0) - 1.0).abs() < 2e-3, "{areas:?}");
+    }
     for f in m.faces.iter().filter(|f| f.surface.degrees() == (2, 1)) {
         // Cylinders (degree 2 round, 1 along): rulings parallel to the vertical axis.
         let n = f

@@ -118,6 +118,32 @@ pub(crate) fn candidates(
         .collect()
 }
 
+/// The edge's piece in the parameters of the plane `origin + u·x + v·y` (x, y orthonormal):
+/// the projection is affine, so mapping the control points gives the exact 2-D NURBS.
+pub(crate) fn project_to_plane(
+    curve: &Trimmed<Nurbs>,
+    (origin, x, y): &(Vec3, Vec3, Vec3),
+) -> Option<Trimmed<Nurbs>> {
+    let inner = curve.inner();
+    let points: Vec<Vec3> = inner
+        .control_points()
+        .into_iter()
+        .map(|p| {
+            let d = p - origin;
+            Vec3::new(d.dot(x), d.dot(y), 0.0)
+        })
+        .collect();
+    let flat = Nurbs::new(
+        inner.degree(),
+        &points,
+        &inner.weights(),
+        inner.knots().to_vec(),
+    )
+    .ok()?;
+    let (a, b) = curve.domain();
+    Trimmed::new(flat, a, b).ok()
+}
+
 fn remap(pc: &Trimmed<Nurbs>, m: &ParamMap) -> Option<Trimmed<Nurbs>> {
     let at = |p: Vec3| Vec3::new(m.u.map(p.x * m.u_scale), m.v.map(p.y * m.v_scale), 0.0);
     let affine = |a: &Axis| !matches!(a, Axis::Arc { .. });

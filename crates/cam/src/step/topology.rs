@@ -156,12 +156,15 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
         bounds.push(read_bound(g, &b, &mut ranges)?);
     }
     let s = g.ex.get(f.reference(2, "face_geometry")?, f)?;
+    let mut plane_frame = None;
     // The surface, and how the pcurves' coordinates become its parameters (a plane's are
     // lengths: the unit's scale; revolved and swept surfaces: a map).
     let (surface, map) = if is_bspline(s.instance, &BSPLINE_SURFACES) {
         (g.bspline_surface(&s)?, ParamMap::scale(1.0))
     } else if s.name() == "PLANE" && !s.instance.complex {
-        (plane(g, &s, &bounds)?, ParamMap::scale(g.mm))
+        let surface = plane(g, &s, &bounds)?;
+        plane_frame = Some(g.placement(s.reference(1, "position")?, &s)?);
+        (surface, ParamMap::scale(g.mm))
     } else if revolved::REVOLVED.contains(&s.name()) && !s.instance.complex {
         revolved::surface(g, &s, &ranges, &bounds)?
     } else if swept::SWEPT.contains(&s.name()) && !s.instance.complex {
@@ -180,9 +183,19 @@ fn read_face(g: &Geometry<'_>, f: &Entity<'_>, sense: bool) -> Result<Face, Step
         };
         let candidates = edges
             .iter()
-            .map(|_| match ranges.next() {
-                Some(Some(range)) => pcurve::candidates(g, s.id, &map, range),
-                _ => Vec::new(),
+            .map(|e| {
+                let from_file = match ranges.next() {
+                    Some(Some(range)) => pcurve::candidates(g, s.id, &map, range),
+                    _ => Vec::new(),
+                };
+                // A plane is an affine image of its parameters, so an edge without a pcurve
+                // gets an exact one by projection (writers such as Parasolid give none).
+                match (&plane_frame, from_file.is_empty()) {
+                    (Some(frame), true) => pcurve::project_to_plane(&e.curve, frame)
+                        .into_iter()
+                        .collect(),
+                    _ => from_file,
+                }
             })
             .collect();
         pcurve::attach_loop(&surface, edges, candidates);
