@@ -499,6 +499,20 @@ fn filleted_block_without_pcurves() {
         assert!((outer / rounded - 1.0).abs() < 1e-3, "{areas:?}");
         assert!((hole / (pi * 64.0) - 1.0).abs() < 2e-3, "{areas:?}");
     }
+    // Every edge of a plane face got its projected pcurve, lying on the 3-D edge.
+    for f in m.faces.iter().filter(|f| f.surface.degrees() == (1, 1)) {
+        for b in &f.bounds {
+            let BoundKind::Edges(edges) = &b.kind else {
+                panic!("edge loops")
+            };
+            for e in edges {
+                let pc = e.pcurve.as_ref().expect("a projected pcurve");
+                for (uv, p) in pc.polyline(16).iter().zip(e.polyline(16)) {
+                    assert!((f.surface.point(uv.u, uv.v) - p).norm() < 1e-9);
+                }
+            }
+        }
+    }
     for f in m.faces.iter().filter(|f| f.surface.degrees() == (2, 1)) {
         // Cylinders (degree 2 round, 1 along): rulings parallel to the vertical axis.
         let n = f
