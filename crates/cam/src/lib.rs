@@ -15,6 +15,7 @@ pub mod orientation;
 pub mod post;
 pub mod scallop;
 pub mod select;
+pub mod step;
 pub mod strategy;
 #[doc(hidden)]
 pub mod testing;

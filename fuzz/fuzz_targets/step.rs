@@ -1,0 +1,8 @@
+//! Arbitrary bytes through STEP input: the Part 21 parser, units, the face walk and every
+//! surface and curve mapper. Errors are expected; a panic, a hang or an out-of-memory is a bug.
+//! Seed corpus: `fuzz/corpus/step` (the OpenCascade fixtures of crates/cam/tests/fixtures).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| tezgah_cam::step::fuzz(data));
