@@ -7,8 +7,9 @@ use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions, Posted};
+use tezgah_cam::step::Face;
 use tezgah_cam::verify::{self, Verification, VerifyOptions};
-use tezgah_cam::{Cutter, CutterShape, ToolPath};
+use tezgah_cam::{Cutter, CutterShape, Settings, StrategyKind, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::Machine;
 
@@ -29,51 +30,100 @@ pub struct CamArgs {
     pub report: Option<PathBuf>,
     pub tool_table: Option<PathBuf>,
     pub tool_number: u32,
+    /// The STEP `#id` of the face to machine.
+    pub face: Option<u64>,
 }
 
 /// What the strategy is asked for.
-// The strategies read these once `plan_surface` is connected (TODO(lead) below).
-#[allow(dead_code)]
 pub struct PlanRequest<'a> {
     pub strategy: &'a str,
     pub scallop_mm: f64,
     pub tolerance_mm: f64,
     pub lead_deg: f64,
     pub tilt_deg: f64,
+    /// The STEP `#id` of the face to machine (needed when the file has several).
+    pub face: Option<u64>,
 }
 
-/// The surface of a STEP file and the tool path the strategy plans on it.
-///
-/// TODO(lead, at merge): connect STEP import (branch `step`) and the strategies (branch
-/// `strategy`) here. With the APIs on those branches today this is:
-///
-/// ```text
-/// let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
-/// let face = model.faces.first().ok_or_else(|| miette!("{}: no face", path.display()))?;
-/// let kind = request.strategy.parse::<tezgah_cam::StrategyKind>().map_err(|e| miette!("{e}"))?;
-/// let mut settings = tezgah_cam::Settings::new(kind, request.scallop_mm, request.tolerance_mm);
-/// if let tezgah_cam::ToolAxis::Surface { lead_deg, tilt_deg, .. } = &mut settings.axis {
-///     (*lead_deg, *tilt_deg) = (request.lead_deg, request.tilt_deg);
-/// }
-/// settings.reverse_normal = !face.same_sense;
-/// let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
-/// // plan.refused lists gouging points the strategy could not correct: print them.
-/// Ok((face.surface.clone(), plan.path))
-/// ```
-///
-/// Everything after this call (post, verification, files) is complete and tested end to end
-/// from tool paths built in the tests.
+/// How close a face's loops must run to its surface's domain boundary for the face to count
+/// as the whole surface, mm.
+const UNTRIMMED_TOLERANCE_MM: f64 = 1e-3;
+
+/// The face of a STEP file to machine: the one `--face` names, or the file's only face.
+fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -> Result<Face> {
+    let ids = || {
+        model
+            .faces
+            .iter()
+            .map(|f| format!("#{}", f.id))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let face = match id {
+        Some(id) => model
+            .faces
+            .iter()
+            .find(|f| f.id == id)
+            .cloned()
+            .ok_or_else(|| miette!("{}: no face #{id}; its faces are {}", path.display(), ids()))?,
+        None => match model.faces.as_slice() {
+            [one] => one.clone(),
+            [] => return Err(miette!("{}: the file has no face", path.display())),
+            _ => {
+                return Err(miette!(
+                    "{}: the file has {} faces ({}); choose one with --face ID",
+                    path.display(),
+                    model.faces.len(),
+                    ids()
+                ))
+            }
+        },
+    };
+    // The strategies cover a surface's whole domain: cutting a trimmed face that way would
+    // run outside its loops, into whatever lies there.
+    if !face.is_untrimmed(UNTRIMMED_TOLERANCE_MM) {
+        return Err(miette!(
+            "{}: face #{} is trimmed by its loops; the strategies machine whole surfaces \
+             (faces bounded by their surface's domain) only",
+            path.display(),
+            face.id
+        ));
+    }
+    Ok(face)
+}
+
+/// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
+/// points the strategy could not correct are left out of the path and listed here.
 fn plan_surface(
     path: &Path,
-    _cutter: Cutter,
+    cutter: Cutter,
     request: &PlanRequest<'_>,
 ) -> Result<(NurbsSurface, ToolPath)> {
-    Err(miette!(
-        "{}: STEP import and the '{}' strategy are not connected in this build yet \
-         (see plan_surface in crates/cli/src/cam.rs)",
-        path.display(),
-        request.strategy
-    ))
+    let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
+    let face = pick_face(path, model, request.face)?;
+    let kind = request
+        .strategy
+        .parse::<StrategyKind>()
+        .map_err(|e| miette!("{e}"))?;
+    let mut settings = Settings::new(kind, request.scallop_mm, request.tolerance_mm);
+    if let ToolAxis::Surface {
+        lead_deg, tilt_deg, ..
+    } = &mut settings.axis
+    {
+        (*lead_deg, *tilt_deg) = (request.lead_deg, request.tilt_deg);
+    }
+    // Cut the face's outside: the side its orientation says the material is not.
+    settings.reverse_normal = !face.same_sense;
+    let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
+    if !plan.refused.is_empty() {
+        eprintln!(
+            "warning: {} contact points would gouge and were left out (passes split there); \
+             {} were corrected",
+            plan.refused.len(),
+            plan.corrected
+        );
+    }
+    Ok((face.surface, plan.path))
 }
 
 fn positive(name: &str, v: f64) -> Result<f64> {
@@ -138,6 +188,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         tolerance_mm: 0.5 * tolerance,
         lead_deg: args.lead_deg,
         tilt_deg: args.tilt_deg,
+        face: args.face,
     };
     let (surface, path) = plan_surface(&args.surface, cutter, &request)?;
     let options = PostOptions {

@@ -139,6 +139,9 @@ enum Command {
         /// The tool number for T and H words.
         #[arg(long, default_value_t = 1)]
         tool_number: u32,
+        /// The STEP `#id` of the face to machine (needed when the file has several faces).
+        #[arg(long)]
+        face: Option<u64>,
     },
     /// List the built-in machine definitions.
     Machines,
@@ -197,6 +200,7 @@ fn main() -> ExitCode {
             report,
             tool_table,
             tool_number,
+            face,
         } => cam::cam(cam::CamArgs {
             surface,
             tool,
@@ -213,6 +217,7 @@ fn main() -> ExitCode {
             report,
             tool_table,
             tool_number,
+            face,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
     };
