@@ -127,6 +127,9 @@ impl std::fmt::Debug for Segment {
 }
 
 /// What the path stage emits, in program order.
+// Nearly every item is a segment, so boxing it would cost an allocation per segment to save
+// space only on the rare dwells and stops.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
 pub enum PathItem {
     Segment(Segment),
