@@ -128,6 +128,8 @@ impl std::fmt::Debug for Segment {
 
 /// What the path stage emits, in program order.
 #[derive(Debug)]
+// Almost every item is a segment: boxing it would allocate once per segment for nothing.
+#[allow(clippy::large_enum_variant)]
 pub enum PathItem {
     Segment(Segment),
     /// G4: stand still this long, seconds (the segment before ends with [`Junction::Stop`]).
