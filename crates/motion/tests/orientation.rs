@@ -69,7 +69,10 @@ fn the_machine_gives_the_closed_form_axis() {
     );
     // Y-Z-C-A: C follows the tip, the axis is not the angles' alone.
     let yzca = PlanMachine::from_machine(&Machine::builtin("yzca").unwrap()).unwrap();
-    assert_eq!(yzca.axis(TCP, &Vec3::new(50.0, 0.0, 0.0), &[10.0, 0.0, 0.0]), None);
+    assert_eq!(
+        yzca.axis(TCP, &Vec3::new(50.0, 0.0, 0.0), &[10.0, 0.0, 0.0]),
+        None
+    );
 }
 
 /// Reference 004 §2.4 Steps 5–7 and §5.4 in physical time: the 90° line–line corner with
