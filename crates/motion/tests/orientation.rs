@@ -67,6 +67,12 @@ fn the_machine_gives_the_closed_form_axis() {
         pm.axis(ToolControl::Joints, &Vec3::zeros(), &[30.0, 0.0, 0.0]),
         None
     );
+    // Y-Z-C-A: C follows the tip, the axis is not the angles' alone.
+    let yzca = PlanMachine::from_machine(&Machine::builtin("yzca").unwrap()).unwrap();
+    assert_eq!(
+        yzca.axis(TCP, &Vec3::new(50.0, 0.0, 0.0), &[10.0, 0.0, 0.0]),
+        None
+    );
 }
 
 /// Reference 004 §2.4 Steps 5–7 and §5.4 in physical time: the 90° line–line corner with
@@ -130,8 +136,9 @@ fn two_curve_blend_matches_reference_004_steps_5_to_7() {
     }
 }
 
-/// One step of a random 5-axis polyline: turn the heading by `turn` in XY, go `len` mm,
-/// climb `dz`, turn A by `da`° and C by `dc`°.
+/// One step of a random 5-axis program: turn the heading by `turn` in XY, then go `len` mm
+/// straight, or (with `arc`) along an arc of radius `len` and signed sweep `arc` rad (a helix
+/// with `dz`), climbing `dz`, turning A by `da`° and C by `dc`°.
 #[derive(Debug, Clone)]
 struct Step {
     turn: f64,
@@ -139,6 +146,7 @@ struct Step {
     dz: f64,
     da: f64,
     dc: f64,
+    arc: Option<f64>,
 }
 
 fn step() -> impl Strategy<Value = Step> {
@@ -148,13 +156,18 @@ fn step() -> impl Strategy<Value = Step> {
         -1.0f64..1.0,
         -8.0f64..8.0,
         prop_oneof![-40.0f64..-0.5, 0.5f64..40.0],
+        prop_oneof![
+            3 => Just(None),
+            1 => (-2.5f64..2.5).prop_filter("a real sweep", |s| s.abs() > 0.05).prop_map(Some),
+        ],
     )
-        .prop_map(|(turn, len, dz, da, dc)| Step {
+        .prop_map(|(turn, len, dz, da, dc, arc)| Step {
             turn,
             len,
             dz,
             da,
             dc,
+            arc,
         })
 }
 
@@ -162,6 +175,14 @@ struct Program {
     moves: Vec<Move>,
     /// Programmed points with their A and C (start first).
     points: Vec<(Vec3, f64, f64)>,
+    /// For each move ending at `points[i]` that is an arc: its centre (XY, at the start's
+    /// height) and signed sweep.
+    arcs: Vec<Option<(Vec3, f64)>>,
+}
+
+fn rot(v: Vec3, a: f64) -> Vec3 {
+    let (s, c) = a.sin_cos();
+    Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
 }
 
 fn program(steps: &[Step], tolerance: f64) -> Program {
@@ -184,33 +205,90 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
     // The rapid starts from the origin (A 0, C 0).
     let mut points = vec![(Vec3::zeros(), 0.0, 0.0), start];
     let (mut pos, mut a, mut c) = start;
+    let mut arcs = vec![None, None];
     let mut heading = Vec3::x();
     for (i, s) in steps.iter().enumerate() {
-        let (sn, cs) = s.turn.sin_cos();
-        heading = Vec3::new(
-            cs * heading.x - sn * heading.y,
-            sn * heading.x + cs * heading.y,
-            0.0,
-        );
-        pos += heading * s.len + Vec3::new(0.0, 0.0, s.dz);
+        heading = rot(heading, s.turn);
         a = (a + s.da).clamp(5.0, 80.0);
         c += s.dc;
-        moves.push(g1ac(i as u32 + 4, pos, a, c));
+        let line = i as u32 + 4;
+        match s.arc {
+            None => {
+                pos += heading * s.len + Vec3::new(0.0, 0.0, s.dz);
+                moves.push(g1ac(line, pos, a, c));
+                arcs.push(None);
+            }
+            Some(sweep) => {
+                let side = if sweep > 0.0 { PI / 2.0 } else { -PI / 2.0 };
+                let centre = pos + rot(heading, side) * s.len;
+                let end = centre + rot(pos - centre, sweep) + Vec3::new(0.0, 0.0, s.dz);
+                moves.push(Move {
+                    line,
+                    kind: MoveKind::Arc(tezgah_geom::ArcMove {
+                        plane: tezgah_geom::Plane::XY,
+                        end: Pose::new(end.x, end.y, end.z, a, 0.0, c),
+                        center: [centre.x, centre.y],
+                        turn: if sweep > 0.0 { 1 } else { -1 },
+                    }),
+                });
+                arcs.push(Some((centre, sweep)));
+                heading = rot(heading, sweep);
+                pos = end;
+            }
+        }
         points.push((pos, a, c));
     }
-    Program { moves, points }
+    Program {
+        moves,
+        points,
+        arcs,
+    }
 }
 
 /// The programmed axis at the point of move `m` (from `points[m − 1]` to `points[m]`; the
 /// move of source line L is m = L − 2) nearest `q`: the great circle between the closed-form axes of its ends, at the fraction of
 /// its length (reference 004 Eq 3). Returns (distance, axis).
-fn programmed(points: &[(Vec3, f64, f64)], m: usize, q: &Vec3) -> (f64, Vec3) {
-    let (p0, a0, c0) = points[m - 1];
-    let (p1, a1, c1) = points[m];
-    let d = p1 - p0;
-    let t = ((q - p0).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+fn programmed(prog: &Program, m: usize, q: &Vec3) -> (f64, Vec3) {
+    let (p0, a0, c0) = prog.points[m - 1];
+    let (p1, a1, c1) = prog.points[m];
     let g = GreatCircle::new(table_ac_axis(a0, c0), table_ac_axis(a1, c1)).unwrap();
-    ((p0 + d * t - q).norm(), g.at(t))
+    let Some((centre, sweep)) = prog.arcs[m] else {
+        let d = p1 - p0;
+        let t = ((q - p0).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
+        return ((p0 + d * t - q).norm(), g.at(t));
+    };
+    // A helix is uniform in its parameter. The nearest point: the parameter of `q`'s angle
+    // about the centre (or the nearer end outside the sweep), refined by golden sections in
+    // a window around it (the blends are within a fraction of a mm of the helix).
+    let at = |t: f64| centre + rot(p0 - centre, sweep * t) + Vec3::new(0.0, 0.0, (p1.z - p0.z) * t);
+    let d = |t: f64| (at(t) - q).norm();
+    let (u, v) = (p0 - centre, q - centre);
+    let turn = (u.x * v.y - u.y * v.x).atan2(u.x * v.x + u.y * v.y);
+    let angle = if sweep > 0.0 {
+        turn.rem_euclid(2.0 * PI)
+    } else {
+        -(-turn).rem_euclid(2.0 * PI)
+    };
+    let guess = angle / sweep;
+    let guess = if guess <= 1.0 {
+        guess
+    } else if d(0.0) < d(1.0) {
+        0.0
+    } else {
+        1.0
+    };
+    let (mut lo, mut hi) = ((guess - 0.05).max(0.0), (guess + 0.05).min(1.0));
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (x1, x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
+        if d(x1) <= d(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    let t = 0.5 * (lo + hi);
+    (d(t), g.at(t))
 }
 
 fn check(prog: &Program, items: &[PathItem], pm: &PlanMachine, angular: f64) -> Result<(), String> {
@@ -231,11 +309,11 @@ fn check(prog: &Program, items: &[PathItem], pm: &PlanMachine, angular: f64) -> 
         // tolerance of the programmed axis at the nearest point of its two moves.
         if let AxisPath::Blend(b) = path {
             let m = (s.line - 2) as usize;
-            for k in 0..=200 {
-                let u = k as f64 / 200.0;
+            for k in 0..=100 {
+                let u = k as f64 / 100.0;
                 let tip = s.curve.point(u);
-                let (da, oa) = programmed(&prog.points, m, &tip);
-                let (db, ob) = programmed(&prog.points, m + 1, &tip);
+                let (da, oa) = programmed(prog, m, &tip);
+                let (db, ob) = programmed(prog, m + 1, &tip);
                 let reference = if da <= db { oa } else { ob };
                 let dev = angle_between(&b.at(u), &reference);
                 if dev > budget + 1e-12 {
@@ -287,7 +365,7 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
 
     #[test]
-    fn random_five_axis_polylines(
+    fn random_five_axis_polylines_and_arc_chains(
         steps in proptest::collection::vec(step(), 1..12),
         tol in prop_oneof![Just(0.01), Just(0.002), Just(0.1)],
         angular in prop_oneof![Just(0.1), Just(0.01), Just(1.0)],
@@ -336,7 +414,9 @@ fn a_blend_is_shortened_to_keep_the_axis_within_tolerance() {
 #[test]
 fn moves_the_axis_cannot_describe_keep_linear_angles() {
     let pm = machine();
-    let cases: [(&[(f64, f64)], &[bool]); 6] = [
+    // (A, C) of each move, and whether each carries its axis.
+    type Case = (&'static [(f64, f64)], &'static [bool]);
+    let cases: [Case; 6] = [
         // Reversal at the second move.
         (&[(90.0, 0.0), (90.0, 180.0)], &[true, false]),
         // A whole turn.

@@ -124,6 +124,14 @@ impl PlanMachine {
         !matches!(self.model, Model::Cartesian(_) | Model::LinearDelta(_))
     }
 
+    /// Whether the program angles alone give the tool axis, which the path can then carry as
+    /// a vector: the five-axis trunnions. Not Y-Z-C-A, a four-axis machine whose C follows the
+    /// tip (the axis must stay in the plane through the tip and the C axis, so a vector
+    /// interpolated freely between two reachable axes is not reachable in between).
+    fn carries_axis(&self) -> bool {
+        matches!(self.model, Model::TableAc(_) | Model::TableBc(_))
+    }
+
     /// The angle (degrees) the tool axis turns through along a rotary-only segment under
     /// tool-centre-point control on a machine whose rotaries orient the tool: the length of
     /// its path on the unit sphere, summed over [`SWEEP_STEPS`] steps of the program angles
@@ -270,7 +278,7 @@ impl PlanMachine {
             [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f)
         };
         match (seg.axis, seg.control) {
-            (Some(path), ToolControl::CentrePoint { tool_length }) if self.orients() => {
+            (Some(path), ToolControl::CentrePoint { tool_length }) if self.carries_axis() => {
                 let pose = ToolPose::new(*tip, path.at(u, f));
                 let q = self
                     .model
@@ -311,7 +319,7 @@ impl ToolAxisMap for PlanMachine {
         let ToolControl::CentrePoint { tool_length } = control else {
             return None;
         };
-        if !self.orients() {
+        if !self.carries_axis() {
             return None;
         }
         // The rotary joints are the angles themselves (no branch to choose), so the axis

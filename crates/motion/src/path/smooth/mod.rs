@@ -582,8 +582,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
     /// The orientation side of a placed blend, `None` if it leaves the angular tolerance: the
     /// two-curve axis blend and its deviation (rad) where both pieces carry a tool axis,
     /// otherwise no axis blend and the rotary axes' deviation at mid-blend (degrees → rad).
-    #[allow(clippy::type_complexity)]
-    fn orientation(&self, a: &Piece, b: &Piece, p: &Placed) -> Option<(Option<AxisBlend>, f64)> {
+    fn orientation(&self, a: &Piece, b: &Piece, p: &Placed) -> Option<Fit> {
         let tolerance = self.opts.angular_tolerance;
         // A move with linear angles next to one carrying its axis: the two meet only at the
         // programmed point (a blend would start the axis from where each left it).
@@ -604,6 +603,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         (deviation <= tolerance).then_some((None, 0.0))
     }
 }
+
+/// The orientation side of a blend that fits: the axis blend (none where the rotary axes run
+/// linearly) and its deviation from the programmed axis, rad.
+type Fit = (Option<AxisBlend>, f64);
 
 /// Whether the orientation's rate of change by arc length (and, for the tool axis, its second
 /// derivative) is the same on both sides of a tangent junction, to 1e-9 relative.
