@@ -131,8 +131,6 @@ impl std::fmt::Debug for Segment {
 // space only on the rare dwells and stops.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug)]
-// Almost every item is a segment: boxing it would allocate once per segment for nothing.
-#[allow(clippy::large_enum_variant)]
 pub enum PathItem {
     Segment(Segment),
     /// G4: stand still this long, seconds (the segment before ends with [`Junction::Stop`]).
