@@ -137,12 +137,7 @@ fn positive(name: &str, v: f64) -> Result<f64> {
 /// The tool length of `number` in the tool table (0 without a table).
 fn tool_length(table: Option<&Path>, number: u32) -> Result<f64> {
     let Some(path) = table else { return Ok(0.0) };
-    let text = std::fs::read_to_string(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-    let table = tezgah_gcode::ToolTable::parse(&text)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("in {}", path.display()))?;
+    let table = crate::library::load_tool_table(Some(path))?;
     table
         .get(i64::from(number))
         .map(|t| t.offset.z())

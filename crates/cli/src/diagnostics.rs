@@ -31,6 +31,30 @@ pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
     .with_source_code(NamedSource::new(name, text.to_string()))
 }
 
+/// A report for an error known only by its 1-based line (the path and the kinematics keep
+/// lines, not columns): `file:line:col` of the line's first word, underlined.
+pub fn report_line(path: &Path, text: &str, line: u32, message: &str) -> Report {
+    let name = path.display().to_string();
+    let start: usize = text
+        .split_inclusive('\n')
+        .take((line as usize).saturating_sub(1))
+        .map(str::len)
+        .sum();
+    let body = text[start.min(text.len())..].lines().next().unwrap_or("");
+    let indent = body.len() - body.trim_start().len();
+    let width = body.trim().len().max(1);
+    let label = LabeledSpan::at(
+        (start + indent).min(text.len())..(start + indent + width).min(text.len()),
+        "here",
+    );
+    miette!(
+        labels = vec![label],
+        "{name}:{line}:{}: {message}",
+        indent + 1
+    )
+    .with_source_code(NamedSource::new(name, text.to_string()))
+}
+
 /// Counts of what a program does, for `check`'s summary line.
 #[derive(Default)]
 pub struct Counts {

@@ -31,6 +31,19 @@ pub struct ProgramInputs {
 }
 
 /// Read a LinuxCNC parameter file (`.var`).
+/// The tool table at `path` (LinuxCNC's format), or an empty one without a path.
+pub fn load_tool_table(path: Option<&Path>) -> Result<tezgah_gcode::ToolTable> {
+    let Some(path) = path else {
+        return Ok(tezgah_gcode::ToolTable::default());
+    };
+    let bytes = std::fs::read(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
+    tezgah_gcode::ToolTable::parse(&String::from_utf8_lossy(&bytes))
+        .into_diagnostic()
+        .wrap_err_with(|| format!("in {}", path.display()))
+}
+
 pub fn load_parameters(path: Option<&Path>) -> Result<Option<Arc<ParameterFile>>> {
     let Some(path) = path else { return Ok(None) };
     let text = std::fs::read_to_string(path)

@@ -13,7 +13,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use miette::{IntoDiagnostic, Result, WrapErr};
-use tezgah_gcode::{Canon, CanonSink, Config, Interpreter, Origin, ToolTable};
+use tezgah_gcode::{Canon, CanonSink, Config, Interpreter, Origin};
 
 #[derive(Parser)]
 #[command(name = "tezgah", version, about = "CNC motion control and CAM")]
@@ -64,6 +64,10 @@ enum Command {
     Check {
         /// The G-code program.
         program: PathBuf,
+        /// Also build the path for this machine (built-in name or file) and check that every
+        /// move is within its reach and joint limits.
+        #[arg(long)]
+        machine: Option<String>,
         #[command(flatten)]
         inputs: Inputs,
     },
@@ -161,7 +165,11 @@ fn main() -> ExitCode {
     }));
     let result = match cli.command {
         Command::Canon { program, inputs } => canon(&program, &inputs),
-        Command::Check { program, inputs } => check(&program, &inputs),
+        Command::Check {
+            program,
+            machine,
+            inputs,
+        } => check(&program, machine.as_deref(), &inputs),
         Command::Run {
             program,
             machine,
@@ -237,16 +245,6 @@ fn read_text(path: &Path) -> Result<String> {
         .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
 }
 
-/// The tool table of `--tool-table`, if given.
-fn load_tool_table(tool_table: Option<&Path>) -> Result<ToolTable> {
-    match tool_table {
-        Some(path) => ToolTable::parse(&read_text(path)?)
-            .into_diagnostic()
-            .wrap_err_with(|| format!("in {}", path.display())),
-        None => Ok(ToolTable::default()),
-    }
-}
-
 /// `tezgah canon`: one call per line; on error the calls made so far, then the error.
 fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
@@ -256,7 +254,7 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
         subroutines: extra.subroutines,
         ini: extra.ini,
         parameters: extra.parameters,
-        ..Config::linuxcnc(load_tool_table(inputs.tool_table.as_deref())?)
+        ..Config::linuxcnc(library::load_tool_table(inputs.tool_table.as_deref())?)
     };
     let mut interp = Interpreter::new(config);
     let mut out = std::io::BufWriter::new(std::io::stdout().lock());
@@ -288,20 +286,36 @@ impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
 }
 
 /// `tezgah check`: every error with its place, or a summary of the program.
-fn check(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
+fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitCode> {
     let text = read_text(program)?;
     let mut counts = diagnostics::Counts::default();
     // As `run`: the machine's units (mm) for the tool table and the stored offsets.
     let extra = inputs.program_inputs(Some(program))?;
     let config = Config {
-        tool_table: load_tool_table(inputs.tool_table.as_deref())?,
+        tool_table: library::load_tool_table(inputs.tool_table.as_deref())?,
         subroutines: extra.subroutines,
         ini: extra.ini,
         parameters: extra.parameters,
         ..Config::default()
     };
-    let errors = tezgah_gcode::check_into(&text, config, &mut counts);
+    let machine = machine.map(|m| run::load_machine(Some(m))).transpose()?;
+    let config = Config {
+        tool_centre_point_always: machine
+            .as_ref()
+            .is_some_and(|m| m.tcp == tezgah_kinematics::TcpSwitch::Always),
+        ..config
+    };
+    let errors = tezgah_gcode::check_into(&text, config.clone(), &mut counts);
     if errors.is_empty() {
+        if let Some(machine) = &machine {
+            // The interpreter found nothing: its moves exist; the machine checks them.
+            let moves = tezgah_gcode::program_moves(&text, config)
+                .map_err(|e| diagnostics::report(program, &text, &e))?;
+            let tolerance = machine.motion.tolerance_mm;
+            run::build_path(program, &text, moves, machine, tolerance)?;
+            println!("{}: OK on {}, {counts}", program.display(), machine.name);
+            return Ok(ExitCode::SUCCESS);
+        }
         println!("{}: OK, {counts}", program.display());
         return Ok(ExitCode::SUCCESS);
     }

@@ -43,6 +43,42 @@ fn smooth_options(
     }
 }
 
+/// The path a machine will follow, checked whole before anything moves.
+pub struct BuiltPath {
+    pub items: Vec<tezgah_motion::PathItem>,
+    pub pm: PlanMachine,
+    /// The program pose the machine starts from.
+    pub start: Pose,
+}
+
+/// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
+/// the tolerance, G61 keeps corners, G61.1 stops at every block end), then the pre-flight:
+/// every segment within the machine's reach and joint limits, else a report naming the line.
+pub fn build_path(
+    program: &std::path::Path,
+    text: &str,
+    moves: Vec<tezgah_geom::Move>,
+    machine: &Machine,
+    tolerance: f64,
+) -> Result<BuiltPath> {
+    let start = Pose::ZERO;
+    let pm = PlanMachine::from_machine(machine).map_err(|e| miette!("{e}"))?;
+    let items = smooth::build(moves, &smooth_options(&machine.path, tolerance, start, &pm))
+        .map_err(|e| miette!("{e}"))?;
+    let start_joints = pm
+        .joints(
+            pm.initial,
+            &Vec3::from(start.xyz()),
+            &[start.0[3], start.0[4], start.0[5]],
+            &tezgah_kinematics::Joints::zeros(pm.joint_count()),
+        )
+        .map_err(|e| miette!("the start pose: {e}"))?;
+    tezgah_motion::preflight::check_path(&items, &pm, start_joints).map_err(|e| {
+        crate::diagnostics::report_line(program, text, e.line, &e.source.to_string())
+    })?;
+    Ok(BuiltPath { items, pm, start })
+}
+
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
 /// The demo's tool table.
 pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
@@ -114,15 +150,8 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         None => ("built-in demo".to_owned(), DEMO.to_owned()),
     };
     let table = match &args.tool_table {
-        Some(path) => ToolTable::parse(
-            &std::fs::read_to_string(path)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("cannot read {}", path.display()))?,
-        )
-        .into_diagnostic()
-        .wrap_err_with(|| format!("in {}", path.display()))?,
         None if args.program.is_none() => ToolTable::parse(DEMO_TOOLS).into_diagnostic()?,
-        None => ToolTable::default(),
+        table => crate::library::load_tool_table(table.as_deref())?,
     };
     let extra = crate::library::program_inputs(
         args.program.as_deref(),
@@ -154,15 +183,8 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
-    let start = Pose::ZERO;
-    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
-    // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
-    // G61 keeps corners, G61.1 stops at every block end.
-    let items = smooth::build(
-        moves.iter().cloned(),
-        &smooth_options(&machine.path, tolerance, start, &pm),
-    )
-    .map_err(|e| miette!("{e}"))?;
+    let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
+    let BuiltPath { items, pm, start } = build_path(&path_name, &text, moves, &machine, tolerance)?;
     let segments = items
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))

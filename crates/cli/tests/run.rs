@@ -206,3 +206,47 @@ fn spline_example_runs_within_tolerance_and_limits() {
     assert!(first[5].hypot(first[6]) < 0.01, "{first:?}");
     assert!(rows.iter().any(|r| r[1] == 21.0), "the second NURBS runs");
 }
+
+/// A program that leaves the machine's envelope is refused whole, before anything is written:
+/// on a straight move, and on an arc whose ends are inside while its middle bulges out.
+#[test]
+fn pre_flight_refuses_a_program_past_a_joint_limit_before_any_output() {
+    let cases = [
+        ("line.ngc", "G21 G90\nG1 X50 F1000\nG1 X500\nM2\n", ":3:1"),
+        (
+            "arc.ngc",
+            "G21 G90\nG0 X190 Y-15\n  G3 X190 Y15 I0 J15 F1000\nM2\n",
+            ":3:3",
+        ),
+    ];
+    for (name, program, place) in cases {
+        let (file, csv) = (tmp(name), tmp(&format!("{name}.csv")));
+        std::fs::write(&file, program).unwrap();
+        let out = tezgah()
+            .arg("run")
+            .arg(&file)
+            .arg("--samples")
+            .arg(&csv)
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{name}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains(&format!("{name}{place}"))
+                && err.contains("outside its limits [-200, 200]"),
+            "{err}"
+        );
+        assert!(!csv.exists(), "{name}: nothing is written");
+        // `check` finds it with a machine, and only the interpreter's faults without one.
+        let with = tezgah()
+            .arg("check")
+            .arg(&file)
+            .args(["--machine", "mill3"])
+            .output()
+            .unwrap();
+        assert!(!with.status.success(), "{name}");
+        assert!(String::from_utf8_lossy(&with.stderr).contains(&format!("{name}{place}")));
+        let without = tezgah().arg("check").arg(&file).output().unwrap();
+        assert!(without.status.success(), "{name}");
+    }
+}

@@ -2,6 +2,7 @@
 //!
 //! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. Stages:
 //! [`path`] (moves → segments), [`takeup`] (the joint move at a tool-centre-point switch),
+//! [`preflight`] (every segment's joints within reach and limits before anything moves),
 //! [`plan`] (speed limits, look-ahead, one [`profile`] per group of segments), [`interpolate`]
 //! (samples at the period, joints by the kinematics under each segment's tool control) and
 //! [`verify`] (the post-run replay).
@@ -9,6 +10,7 @@
 pub mod interpolate;
 pub mod path;
 pub mod plan;
+pub mod preflight;
 pub mod profile;
 pub mod takeup;
 pub mod verify;
