@@ -62,7 +62,9 @@ pub enum RunState {
     /// Feed hold complete; resume continues.
     Held,
     /// Stopped in a program; cycle start continues.
-    Paused { reason: PauseReason },
+    Paused {
+        reason: PauseReason,
+    },
     /// Abort: slowing to a stop on the path, then idle.
     Aborting,
     /// The real-time side stopped on an underrun or drive fault; abort clears it.

@@ -11,7 +11,7 @@ use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
 use tezgah_motion::path::smooth::{SmoothOptions, CHORD_SHARE};
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
-use tezgah_motion::{Junction, Segment, State};
+use tezgah_motion::{Junction, Segment};
 
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
@@ -30,6 +30,9 @@ pub struct Produced {
     pub rotary: [f64; 3],
     /// Path speed this period, mm/s (r times the plan's).
     pub feed: f64,
+    /// Path coordinate run since the executor started (mm, degrees on rotary-only moves):
+    /// monotone, so a hold and resume can be checked to lose and repeat nothing.
+    pub path: f64,
 }
 
 /// Settings of the executor.
@@ -95,6 +98,11 @@ pub struct Executor {
     single_block: bool,
     optional_stop: bool,
     mdi: Mdi,
+    /// The modal moves MDI blocks have made (feed, feed mode, path mode, …), last of each
+    /// kind: every MDI job starts with them, as the interpreter's modal state carries over.
+    mdi_modal: Vec<Move>,
+    /// Where the MDI interpreter believes the machine is (the end of its last move).
+    mdi_at: Pose,
     error: Option<String>,
     /// Where the tool is (the last sample, or a piece's exact end).
     pose: CursorPose,
@@ -103,6 +111,9 @@ pub struct Executor {
     prev_velocity: Joints,
     /// Segments passed since the last set-point (for path checks).
     passed: Vec<Arc<Segment>>,
+    /// Path length of the pieces finished, and where in the current one the tool is.
+    done_length: f64,
+    s: f64,
 }
 
 fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
@@ -134,6 +145,8 @@ impl Executor {
             machine: pm,
             options,
             mdi: Mdi::new(gcode.clone()),
+            mdi_modal: Vec::new(),
+            mdi_at: Pose::ZERO,
             gcode,
             program: None,
             job: None,
@@ -155,6 +168,8 @@ impl Executor {
             prev_joints: joints,
             prev_velocity: Joints::zeros(n),
             passed: Vec::new(),
+            done_length: 0.0,
+            s: 0.0,
         })
     }
 
@@ -169,6 +184,14 @@ impl Executor {
     /// The machine as the planner sees it.
     pub fn machine(&self) -> &PlanMachine {
         &self.machine
+    }
+
+    /// The path limits (speed, acceleration, jerk along the path) of the piece in hand.
+    pub fn path_limits(&self) -> Option<tezgah_motion::Limits> {
+        match &self.current {
+            Some(Current::Piece { cursor, .. }) => Some(cursor.piece().limits),
+            _ => None,
+        }
     }
 
     /// The segments the tool passed since the previous set-point, ending with its own.
@@ -220,16 +243,22 @@ impl Executor {
         }
     }
 
-    fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
+    /// The tool's pose in the coordinates of the moves (mm, degrees).
+    fn program_pose(&self) -> Pose {
         let p = &self.pose;
-        let start = Pose::new(
+        Pose::new(
             p.tip.x,
             p.tip.y,
             p.tip.z,
             p.rotary[0],
             p.rotary[1],
             p.rotary[2],
-        );
+        )
+    }
+
+    fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
+        let p = &self.pose;
+        let start = self.program_pose();
         let job = Job::new(moves, &self.machine, &self.job_options(), start, p.joints)?;
         self.job = Some(job);
         self.current = None;
@@ -308,8 +337,26 @@ impl Executor {
                 if self.state != RunState::Idle {
                     return Err(self.busy("MDI"));
                 }
+                let here = self.program_pose();
+                if here.0 != self.mdi_at.0 {
+                    self.mdi.sync(&here)?;
+                    self.mdi_at = here;
+                }
                 let moves = self.mdi.block(&block)?;
-                self.start_job(moves, Mode::Mdi)
+                if let Some(end) = moves.iter().rev().find_map(|m| move_end(&m.kind)) {
+                    self.mdi_at = end;
+                }
+                let mut job = self.mdi_modal.clone();
+                for m in moves {
+                    if is_modal(&m.kind) {
+                        let d = std::mem::discriminant(&m.kind);
+                        self.mdi_modal
+                            .retain(|k| std::mem::discriminant(&k.kind) != d);
+                        self.mdi_modal.push(m.clone());
+                    }
+                    job.push(m);
+                }
+                self.start_job(job, Mode::Mdi)
             }
             Command::RestartFrom { line } => {
                 if self.state != RunState::Idle {
@@ -323,6 +370,9 @@ impl Executor {
     }
 
     fn drop_job(&mut self) {
+        // The path run so far stays counted.
+        self.done_length += self.s;
+        self.s = 0.0;
         self.job = None;
         self.current = None;
         self.state = RunState::Idle;
@@ -386,26 +436,19 @@ impl Executor {
             }
         }
         // The time scale moves with the plan's state where the tool is.
-        let (state, limits, factor) = match &self.current {
-            Some(Current::Piece { cursor, tau, factor }) => {
-                let p = cursor.piece();
-                (p.profile.state_at(*tau), Some(p.limits), *factor)
-            }
-            _ => (
-                State {
-                    s: 0.0,
-                    v: 0.0,
-                    a: 0.0,
-                    j: 0.0,
-                },
-                None,
-                1.0,
-            ),
+        let factor = match &self.current {
+            Some(Current::Piece { factor, .. }) => *factor,
+            _ => 1.0,
         };
         let target = self.target(factor);
-        let dtau = match limits {
-            Some(l) => self.scale.step(target, &state, &l, ts).dtau,
-            None => {
+        let dtau = match &self.current {
+            Some(Current::Piece { cursor, tau, .. }) => {
+                let p = cursor.piece();
+                self.scale
+                    .step(target, &p.profile, *tau, &p.limits, ts)
+                    .dtau
+            }
+            _ => {
                 // Standing still (a dwell): r may jump, nothing moves.
                 self.scale.r = target;
                 self.scale.rate = 0.0;
@@ -522,6 +565,8 @@ impl Executor {
                     // The piece's exact end, and every segment passed on the way.
                     let end = cursor.piece().length();
                     self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
+                    self.done_length += end;
+                    self.s = 0.0;
                     self.passed.extend(cursor.passed().iter().cloned());
                     let stop = cursor
                         .piece()
@@ -529,7 +574,11 @@ impl Executor {
                         .last()
                         .is_some_and(|s| s.end == Junction::Stop);
                     self.current = None;
-                    if stop && self.single_block && self.state == RunState::Running {
+                    if stop
+                        && self.single_block
+                        && self.mode == Mode::Auto
+                        && self.state == RunState::Running
+                    {
                         return Ok(Event::Paused(PauseReason::SingleBlock));
                     }
                 }
@@ -551,6 +600,7 @@ impl Executor {
     fn sample(&mut self) -> Result<(), ExecError> {
         if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
             let s = cursor.piece().profile.state_at(*tau).s;
+            self.s = s.clamp(0.0, cursor.piece().length());
             self.pose = cursor.pose(&self.machine, s, &self.pose.joints)?;
             // Segments passed inside this piece (its cursor keeps the current one).
             for seg in cursor.passed() {
@@ -591,6 +641,7 @@ impl Executor {
             tip: self.pose.tip,
             rotary: self.pose.rotary,
             feed,
+            path: self.done_length + self.s,
         }
     }
 }
@@ -606,18 +657,21 @@ pub fn restart_moves(program: &[Move], line: u32) -> Result<Vec<Move>, ExecError
     let mut out = Vec::new();
     let mut start = None;
     for m in &program[..first] {
-        match &m.kind {
-            MoveKind::Rapid { end } | MoveKind::Feed { end } => start = Some(*end),
-            MoveKind::Arc(a) => start = Some(a.end),
-            MoveKind::Nurbs(n) => start = Some(n.end),
-            MoveKind::Dwell { .. } | MoveKind::Stop(_) => {}
-            _ => out.push(m.clone()),
+        if let Some(end) = move_end(&m.kind) {
+            start = Some(end);
+        } else if is_modal(&m.kind) {
+            out.push(m.clone());
         }
     }
     if let Some(end) = start {
         out.push(Move {
             line,
             kind: MoveKind::Rapid { end },
+        });
+        // Exactly there before the line runs (a dwell ends the path in a stop).
+        out.push(Move {
+            line,
+            kind: MoveKind::Dwell { seconds: 0.0 },
         });
     }
     out.extend(program[first..].iter().cloned());
@@ -629,4 +683,27 @@ fn is_motion(kind: &MoveKind) -> bool {
         kind,
         MoveKind::Rapid { .. } | MoveKind::Feed { .. } | MoveKind::Arc(_) | MoveKind::Nurbs(_)
     )
+}
+
+/// Moves that change a mode the path builder keeps (they move nothing).
+fn is_modal(kind: &MoveKind) -> bool {
+    matches!(
+        kind,
+        MoveKind::FeedRate { .. }
+            | MoveKind::FeedMode(_)
+            | MoveKind::SpindleSpeed { .. }
+            | MoveKind::PathMode(_)
+            | MoveKind::Smoothing(_)
+            | MoveKind::ToolControl { .. }
+    )
+}
+
+/// Where a motion move ends.
+fn move_end(kind: &MoveKind) -> Option<Pose> {
+    match kind {
+        MoveKind::Rapid { end } | MoveKind::Feed { end } => Some(*end),
+        MoveKind::Arc(a) => Some(a.end),
+        MoveKind::Nurbs(n) => Some(n.end),
+        _ => None,
+    }
 }

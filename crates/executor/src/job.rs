@@ -140,12 +140,14 @@ impl Job {
             match self.items.next() {
                 Some(item) => {
                     let item = item.map_err(ExecError::Path)?;
-                    if let Some(t) = self.takeup.before(&item).map_err(|e| {
-                        ExecError::Kinematics {
-                            line: e.line,
-                            message: e.source.to_string(),
-                        }
-                    })? {
+                    if let Some(t) =
+                        self.takeup
+                            .before(&item)
+                            .map_err(|e| ExecError::Kinematics {
+                                line: e.line,
+                                message: e.source.to_string(),
+                            })?
+                    {
                         self.push(t, factor)?;
                     }
                     self.push(item, factor)?;

@@ -4,8 +4,8 @@
 use std::sync::mpsc;
 
 use tezgah_gcode::interp::{line_at, LinePos};
-use tezgah_gcode::{Config, Interpreter, MoveBuilder};
-use tezgah_geom::Move;
+use tezgah_gcode::{Config, Interpreter, MoveBuilder, Units};
+use tezgah_geom::{Move, Pose};
 
 use crate::error::ExecError;
 
@@ -38,6 +38,33 @@ impl Mdi {
         };
         while mdi.moves.try_recv().is_ok() {}
         mdi
+    }
+
+    /// Tells the interpreter the machine is at `pose` (machine coordinates, mm and degrees)
+    /// after motion it did not make (AUTO, an abort): a `G53 G0` there, whose move (of zero
+    /// length) is dropped; G90/G91 is restored, the motion mode is G0 afterwards.
+    pub fn sync(&mut self, pose: &Pose) -> Result<(), ExecError> {
+        let st = self.interp.state();
+        let incremental = st.incremental;
+        let scale = match st.units {
+            Units::Inches => 1.0 / 25.4,
+            _ => 1.0,
+        };
+        let p = &pose.0;
+        let line = format!(
+            "G90 G53 G0 X{:.9} Y{:.9} Z{:.9} A{:.9} B{:.9} C{:.9}",
+            p[0] * scale,
+            p[1] * scale,
+            p[2] * scale,
+            p[3],
+            p[4],
+            p[5]
+        );
+        self.block(&line)?;
+        if incremental {
+            self.block("G91")?;
+        }
+        Ok(())
     }
 
     /// The moves of one block (line number 1). An error leaves the modal state as the

@@ -1,22 +1,35 @@
 //! Re-timing: the path-time scale r = dτ/dt between wall time t and the planned profile's
 //! time τ. Feed override sets the target r, feed hold drives it to 0, resume back; the path
-//! itself never changes (re-timed, not re-shaped), and r moves along a ramp whose rate and
-//! acceleration are chosen each period so the re-timed motion keeps the segment's limits.
+//! itself never changes (re-timed, not re-shaped).
 //!
 //! With the plan at τ giving speed v, acceleration a and jerk j along the path, the re-timed
-//! path moves at ṡ = r·v, s̈ = ṙ·v + r²·a and s⃛ = r̈·v + 3r·ṙ·a + r³·j (chain rule). With
-//! r ≤ 1 the speed stays within the plan's; |s̈| ≤ A bounds ṙ to
-//! [(−A − r²a)/v, (A − r²a)/v] and |s⃛| ≤ J bounds r̈ to [(−J − 3rṙa − r³j)/v, (J − …)/v].
-//! Within those bounds r follows a square-root approach to its target (the time-optimal
-//! second-order approach: ṙ = ±√(2·r̈_max·|e|)). Where the plan brakes at its limit
-//! (a = −A at r = 1) no faster slowing is possible and r waits: the hold then never stops
-//! later than the plan itself would.
+//! motion has ṡ = r·v, s̈ = ṙ·v + r²·a and s⃛ = r̈·v + 3r·ṙ·a + r³·j (chain rule). With
+//! 0 ≤ r ≤ 1 the speed stays within the plan's; each period r̈ is chosen so that
+//! |s̈| ≤ A and |s⃛| ≤ J of the piece's path limits hold — which keeps every joint within its
+//! limits, since the planner derived the path limits for any speed up to the piece's V.
+//!
+//! Why a look-ahead on r: the plan itself may use the whole jerk (r³j = J at r = 1), and then
+//! no r̈ can brake ṙ; a ramp that runs into such a stretch with ṙ ≠ 0 cannot stop in time and
+//! would overshoot r = 0 or 1 (an acceleration step). Holding r constant is always admissible
+//! (s̈ = r²a, s⃛ = r³j), so a state is kept only if from it ṙ can be braked to 0 within the
+//! limits against the plan's actual states ahead ([`TimeScale::can_settle`]). Each period takes
+//! the most direct of a few candidate r̈ (the square-root approach to the target, blended
+//! toward braking) that passes that test.
 
-use tezgah_motion::{Limits, State};
+use tezgah_motion::{Limits, Profile, State};
 
-/// A share of each path limit the re-timed motion may use; the rest absorbs the
-/// discretisation of r̈ per period.
-const LIMIT_SHARE: f64 = 0.97;
+/// The ramp of r alone may use this share of the path limits (its own rate and acceleration
+/// bounds); the checks against the plan's terms use the full limits.
+const RAMP_SHARE: f64 = 0.5;
+
+/// Largest change of r in one period.
+const MAX_SWING: f64 = 0.1;
+
+/// Slack on the limit checks for rounding.
+const SLACK: f64 = 1e-9;
+
+/// Periods the settling test looks ahead at most.
+const HORIZON: usize = 4000;
 
 /// The time scale and its rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,6 +51,71 @@ pub struct Advance {
     pub dtau: f64,
 }
 
+/// The plan along one piece, evaluated anywhere (past the end: the end state, with the next
+/// piece's jerk unknown, so both signs of the piece's J are assumed).
+struct Plan<'a> {
+    profile: &'a Profile,
+    limits: &'a Limits,
+}
+
+impl Plan<'_> {
+    fn at(&self, tau: f64) -> (State, bool) {
+        let d = self.profile.duration();
+        if tau <= d {
+            (self.profile.state_at(tau), false)
+        } else {
+            let mut e = self.profile.end();
+            e.a = 0.0;
+            e.j = 0.0;
+            (e, true)
+        }
+    }
+
+    /// The r̈ interval over one period from τ that keeps |s⃛| ≤ J at five instants of it (the
+    /// plan's jerk may switch inside the period, and r, ṙ move): at a fraction f of the
+    /// period, r ≈ r₀ + ṙ₀fTs and ṙ = ṙ₀ + r̈fTs, so s⃛ = r̈(v + 3r·fTs·a) + 3rṙ₀a + r³j is
+    /// linear in r̈.
+    fn period_range(&self, r: f64, rd: f64, tau: f64, ts: f64) -> (f64, f64) {
+        let j_max = self.limits.max_jerk();
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let rf = (r + rd * f * ts).clamp(0.0, 1.0);
+            let (st, beyond) = self.at(tau + f * rf * ts);
+            let c = st.v + 3.0 * rf * f * ts * st.a;
+            if c <= 0.0 {
+                continue;
+            }
+            let cross = 3.0 * rf * rd * st.a;
+            let (l, h) = if beyond {
+                let room = j_max * (1.0 - rf * rf * rf) - cross.abs();
+                (-room / c, room / c)
+            } else {
+                let rest = cross + rf * rf * rf * st.j;
+                ((-j_max - rest) / c, (j_max - rest) / c)
+            };
+            lo = lo.max(l);
+            hi = hi.min(h);
+        }
+        // Whatever the bounds allow, r̈ never swings r by more than MAX_SWING in a period:
+        // the checks above sample the period and assume r moves little within it.
+        let swing = MAX_SWING / (ts * ts);
+        (lo.max(-swing), hi.min(swing))
+    }
+
+    /// |s̈| ≤ A at rate rd.
+    fn acc_ok(&self, r: f64, rd: f64, st: &State) -> bool {
+        (rd * st.v + r * r * st.a).abs() <= self.limits.max_acceleration() * (1.0 + SLACK)
+    }
+}
+
+fn integrate(r: f64, rd: f64, rdd: f64, ts: f64) -> (f64, f64, f64) {
+    (
+        r + rd * ts + rdd * ts * ts / 2.0,
+        rd + rdd * ts,
+        r * ts + rd * ts * ts / 2.0 + rdd * ts * ts * ts / 6.0,
+    )
+}
+
 impl TimeScale {
     /// At rest (r = 0), as after a hold.
     pub fn held() -> TimeScale {
@@ -49,54 +127,98 @@ impl TimeScale {
         self.r == 0.0 && self.rate == 0.0
     }
 
-    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) given the plan's state at
-    /// the current τ and the path limits in force.
-    pub fn step(&mut self, target: f64, plan: &State, limits: &Limits, ts: f64) -> Advance {
+    /// Whether from (r, ṙ) at τ the rate can be braked to 0 within the limits against the
+    /// plan ahead, with r staying within [0, 1].
+    fn can_settle(plan: &Plan, mut r: f64, mut rd: f64, mut tau: f64, ts: f64) -> bool {
+        for _ in 0..HORIZON {
+            if rd == 0.0 {
+                return true;
+            }
+            let (st, _) = plan.at(tau);
+            if st.v <= 0.0 {
+                return true;
+            }
+            if !plan.acc_ok(r, rd, &st) {
+                return false;
+            }
+            let (lo, hi) = plan.period_range(r, rd, tau, ts);
+            if lo > hi {
+                return false;
+            }
+            let rdd = (-rd / ts).clamp(lo, hi);
+            // The last braking step lands on ṙ = 0 exactly.
+            let (r1, rd1, dtau) = integrate(r, rd, rdd, ts);
+            let rd1 = if rd1 * rd <= 0.0 { 0.0 } else { rd1 };
+            if !(-SLACK..=1.0 + SLACK).contains(&r1) {
+                return false;
+            }
+            r = r1.clamp(0.0, 1.0);
+            rd = rd1;
+            tau += dtau.max(0.0);
+        }
+        false
+    }
+
+    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) at path time `tau` of a
+    /// piece planned as `profile` under path `limits`.
+    pub fn step(
+        &mut self,
+        target: f64,
+        profile: &Profile,
+        tau: f64,
+        limits: &Limits,
+        ts: f64,
+    ) -> Advance {
         let target = target.clamp(0.0, 1.0);
+        let plan = Plan { profile, limits };
+        let (st, _) = plan.at(tau);
+        let v = st.v.max(0.0);
+        if v == 0.0 && st.a == 0.0 {
+            // The plan is at rest here: r may jump (ṡ = s̈ = 0 whatever r is; s⃛ = r³j ≤ J).
+            self.r = target;
+            self.rate = 0.0;
+            return Advance { dtau: target * ts };
+        }
         let (r, rd) = (self.r, self.rate);
-        let v = plan.v.max(0.0);
-        let a_max = LIMIT_SHARE * limits.max_acceleration();
-        let j_max = LIMIT_SHARE * limits.max_jerk();
-        // At (near) rest r may change freely: nothing moves whatever r does. Otherwise the
-        // ramp's own bounds are those a speed v allows.
         let v_ref = v.max(1e-9);
-        let rdd_max = j_max / v_ref;
-        let rd_max = a_max / v_ref;
+        // At low speed r could swing within a period; the plan's state is only sampled
+        // there, so r moves at most a few percent per period.
+        let rd_max = (RAMP_SHARE * limits.max_acceleration() / v_ref).min(MAX_SWING / ts);
+        let rdd_max = (RAMP_SHARE * limits.max_jerk() / v_ref).min(MAX_SWING / (4.0 * ts * ts));
         let e = target - r;
-        // Square-root approach: the rate from which r̈_max stops exactly at the target.
-        let want = e.signum() * (2.0 * rdd_max * e.abs()).sqrt().min(rd_max);
-        let mut rdd = ((want - rd) / ts).clamp(-rdd_max, rdd_max);
-        if v > 0.0 {
-            // |ṙv + r²a| ≤ A on the rate reached at the period's end.
-            let (lo, hi) = ((-a_max - r * r * plan.a) / v, (a_max - r * r * plan.a) / v);
-            rdd = rdd.clamp(((lo - rd) / ts).min(0.0), ((hi - rd) / ts).max(0.0));
-            // |r̈v + 3rṙa + r³j| ≤ J.
-            let rest = 3.0 * r * rd * plan.a + r * r * r * plan.j;
-            let (lo, hi) = ((-j_max - rest) / v, (j_max - rest) / v);
-            if lo <= hi {
-                rdd = rdd.clamp(lo, hi);
+        // Discrete-time square-root approach: the rate from which braking at r̈_max in whole
+        // periods ends exactly at the target, ṙ = r̈Ts·(√(¼ + 2|e|/(r̈Ts²)) − ½).
+        let step = rdd_max * ts;
+        let brake_rate = step * ((0.25 + 2.0 * e.abs() / (step * ts)).sqrt() - 0.5);
+        let want = e.signum() * brake_rate.min(rd_max);
+        let direct = ((want - rd) / ts).clamp(-rdd_max, rdd_max);
+        let (lo, hi) = plan.period_range(r, rd, tau, ts);
+        let brake = (-rd / ts).clamp(lo.min(hi), hi.max(lo));
+        let mut chosen = brake;
+        for lambda in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let rdd = (direct * (1.0 - lambda) + brake * lambda).clamp(lo.min(hi), hi.max(lo));
+            let (r1, rd1, dtau) = integrate(r, rd, rdd, ts);
+            if !(-SLACK..=1.0 + SLACK).contains(&r1) {
+                continue;
+            }
+            let (st1, _) = plan.at(tau + dtau.max(0.0));
+            if plan.acc_ok(r1, rd1, &st1)
+                && Self::can_settle(&plan, r1.clamp(0.0, 1.0), rd1, tau + dtau.max(0.0), ts)
+            {
+                chosen = rdd;
+                break;
             }
         }
-        let mut r1 = r + rd * ts + rdd * ts * ts / 2.0;
-        let mut rd1 = rd + rdd * ts;
-        let mut dtau = r * ts + rd * ts * ts / 2.0 + rdd * ts * ts * ts / 6.0;
-        // Arrival: crossing (or touching) the target ends the ramp there. The rate left is
-        // ≤ √(2·r̈·|e|) → small, and nothing moves at r = 0.
-        if (r - target) * (r1 - target) <= 0.0 && (rd1.abs() <= rdd_max * ts || v == 0.0) {
+        let (mut r1, mut rd1, dtau) = integrate(r, rd, chosen, ts);
+        if (target - r1).abs() < 1e-9 && rd1.abs() < 1e-3 {
+            // Arrived (the approach lands with ṙ ≈ √(2r̈·1e-9): no step worth the name).
             r1 = target;
             rd1 = 0.0;
         }
-        if r1 < 0.0 {
-            r1 = 0.0;
-            rd1 = 0.0;
+        self.r = r1.clamp(0.0, 1.0);
+        self.rate = if self.r == r1 { rd1 } else { 0.0 };
+        Advance {
+            dtau: dtau.max(0.0),
         }
-        if r1 > 1.0 {
-            r1 = 1.0;
-            rd1 = 0.0;
-        }
-        dtau = dtau.max(0.0);
-        self.r = r1;
-        self.rate = rd1;
-        Advance { dtau }
     }
 }

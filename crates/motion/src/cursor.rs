@@ -10,7 +10,7 @@ use tezgah_kinematics::Joints;
 
 use crate::interpolate::{InterpolateError, Param};
 use crate::path::Segment;
-use crate::plan::{PlanMachine, Piece};
+use crate::plan::{Piece, PlanMachine};
 
 /// Where the tool is at one path coordinate.
 #[derive(Debug, Clone, Copy, PartialEq)]
