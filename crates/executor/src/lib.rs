@@ -15,6 +15,7 @@ pub mod rt;
 pub mod scale;
 pub mod setpoint;
 pub mod stop;
+pub mod threads;
 
 pub use drive::{Drive, DriveFault, DriveStatus};
 pub use setpoint::SetPoint;

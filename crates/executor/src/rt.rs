@@ -24,6 +24,17 @@ pub struct StopLimits {
     pub max_jerk: Joints,
 }
 
+impl StopLimits {
+    /// The machine's joint limits as the planner holds them (internal units).
+    pub fn of(machine: &tezgah_motion::plan::PlanMachine) -> StopLimits {
+        let j = |v: &[f64]| Joints::from_slice(v).unwrap_or_else(|_| Joints::zeros(0));
+        StopLimits {
+            max_acceleration: j(&machine.max_acceleration),
+            max_jerk: j(&machine.max_jerk),
+        }
+    }
+}
+
 /// The real-time loop's counters.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RtCounters {
@@ -155,11 +166,8 @@ impl<D: Drive> RtLoop<D> {
                     self.state = RtState::Stopping;
                     return self.stopping();
                 }
-                Err(_) => {
-                    let mut hold = self.last;
-                    hold.index += 1;
-                    return hold;
-                }
+                // Idle: the last set-point again (same index: no new set-point was due).
+                Err(_) => return self.last,
             }
         }
     }
