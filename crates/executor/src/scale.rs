@@ -52,7 +52,8 @@ pub struct Advance {
 }
 
 /// The plan along one piece, evaluated anywhere (past the end: the end state, with the next
-/// piece's jerk unknown, so both signs of the piece's J are assumed).
+/// piece's jerk unknown, so both signs of the piece's J are assumed; a ramp must settle before
+/// it gets there, see [`TimeScale::can_settle`]).
 struct Plan<'a> {
     profile: &'a Profile,
     limits: &'a Limits,
@@ -134,9 +135,14 @@ impl TimeScale {
             if rd == 0.0 {
                 return true;
             }
-            let (st, _) = plan.at(tau);
+            let (st, beyond) = plan.at(tau);
             if st.v <= 0.0 {
                 return true;
+            }
+            if beyond {
+                // The next piece's limits are not known here (they may be far lower): a ramp
+                // must have settled by the end of its piece, unless the plan stops there.
+                return false;
             }
             if !plan.acc_ok(r, rd, &st) {
                 return false;
@@ -191,7 +197,12 @@ impl TimeScale {
         let step = rdd_max * ts;
         let brake_rate = step * ((0.25 + 2.0 * e.abs() / (step * ts)).sqrt() - 0.5);
         let want = e.signum() * brake_rate.min(rd_max);
-        let direct = ((want - rd) / ts).clamp(-rdd_max, rdd_max);
+        // Speeding the ramp up uses its share; slowing it down may use whatever the full
+        // limits leave (the range below), so a ramp never overshoots for want of braking.
+        let mut direct = (want - rd) / ts;
+        if direct * rd >= 0.0 || want * rd < 0.0 {
+            direct = direct.clamp(-rdd_max, rdd_max);
+        }
         let (lo, hi) = plan.period_range(r, rd, tau, ts);
         let brake = (-rd / ts).clamp(lo.min(hi), hi.max(lo));
         let mut chosen = brake;
