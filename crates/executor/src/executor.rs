@@ -17,7 +17,7 @@ use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
 use crate::job::{Job, JobOptions, PlannedItem};
 use crate::mdi::Mdi;
-use crate::scale::TimeScale;
+use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::SetPoint;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
@@ -91,6 +91,8 @@ pub struct Executor {
     program: Option<Vec<Move>>,
     job: Option<Job>,
     current: Option<Current>,
+    /// The planned item after the current one, taken early for the time scale's look-ahead.
+    peeked: Option<PlannedItem>,
     scale: TimeScale,
     mode: Mode,
     state: RunState,
@@ -151,6 +153,7 @@ impl Executor {
             program: None,
             job: None,
             current: None,
+            peeked: None,
             scale: TimeScale::default(),
             mode: Mode::Auto,
             state: RunState::Idle,
@@ -262,6 +265,7 @@ impl Executor {
         let job = Job::new(moves, &self.machine, &self.job_options(), start, p.joints)?;
         self.job = Some(job);
         self.current = None;
+        self.peeked = None;
         self.mode = mode;
         self.state = RunState::Running;
         self.scale = TimeScale::held();
@@ -375,6 +379,7 @@ impl Executor {
         self.s = 0.0;
         self.job = None;
         self.current = None;
+        self.peeked = None;
         self.state = RunState::Idle;
         self.scale = TimeScale::held();
     }
@@ -441,12 +446,31 @@ impl Executor {
             _ => 1.0,
         };
         let target = self.target(factor);
+        if matches!(self.current, Some(Current::Piece { .. })) && self.peeked.is_none() {
+            // The scale looks into the next piece (its limits may be lower).
+            let factor = (self.override_pct / 100.0).max(1.0);
+            if let Some(job) = self.job.as_mut() {
+                self.peeked = job.next(factor)?;
+            }
+        }
+        let next = match &self.peeked {
+            Some(PlannedItem {
+                item: Planned::Motion(p),
+                ..
+            }) => Some(PieceView {
+                profile: &p.profile,
+                limits: &p.limits,
+            }),
+            _ => None,
+        };
         let dtau = match &self.current {
             Some(Current::Piece { cursor, tau, .. }) => {
                 let p = cursor.piece();
-                self.scale
-                    .step(target, &p.profile, *tau, &p.limits, ts)
-                    .dtau
+                let current = PieceView {
+                    profile: &p.profile,
+                    limits: &p.limits,
+                };
+                self.scale.step(target, current, next, *tau, ts).dtau
             }
             _ => {
                 // Standing still (a dwell): r may jump, nothing moves.
@@ -509,7 +533,11 @@ impl Executor {
             let Some(job) = self.job.as_mut() else {
                 return Ok(Some(Event::Done));
             };
-            let Some(PlannedItem { item, factor }) = job.next(factor)? else {
+            let next = match self.peeked.take() {
+                Some(p) => Some(p),
+                None => job.next(factor)?,
+            };
+            let Some(PlannedItem { item, factor }) = next else {
                 return Ok(Some(Event::Done));
             };
             match item {

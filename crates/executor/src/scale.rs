@@ -51,24 +51,56 @@ pub struct Advance {
     pub dtau: f64,
 }
 
-/// The plan along one piece, evaluated anywhere (past the end: the end state, with the next
-/// piece's jerk unknown, so both signs of the piece's J are assumed; a ramp must settle before
-/// it gets there, see [`TimeScale::can_settle`]).
-struct Plan<'a> {
-    profile: &'a Profile,
-    limits: &'a Limits,
+/// One planned piece as the scale sees it: its profile and path limits.
+#[derive(Clone, Copy)]
+pub struct PieceView<'a> {
+    pub profile: &'a Profile,
+    pub limits: &'a Limits,
 }
 
-impl Plan<'_> {
-    fn at(&self, tau: f64) -> (State, bool) {
-        let d = self.profile.duration();
+/// Where τ falls: the plan's state there and the limits in force, or past what is known.
+struct At<'a> {
+    state: State,
+    limits: &'a Limits,
+    /// Past the pieces known: the end state, jerk unknown.
+    unknown: bool,
+}
+
+/// The plan along the piece in hand and the next one if it is planned already; past them the
+/// end state with the jerk unknown (a ramp must settle before it gets there, see
+/// [`TimeScale::can_settle`]).
+struct Plan<'a> {
+    current: PieceView<'a>,
+    next: Option<PieceView<'a>>,
+}
+
+impl<'a> Plan<'a> {
+    fn at(&self, tau: f64) -> At<'a> {
+        let d = self.current.profile.duration();
         if tau <= d {
-            (self.profile.state_at(tau), false)
-        } else {
-            let mut e = self.profile.end();
-            e.a = 0.0;
-            e.j = 0.0;
-            (e, true)
+            return At {
+                state: self.current.profile.state_at(tau),
+                limits: self.current.limits,
+                unknown: false,
+            };
+        }
+        if let Some(n) = self.next {
+            if tau - d <= n.profile.duration() {
+                return At {
+                    state: n.profile.state_at(tau - d),
+                    limits: n.limits,
+                    unknown: false,
+                };
+            }
+        }
+        let last = self.next.unwrap_or(self.current);
+        let mut e = last.profile.end();
+        e.a = 0.0;
+        e.j = 0.0;
+        At {
+            state: e,
+            limits: last.limits,
+            unknown: true,
         }
     }
 
@@ -77,17 +109,17 @@ impl Plan<'_> {
     /// period, r ≈ r₀ + ṙ₀fTs and ṙ = ṙ₀ + r̈fTs, so s⃛ = r̈(v + 3r·fTs·a) + 3rṙ₀a + r³j is
     /// linear in r̈.
     fn period_range(&self, r: f64, rd: f64, tau: f64, ts: f64) -> (f64, f64) {
-        let j_max = self.limits.max_jerk();
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
             let rf = (r + rd * f * ts).clamp(0.0, 1.0);
-            let (st, beyond) = self.at(tau + f * rf * ts);
+            let at = self.at(tau + f * rf * ts);
+            let (st, j_max) = (at.state, at.limits.max_jerk());
             let c = st.v + 3.0 * rf * f * ts * st.a;
             if c <= 0.0 {
                 continue;
             }
             let cross = 3.0 * rf * rd * st.a;
-            let (l, h) = if beyond {
+            let (l, h) = if at.unknown {
                 let room = j_max * (1.0 - rf * rf * rf) - cross.abs();
                 (-room / c, room / c)
             } else {
@@ -104,8 +136,8 @@ impl Plan<'_> {
     }
 
     /// |s̈| ≤ A at rate rd.
-    fn acc_ok(&self, r: f64, rd: f64, st: &State) -> bool {
-        (rd * st.v + r * r * st.a).abs() <= self.limits.max_acceleration() * (1.0 + SLACK)
+    fn acc_ok(r: f64, rd: f64, at: &At) -> bool {
+        (rd * at.state.v + r * r * at.state.a).abs() <= at.limits.max_acceleration() * (1.0 + SLACK)
     }
 }
 
@@ -135,16 +167,16 @@ impl TimeScale {
             if rd == 0.0 {
                 return true;
             }
-            let (st, beyond) = plan.at(tau);
-            if st.v <= 0.0 {
+            let at = plan.at(tau);
+            if at.state.v <= 0.0 {
                 return true;
             }
-            if beyond {
-                // The next piece's limits are not known here (they may be far lower): a ramp
-                // must have settled by the end of its piece, unless the plan stops there.
+            if at.unknown {
+                // The limits past the pieces known may be far lower: a ramp must have settled
+                // by then, unless the plan stops there.
                 return false;
             }
-            if !plan.acc_ok(r, rd, &st) {
+            if !Plan::acc_ok(r, rd, &at) {
                 return false;
             }
             let (lo, hi) = plan.period_range(r, rd, tau, ts);
@@ -165,19 +197,20 @@ impl TimeScale {
         false
     }
 
-    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) at path time `tau` of a
-    /// piece planned as `profile` under path `limits`.
+    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) at path time `tau` of the
+    /// piece in hand (`next`: the following piece, if planned already).
     pub fn step(
         &mut self,
         target: f64,
-        profile: &Profile,
+        current: PieceView,
+        next: Option<PieceView>,
         tau: f64,
-        limits: &Limits,
         ts: f64,
     ) -> Advance {
         let target = target.clamp(0.0, 1.0);
-        let plan = Plan { profile, limits };
-        let (st, _) = plan.at(tau);
+        let plan = Plan { current, next };
+        let limits = current.limits;
+        let st = plan.at(tau).state;
         let v = st.v.max(0.0);
         if v == 0.0 && st.a == 0.0 {
             // The plan is at rest here: r may jump (ṡ = s̈ = 0 whatever r is; s⃛ = r³j ≤ J).
@@ -212,8 +245,8 @@ impl TimeScale {
             if !(-SLACK..=1.0 + SLACK).contains(&r1) {
                 continue;
             }
-            let (st1, _) = plan.at(tau + dtau.max(0.0));
-            if plan.acc_ok(r1, rd1, &st1)
+            let at1 = plan.at(tau + dtau.max(0.0));
+            if Plan::acc_ok(r1, rd1, &at1)
                 && Self::can_settle(&plan, r1.clamp(0.0, 1.0), rd1, tau + dtau.max(0.0), ts)
             {
                 chosen = rdd;

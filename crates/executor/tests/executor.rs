@@ -338,3 +338,21 @@ fn commands_and_status_are_json() {
         .is_err());
     assert!(exec.command(Command::CycleStart).is_err());
 }
+
+/// Cases random search found: a hold just before a piece whose limits are far lower (the
+/// ramp overshot r = 1 on resume there: jerk 2× the limit), and a hold near a piece end
+/// (before the scale looked into the next piece it had to settle first and travelled 4.4×
+/// the jerk-limited distance).
+#[test]
+fn holds_found_by_random_search() {
+    for (seed, frac) in [
+        (15152404201983452069u64, 0.1857791240018144),
+        (9140456590163406861, 0.4674030868806516),
+    ] {
+        let program = random_program(seed, 12);
+        let full = reference(&program);
+        let at = ((full.len() as f64) * frac) as usize;
+        let out = hold_and_resume(&program, at);
+        assert!((full.last().unwrap().tip - out.last().unwrap().tip).norm() <= 1e-9);
+    }
+}
