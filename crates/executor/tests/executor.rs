@@ -120,9 +120,8 @@ proptest! {
         prop_assert!((a.tip - b.tip).norm() <= 1e-9);
     }
 
-    /// Override changes at random instants (0–200 %): limits and path hold, the path is
-    /// traced once, and the speed never exceeds the override times the uninterrupted speed
-    /// cap at any point of the path.
+    /// Override changes at random instants (0–200 %): limits and path hold, and the path is
+    /// traced once to the same end.
     #[test]
     fn override_changes_anywhere(seed in any::<u64>(),
                                  changes in proptest::collection::vec((0.0..1.0f64, 0.0..=200.0f64), 1..5)) {
@@ -355,4 +354,41 @@ fn holds_found_by_random_search() {
         let out = hold_and_resume(&program, at);
         assert!((full.last().unwrap().tip - out.last().unwrap().tip).norm() <= 1e-9);
     }
+}
+
+/// Override scales the feed both ways: 50 % halves the cruise speed at once, 200 % doubles it
+/// for moves planned after the change; the limits still cap it.
+#[test]
+fn override_scales_the_programmed_feed() {
+    let program = "G21 G90 F600\nG1 X50\nG1 X100\nG1 X150\nM2\n";
+    let peak = |percent: f64| {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::FeedOverride { percent }).unwrap();
+        run_program(&mut exec, &mut trace, program);
+        let (out, report) = trace.report();
+        assert_within(&report, RETIME_JERK);
+        assert_continuous(&out);
+        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+    };
+    let (v100, n100) = peak(100.0);
+    let (v50, n50) = peak(50.0);
+    let (v200, n200) = peak(200.0);
+    assert!((v100 - 10.0).abs() < 1e-9, "{v100}");
+    assert!((v50 - 5.0).abs() < 1e-6, "{v50}");
+    assert!((v200 - 20.0).abs() < 1e-9, "{v200}");
+    // Cruise dominates: 150 mm at 10 mm/s is 15 s.
+    assert!((n50 as f64 / n100 as f64 - 2.0).abs() < 0.01);
+    assert!((n100 as f64 / n200 as f64 - 2.0).abs() < 0.02);
+    // 20 000 mm/min is beyond the machine (200 mm/s on X): the limit caps it.
+    let fast = "G21 G90 F9000\nG1 X150\nM2\n";
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::FeedOverride { percent: 200.0 })
+        .unwrap();
+    run_program(&mut exec, &mut trace, fast);
+    let (out, report) = trace.report();
+    assert_within(&report, RETIME_JERK);
+    let top = out.iter().map(|p| p.feed).fold(0.0, f64::max);
+    assert!(top <= 200.0 * (1.0 + 1e-9) && top > 150.0, "{top}");
 }
