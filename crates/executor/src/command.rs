@@ -76,8 +76,14 @@ pub enum RunState {
 pub struct Status {
     pub mode: Mode,
     pub state: RunState,
-    /// Source line of the last set-point produced (0 outside a program).
+    /// Source line of the last set-point produced (0 outside a program); the planner runs a
+    /// ring ahead of the machine.
     pub line: u32,
+    /// Source line of the set-point the real-time thread applied last (what the machine is
+    /// executing); 0 when no real-time side reports (the executor alone).
+    pub executing_line: u32,
+    /// Underruns the real-time side counted.
+    pub underruns: u64,
     /// Set-point counter.
     pub index: u64,
     pub feed_override_percent: f64,

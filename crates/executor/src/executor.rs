@@ -207,6 +207,8 @@ impl Executor {
             mode: self.mode,
             state: self.state,
             line: self.pose.line,
+            executing_line: 0,
+            underruns: 0,
             index: self.k,
             feed_override_percent: self.override_pct,
             single_block: self.single_block,

@@ -17,6 +17,9 @@ use crate::executor::Executor;
 use crate::ring::{rings, Rings, RtReport, RtState, Slot};
 use crate::rt::{Jitter, RealClock, RtCounters, RtLoop, StopLimits};
 
+/// Set-points the ring holds by default: 32 ms at 1 ms — commands act within that.
+pub const DEFAULT_RING: usize = 32;
+
 /// How far the planner keeps ahead of the real-time thread, in set-points.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct Lead {
@@ -71,6 +74,16 @@ impl PlannerSide {
 
     pub fn executor(&self) -> &Executor {
         &self.exec
+    }
+
+    /// The executor's status with what the real-time side reported last.
+    pub fn status(&self) -> Status {
+        let mut s = self.exec.status();
+        if let Some(r) = &self.last {
+            s.executing_line = r.line;
+            s.underruns = r.underruns;
+        }
+        s
     }
 
     /// The last real-time report read.
@@ -197,7 +210,7 @@ pub fn spawn<D: Drive + Send + 'static>(
                 }
                 side.pump();
                 if let Ok(mut s) = st.lock() {
-                    *s = side.executor().status();
+                    *s = side.status();
                 }
                 // A quarter period: the ring (tens of periods) never runs dry on a sleep.
                 std::thread::sleep(Duration::from_secs_f64(period / 4.0));

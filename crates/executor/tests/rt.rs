@@ -49,9 +49,18 @@ fn every_setpoint_once_in_order() {
     let (mut side, mut rt) = rig(24);
     side.command(Command::Load { program }).unwrap();
     side.command(Command::CycleStart).unwrap();
-    for _ in 0..(produced.len() + 100) {
+    for k in 0..(produced.len() + 100) {
         side.pump();
         rt.tick();
+        if k == produced.len() / 2 {
+            // The machine executes the set-point the ring delivered this period; the
+            // planner is up to a ring ahead.
+            let s = side.status();
+            let applied = rt.last();
+            assert_eq!(s.executing_line, applied.line);
+            let ahead = s.index - applied.index;
+            assert!((1..=24).contains(&ahead), "{ahead}");
+        }
     }
     assert_eq!(side.executor().state(), RunState::Idle);
     let c = rt.counters();
