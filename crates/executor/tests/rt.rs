@@ -153,3 +153,58 @@ fn underrun_is_a_jerk_limited_stop() {
         side.executor().status()
     );
 }
+
+/// The two threads through their handle: an MDI move on the real clock, status back.
+#[test]
+fn spawned_threads_run_a_command() {
+    use std::time::{Duration, Instant};
+    use tezgah_executor::threads::{spawn, DEFAULT_RING};
+    let exec = executor();
+    let limits = StopLimits::of(exec.machine());
+    let handle = spawn(exec, IdealDrive, limits, DEFAULT_RING);
+    handle
+        .commands
+        .send(Command::Mdi {
+            block: "G21 G90 G0 X5 Y-3".into(),
+        })
+        .unwrap();
+    let t0 = Instant::now();
+    let mut done = false;
+    while t0.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+        let s = handle.status.lock().unwrap().clone();
+        if s.state == RunState::Fault {
+            // A stall of the shared machine longer than the ring (an underrun): abort, again.
+            handle.commands.send(Command::Abort).unwrap();
+            handle
+                .commands
+                .send(Command::Mdi {
+                    block: "G0 X5 Y-3".into(),
+                })
+                .unwrap();
+            continue;
+        }
+        if s.state == RunState::Idle
+            && (s.tip[0] - 5.0).abs() < 1e-9
+            && (s.tip[1] + 3.0).abs() < 1e-9
+        {
+            done = true;
+            break;
+        }
+    }
+    // A refused command comes back as an error.
+    handle
+        .commands
+        .send(Command::FeedOverride { percent: -1.0 })
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(50));
+    let refused = handle.errors.try_recv();
+    let figures = handle.stop();
+    assert!(done, "the move did not finish");
+    assert!(matches!(
+        refused,
+        Ok(tezgah_executor::error::ExecError::Override(_))
+    ));
+    assert!(figures.rt.delivered > 0);
+    assert!(figures.rt.periods >= figures.rt.delivered);
+}
