@@ -18,9 +18,11 @@
 
 use tezgah_motion::{Limits, Profile, State};
 
-/// The ramp of r alone may use this share of the path limits (its own rate and acceleration
-/// bounds); the checks against the plan's terms use the full limits.
-const RAMP_SHARE: f64 = 0.5;
+/// Share of the path limits for the ramp's own rate and acceleration bounds (A/v, J/v); the
+/// checks against the plan's terms use the full limits either way. Half was tried first: holds
+/// then took 1.4× the time-optimal distance from cruise; the whole share reaches it (1.00×)
+/// with no more jerk (the checks, not this share, keep the limits).
+const RAMP_SHARE: f64 = 1.0;
 
 /// Largest change of r in one period.
 const MAX_SWING: f64 = 0.1;
