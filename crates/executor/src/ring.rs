@@ -36,8 +36,8 @@ pub enum RtState {
 pub struct RtReport {
     /// Periods run since the loop started.
     pub period: u64,
-    /// Index of the set-point applied this period (the producer's counter; an extrapolated
-    /// stop continues it).
+    /// Index of the set-point applied this period (the producer's counter; idle periods and
+    /// an extrapolated stop repeat the last one).
     pub index: u64,
     /// Source line of the set-point applied.
     pub line: u32,

@@ -185,8 +185,10 @@ impl<D: Drive> RtLoop<D> {
             self.state = RtState::Halted;
             self.stop = None;
         }
+        // The stop keeps the index of the set-point it continues: indices stay the producer's
+        // (never ahead of what it will send next), so they never go back.
         SetPoint {
-            index: self.last.index + 1,
+            index: self.last.index,
             line,
             position: s.position,
             velocity: s.velocity,

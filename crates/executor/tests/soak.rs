@@ -164,8 +164,9 @@ fn real_clock_soak() {
     // the ring at most its capacity.
     let applied = counters.delivered + counters.discarded;
     assert!(applied as usize <= pushed && pushed - applied as usize <= capacity);
-    // In order, each once: indices never go back, and step by one while moving (a repeat is
-    // an idle period holding the last set-point).
+    // In order, each once: indices never go back (idle periods and an underrun's stop repeat
+    // the last index), and without underruns they step by one while moving (after one, the
+    // set-points discarded while halted leave a gap).
     let rec = &rt.drive().indices;
     for w in rec.windows(2) {
         assert!(w[1] >= w[0], "index went back: {} after {}", w[1], w[0]);
