@@ -388,9 +388,13 @@ impl Executor {
 
     /// The real-time side halted (underrun or drive fault) at `joints`: the job is lost.
     pub fn fault(&mut self, joints: Joints, message: &str) {
+        // A job error that caused the halt stays the message.
+        let job_failed = self.state == RunState::Fault;
         self.drop_job();
         self.state = RunState::Fault;
-        self.error = Some(message.to_owned());
+        if !job_failed {
+            self.error = Some(message.to_owned());
+        }
         // The joints are the truth now; the tip follows where the model says (an underrun
         // stop leaves the path by a little).
         if let Ok(p) = tezgah_kinematics::Kinematics::forward(
@@ -423,11 +427,15 @@ impl Executor {
         match self.advance_one() {
             Ok(p) => Ok(p),
             Err(e) => {
-                // A job that fails mid-way stops where the plan is (the pre-flight of a
-                // program catches the failures it can before anything moves).
-                self.error = Some(e.to_string());
+                // A job that fails mid-way (a pose out of reach: the program's pre-flight
+                // catches only what the interpreter sees) produces nothing more: the
+                // real-time side meets an empty ring while moving, an underrun, and brings
+                // the joints to rest jerk-limited — never the jump a rest set-point here
+                // would be.
                 self.drop_job();
-                Ok(Some(self.emit(true, 0.0)))
+                self.state = RunState::Fault;
+                self.error = Some(e.to_string());
+                Ok(None)
             }
         }
     }

@@ -57,6 +57,8 @@ pub struct PlannerSide {
     lead: Lead,
     /// A re-arm is on its way: reports still saying "halted" are older than it.
     rearming: bool,
+    /// The executor has been told of the current halt.
+    halt_seen: bool,
 }
 
 impl PlannerSide {
@@ -69,6 +71,7 @@ impl PlannerSide {
             last: None,
             lead: Lead::default(),
             rearming: false,
+            halt_seen: false,
         }
     }
 
@@ -103,6 +106,7 @@ impl PlannerSide {
             // The ring has room: the real-time side discards set-points while halted.
             let _ = self.rings.setpoints.push(Slot::Rearm);
             self.rearming = true;
+            self.halt_seen = false;
         }
         Ok(())
     }
@@ -116,8 +120,8 @@ impl PlannerSide {
             if self.rearming && r.state == RtState::Running {
                 self.rearming = false;
             }
-            if r.state == RtState::Halted && !self.rearming && self.exec.state() != RunState::Fault
-            {
+            if r.state == RtState::Halted && !self.rearming && !self.halt_seen {
+                self.halt_seen = true;
                 let why = match r.fault {
                     Some(f) => format!("drive fault {f:?}"),
                     None => format!("set-point underrun ({} so far)", r.underruns),

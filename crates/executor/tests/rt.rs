@@ -208,3 +208,45 @@ fn spawned_threads_run_a_command() {
     assert!(figures.rt.delivered > 0);
     assert!(figures.rt.periods >= figures.rt.delivered);
 }
+
+/// A job that fails while the machine moves (a pose beyond a joint limit: nothing before the
+/// sampling checks position limits, so it is met at X = 200.1 while moving) stops producing:
+/// the real-time side sees an underrun and stops jerk-limited; the executor reports the
+/// job's error with its line.
+#[test]
+fn a_job_error_in_motion_stops_like_an_underrun() {
+    let mut program = String::from("G21 G90 F6000\n");
+    for k in 0..150 {
+        program.push_str(if k % 2 == 0 { "G1 X10\n" } else { "G1 X0\n" });
+    }
+    program.push_str("G1 X250\nM2\n");
+    let (mut side, mut rt) = rig(16);
+    side.command(Command::Load { program }).unwrap();
+    side.command(Command::CycleStart).unwrap();
+    for _ in 0..60_000 {
+        side.pump();
+        rt.tick();
+        if rt.state() == RtState::Halted {
+            break;
+        }
+    }
+    assert_eq!(rt.state(), RtState::Halted);
+    assert_eq!(rt.counters().underruns, 1);
+    side.pump();
+    let s = side.status();
+    assert_eq!(s.state, RunState::Fault);
+    let error = s.error.unwrap();
+    assert!(error.contains("line 152"), "{error}");
+    let ts = side.executor().period();
+    let seen = &rt.drive().seen;
+    assert!(seen.len() > 1000, "it failed while moving, not before");
+    for w in seen.windows(4) {
+        let q = |k: usize| w[k].position.as_slice()[0];
+        let j = (q(3) - 3.0 * q(2) + 3.0 * q(1) - q(0)) / (ts * ts * ts);
+        let a = (q(3) - 2.0 * q(2) + q(1)) / (ts * ts);
+        assert!(
+            j.abs() <= 50_000.0 * 1.005 && a.abs() <= 2000.0 * 1.005,
+            "a {a} j {j}"
+        );
+    }
+}
