@@ -395,3 +395,46 @@ fn override_scales_the_programmed_feed() {
     let top = out.iter().map(|p| p.feed).fold(0.0, f64::max);
     assert!(top <= 200.0 * (1.0 + 1e-9) && top > 150.0, "{top}");
 }
+
+/// At cruise a hold acts in the next period and stops in the time-optimal jerk-limited time
+/// (from 10 mm/s under mill3's path limits) plus the last periods of the discrete approach.
+#[test]
+fn hold_acts_at_once() {
+    let program = "G21 G90 F600\nG1 X150\nM2\n";
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::Load {
+        program: program.into(),
+    })
+    .unwrap();
+    exec.command(Command::CycleStart).unwrap();
+    let at = 3000;
+    drive(&mut exec, &mut trace, 100_000, |k, e| {
+        if k == at {
+            e.command(Command::FeedHold).unwrap();
+        }
+    });
+    assert_eq!(exec.state(), RunState::Held);
+    let out = &trace.out;
+    assert!((out[at - 1].feed - 10.0).abs() < 1e-9, "cruising");
+    assert!(
+        out[at].feed < out[at - 1].feed,
+        "slowing from the next period"
+    );
+    let l = exec.path_limits().unwrap();
+    let (v, a, j) = (10.0, l.max_acceleration(), l.max_jerk());
+    // v < A²/J here, so the optimal stop never reaches A: t = 2√(v/J).
+    let optimal = if v > a * a / j {
+        v / a + a / j
+    } else {
+        2.0 * (v / j).sqrt()
+    };
+    let took = (out.len() - at) as f64 * exec.period();
+    assert!(
+        took <= optimal + 2.0 * exec.period(),
+        "{took} s vs {optimal} s"
+    );
+    let (out, report) = trace.report();
+    assert_within(&report, RETIME_JERK);
+    assert_continuous(&out);
+}
