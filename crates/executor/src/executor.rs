@@ -483,10 +483,15 @@ impl Executor {
                 self.scale.step(target, current, next, *tau, ts).dtau
             }
             _ => {
-                // Standing still (a dwell): r may jump, nothing moves.
+                // Standing still (a dwell): r may jump, nothing moves. A dwell is wall time
+                // (override does not stretch it, as on LinuxCNC); a hold or an abort stops it.
                 self.scale.r = target;
                 self.scale.rate = 0.0;
-                target * ts
+                if target > 0.0 {
+                    ts
+                } else {
+                    0.0
+                }
             }
         };
         let event = self.advance(dtau)?;

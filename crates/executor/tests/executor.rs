@@ -439,3 +439,49 @@ fn hold_acts_at_once() {
     assert_within(&report, RETIME_JERK);
     assert_continuous(&out);
 }
+
+/// A dwell is wall time: 50 % override doubles the motion's time, not the dwell's; a hold
+/// during the dwell holds it.
+#[test]
+fn dwell_runs_in_wall_time() {
+    let periods = |program: &str, percent: f64, hold_at: Option<usize>| {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::FeedOverride { percent }).unwrap();
+        exec.command(Command::Load {
+            program: program.into(),
+        })
+        .unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        let mut held = 0;
+        drive(&mut exec, &mut trace, 100_000, |k, e| {
+            if Some(k) == hold_at {
+                e.command(Command::FeedHold).unwrap();
+            }
+        });
+        if exec.state() == RunState::Held {
+            // Held inside the dwell: nothing is produced, the dwell does not run.
+            held = trace.out.len();
+            exec.command(Command::Resume).unwrap();
+            drive(&mut exec, &mut trace, 100_000, |_, _| {});
+        }
+        assert_eq!(exec.state(), RunState::Idle);
+        (trace.out.len(), held)
+    };
+    let motion = "G21 G90 F600\nG1 X10\nM2\n";
+    let dwell = "G21 G90 F600\nG1 X10\nG4 P0.5\nM2\n";
+    let (m100, _) = periods(motion, 100.0, None);
+    let (m50, _) = periods(motion, 50.0, None);
+    let (d100, _) = periods(dwell, 100.0, None);
+    let (d50, _) = periods(dwell, 50.0, None);
+    // 500 periods of dwell in both, within a period or two.
+    assert!(
+        (d100 as i64 - m100 as i64 - 500).abs() <= 2,
+        "{d100} {m100}"
+    );
+    assert!((d50 as i64 - m50 as i64 - 500).abs() <= 2, "{d50} {m50}");
+    // A hold 100 periods into the dwell: the rest of the dwell still runs after resume.
+    let (dh, held) = periods(dwell, 100.0, Some(m100 + 100));
+    assert!(held > 0, "held inside the dwell");
+    assert!((dh as i64 - d100 as i64).abs() <= 2, "{dh} vs {d100}");
+}
