@@ -268,3 +268,55 @@ impl TimeScale {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use tezgah_motion::solve;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// On a cruise at the speed limit, targets switching at random periods: r stays in
+        /// [0, 1], reaches each target, and the re-timed path keeps A and J (third
+        /// differences at the period, as a drive sees them).
+        #[test]
+        fn ramps_keep_the_limits(v in 1.0..300.0f64, a in 100.0..5000.0f64, j in 1e3..1e6f64,
+                                 targets in proptest::collection::vec((0.0..=1.0f64, 1usize..400), 1..6)) {
+            let limits = Limits::new(v, a, j).unwrap();
+            let ts = 0.001;
+            let length = v * 10.0;
+            let profile = solve(length, v, v, &limits).unwrap();
+            let piece = PieceView { profile: &profile, limits: &limits };
+            let mut scale = TimeScale::default();
+            let mut tau = 0.0;
+            let mut s = vec![0.0];
+            for &(target, periods) in &targets {
+                for _ in 0..periods {
+                    tau += scale.step(target, piece, None, tau, ts).dtau;
+                    prop_assert!((0.0..=1.0).contains(&scale.r));
+                    s.push(profile.state_at(tau).s);
+                }
+            }
+            // Near a target held long enough (the stop from full speed takes at most
+            // v/A + A/J + the discrete tail). Short of r = 0 or 1 the discrete approach may
+            // circle a target by its smallest move, a period at r̈_max (r̈_max·Ts², r̈_max =
+            // min(J/v, MAX_SWING/4Ts²)): a speed ripple of that share, within the limits
+            // checked below. (A proportional end zone removed the circling but cost jerk
+            // elsewhere — 1.06 J on a random hold — and was left out.)
+            let (last, periods) = *targets.last().unwrap();
+            let resolution = (j / v).min(MAX_SWING / (4.0 * ts * ts)) * ts * ts;
+            if (periods as f64) * ts > 2.0 * (v / a + a / j) + 0.02 {
+                prop_assert!((scale.r - last).abs() <= resolution + 1e-9,
+                    "r {} target {last} resolution {resolution}", scale.r);
+            }
+            for w in s.windows(4) {
+                let acc = (w[3] - 2.0 * w[2] + w[1]) / (ts * ts);
+                let jerk = (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]) / (ts * ts * ts);
+                prop_assert!(acc.abs() <= a * 1.005 + 1e-6, "a {acc} of {a}");
+                prop_assert!(jerk.abs() <= j * 1.03 + 1e-3, "j {jerk} of {j}");
+            }
+        }
+    }
+}
