@@ -1,11 +1,24 @@
 //! tezgah-executor: the real-time loop, operating modes and drives.
 //!
-//! Takes timed samples from tezgah-motion and hands one [`SetPoint`] per period to a
-//! [`Drive`]. It grows with the executor issue.
+//! A planner thread runs the [`executor::Executor`] (modes, commands, jobs planned on demand,
+//! re-timed sampling for feed hold and override) and keeps a short lock-free [`ring`] of
+//! [`SetPoint`]s filled; the real-time thread ([`rt::RtLoop`]) takes exactly one per period
+//! and hands it to a [`Drive`], turning an underrun into a jerk-limited [`stop`]. Commands and
+//! status ([`command`]) are plain serde data for a front end.
 
+pub mod command;
 pub mod drive;
+pub mod error;
+pub mod executor;
+pub mod job;
 pub mod manual;
+pub mod mdi;
+pub mod ring;
+pub mod rt;
+pub mod scale;
 pub mod setpoint;
+pub mod stop;
+pub mod threads;
 
 pub use drive::{Drive, DriveFault, DriveStatus};
 pub use setpoint::SetPoint;

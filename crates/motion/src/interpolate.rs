@@ -42,13 +42,13 @@ pub struct Sample {
 
 /// s → u on one segment: identity for arc-length parametrised curves (lines), otherwise an
 /// arc-length map built once per segment.
-struct Param {
+pub(crate) struct Param {
     map: Option<ArcLengthMap>,
     scale: f64,
 }
 
 impl Param {
-    fn new(seg: &Segment) -> Param {
+    pub(crate) fn new(seg: &Segment) -> Param {
         let (a, b) = seg.curve.domain();
         if seg.rotary_only() || (a == 0.0 && b == seg.length) {
             return Param {
@@ -85,7 +85,7 @@ impl Param {
         }
     }
 
-    fn u(&self, seg: &Segment, s: f64) -> f64 {
+    pub(crate) fn u(&self, seg: &Segment, s: f64) -> f64 {
         let (a, _) = seg.curve.domain();
         match &self.map {
             Some(m) => m.u_at(&*seg.curve, s * self.scale),

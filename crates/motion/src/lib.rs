@@ -4,9 +4,12 @@
 //! [`path`] (moves → segments), [`takeup`] (the joint move at a tool-centre-point switch),
 //! [`preflight`] (every segment's joints within reach and limits before anything moves),
 //! [`plan`] (speed limits, look-ahead, one [`profile`] per group of segments), [`interpolate`]
-//! (samples at the period, joints by the kinematics under each segment's tool control) and
+//! (samples at the period, joints by the kinematics under each segment's tool control;
+//! [`cursor`] places the tool at any path coordinate of a piece, for the executor's re-timed
+//! sampling) and
 //! [`verify`] (the post-run replay).
 
+pub mod cursor;
 pub mod interpolate;
 pub mod path;
 pub mod plan;

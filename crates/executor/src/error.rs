@@ -1,0 +1,40 @@
+//! The executor's typed errors: refused commands and failures of the motion stack below.
+
+/// Why a command was refused or a job failed.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum ExecError {
+    #[error("{command} is not possible while {state}")]
+    Busy {
+        command: &'static str,
+        state: &'static str,
+    },
+    #[error("no program loaded")]
+    NoProgram,
+    #[error("feed override {0} % is outside 0–200 %")]
+    Override(f64),
+    #[error("line {0} is not a line of the program with motion after it")]
+    NoSuchLine(u32),
+    #[error("program: {0}")]
+    Gcode(String),
+    #[error("path: {0}")]
+    Path(tezgah_motion::path::smooth::PathError),
+    #[error("plan: {0}")]
+    Plan(tezgah_motion::plan::PlanError),
+    #[error("line {line}: kinematics: {message}")]
+    Kinematics { line: u32, message: String },
+    #[error("machine: {0}")]
+    Machine(String),
+}
+
+impl From<tezgah_motion::interpolate::InterpolateError> for ExecError {
+    fn from(e: tezgah_motion::interpolate::InterpolateError) -> Self {
+        match e {
+            tezgah_motion::interpolate::InterpolateError::Kinematics { line, source } => {
+                ExecError::Kinematics {
+                    line,
+                    message: source.to_string(),
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,752 @@
+//! The executor's non-real-time half: operating modes, commands and the re-timed sampling of
+//! the plan into set-points. It runs on the planner thread (or a test's virtual clock): every
+//! [`Executor::step`] produces the next period's set-point, which the thread pushes into the
+//! ring. Feed override and hold act on the time scale ([`crate::scale`]) here, where samples
+//! are produced, so a command reaches the machine after the ring's few periods.
+
+use std::sync::Arc;
+
+use tezgah_geom::{Move, MoveKind, Pose, StopKind, Vec3};
+use tezgah_kinematics::{Joints, Machine, TcpSwitch};
+use tezgah_motion::cursor::{CursorPose, PieceCursor};
+use tezgah_motion::path::smooth::{SmoothOptions, CHORD_SHARE};
+use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
+use tezgah_motion::{Junction, Segment};
+
+use crate::command::{Command, Mode, PauseReason, RunState, Status};
+use crate::error::ExecError;
+use crate::job::{Job, JobOptions, PlannedItem};
+use crate::mdi::Mdi;
+use crate::scale::{PieceView, TimeScale};
+use crate::setpoint::SetPoint;
+
+/// One produced period: the set-point and, for checks and displays, where the tip is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Produced {
+    pub setpoint: SetPoint,
+    /// Tool tip, workpiece frame, mm.
+    pub tip: Vec3,
+    /// A B C, degrees.
+    pub rotary: [f64; 3],
+    /// Path speed this period, mm/s (r times the plan's).
+    pub feed: f64,
+    /// Path coordinate run since the executor started (mm, degrees on rotary-only moves):
+    /// monotone, so a hold and resume can be checked to lose and repeat nothing.
+    pub path: f64,
+}
+
+/// Settings of the executor.
+#[derive(Debug, Clone)]
+pub struct ExecOptions {
+    pub period: f64,
+    pub smooth: SmoothOptions,
+    pub plan: PlanOptions,
+}
+
+impl ExecOptions {
+    /// The machine file's period and tolerance, a short look-ahead (the planner thread works
+    /// only as far ahead as needed) and `tezgah run`'s tolerance split.
+    pub fn for_machine(machine: &Machine) -> ExecOptions {
+        let period = machine.motion.period_s;
+        ExecOptions {
+            period,
+            smooth: SmoothOptions {
+                tolerance: machine.motion.tolerance_mm,
+                window: 64,
+                ..SmoothOptions::default()
+            },
+            plan: PlanOptions {
+                period,
+                chord_share: CHORD_SHARE,
+                ..PlanOptions::default()
+            },
+        }
+    }
+}
+
+enum Current {
+    Piece {
+        cursor: PieceCursor,
+        tau: f64,
+        factor: f64,
+    },
+    Dwell {
+        left: f64,
+        line: u32,
+    },
+}
+
+/// What advancing along the job met.
+enum Event {
+    Moving,
+    Paused(PauseReason),
+    Done,
+}
+
+/// The executor: modes, commands, the job in hand and its sampling.
+pub struct Executor {
+    machine: PlanMachine,
+    options: ExecOptions,
+    gcode: tezgah_gcode::Config,
+    program: Option<Vec<Move>>,
+    job: Option<Job>,
+    current: Option<Current>,
+    /// The planned item after the current one, taken early for the time scale's look-ahead.
+    peeked: Option<PlannedItem>,
+    scale: TimeScale,
+    mode: Mode,
+    state: RunState,
+    override_pct: f64,
+    single_block: bool,
+    optional_stop: bool,
+    mdi: Mdi,
+    /// The modal moves MDI blocks have made (feed, feed mode, path mode, …), last of each
+    /// kind: every MDI job starts with them, as the interpreter's modal state carries over.
+    mdi_modal: Vec<Move>,
+    /// Where the MDI interpreter believes the machine is (the end of its last move).
+    mdi_at: Pose,
+    error: Option<String>,
+    /// Where the tool is (the last sample, or a piece's exact end).
+    pose: CursorPose,
+    k: u64,
+    prev_joints: Joints,
+    prev_velocity: Joints,
+    /// Segments passed since the last set-point (for path checks).
+    passed: Vec<Arc<Segment>>,
+    /// Path length of the pieces finished, and where in the current one the tool is.
+    done_length: f64,
+    s: f64,
+}
+
+fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
+    let mut out = *a;
+    for (o, y) in out.as_mut_slice().iter_mut().zip(b.as_slice()) {
+        *o = (*o - y) * scale;
+    }
+    out
+}
+
+impl Executor {
+    /// An executor for `machine` standing at program pose `start`.
+    pub fn new(machine: &Machine, options: ExecOptions, start: Pose) -> Result<Self, ExecError> {
+        let pm = PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
+        let tip = Vec3::from(start.xyz());
+        let rotary = [start.0[3], start.0[4], start.0[5]];
+        let joints = pm
+            .joints(pm.initial, &tip, &rotary, &Joints::zeros(pm.joint_count()))
+            .map_err(|e| ExecError::Kinematics {
+                line: 0,
+                message: e.to_string(),
+            })?;
+        let gcode = tezgah_gcode::Config {
+            tool_centre_point_always: machine.tcp == TcpSwitch::Always,
+            ..tezgah_gcode::Config::default()
+        };
+        let n = pm.joint_count();
+        Ok(Executor {
+            machine: pm,
+            options,
+            mdi: Mdi::new(gcode.clone()),
+            mdi_modal: Vec::new(),
+            mdi_at: Pose::ZERO,
+            gcode,
+            program: None,
+            job: None,
+            current: None,
+            peeked: None,
+            scale: TimeScale::default(),
+            mode: Mode::Auto,
+            state: RunState::Idle,
+            override_pct: 100.0,
+            single_block: false,
+            optional_stop: false,
+            error: None,
+            pose: CursorPose {
+                line: 0,
+                tip,
+                rotary,
+                joints,
+            },
+            k: 0,
+            prev_joints: joints,
+            prev_velocity: Joints::zeros(n),
+            passed: Vec::new(),
+            done_length: 0.0,
+            s: 0.0,
+        })
+    }
+
+    pub fn period(&self) -> f64 {
+        self.options.period
+    }
+
+    pub fn state(&self) -> RunState {
+        self.state
+    }
+
+    /// The machine as the planner sees it.
+    pub fn machine(&self) -> &PlanMachine {
+        &self.machine
+    }
+
+    /// The path limits (speed, acceleration, jerk along the path) of the piece in hand.
+    pub fn path_limits(&self) -> Option<tezgah_motion::Limits> {
+        match &self.current {
+            Some(Current::Piece { cursor, .. }) => Some(cursor.piece().limits),
+            _ => None,
+        }
+    }
+
+    /// The segments the tool passed since the previous set-point, ending with its own.
+    pub fn passed(&self) -> &[Arc<Segment>] {
+        &self.passed
+    }
+
+    pub fn status(&self) -> Status {
+        Status {
+            mode: self.mode,
+            state: self.state,
+            line: self.pose.line,
+            executing_line: 0,
+            underruns: 0,
+            index: self.k,
+            feed_override_percent: self.override_pct,
+            single_block: self.single_block,
+            optional_stop: self.optional_stop,
+            program_loaded: self.program.is_some(),
+            joints: self.pose.joints.as_slice().to_vec(),
+            tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
+            time_scale: self.scale.r,
+            error: self.error.clone(),
+        }
+    }
+
+    fn state_name(&self) -> &'static str {
+        match self.state {
+            RunState::Idle => "idle",
+            RunState::Running => "running",
+            RunState::Holding => "holding",
+            RunState::Held => "held",
+            RunState::Paused { .. } => "paused",
+            RunState::Aborting => "aborting",
+            RunState::Fault => "in fault",
+        }
+    }
+
+    fn busy(&self, command: &'static str) -> ExecError {
+        ExecError::Busy {
+            command,
+            state: self.state_name(),
+        }
+    }
+
+    fn job_options(&self) -> JobOptions {
+        JobOptions {
+            smooth: self.options.smooth.clone(),
+            plan: self.options.plan,
+            single_block: self.single_block,
+        }
+    }
+
+    /// The tool's pose in the coordinates of the moves (mm, degrees).
+    fn program_pose(&self) -> Pose {
+        let p = &self.pose;
+        Pose::new(
+            p.tip.x,
+            p.tip.y,
+            p.tip.z,
+            p.rotary[0],
+            p.rotary[1],
+            p.rotary[2],
+        )
+    }
+
+    fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
+        let p = &self.pose;
+        let start = self.program_pose();
+        let job = Job::new(moves, &self.machine, &self.job_options(), start, p.joints)?;
+        self.job = Some(job);
+        self.current = None;
+        self.peeked = None;
+        self.mode = mode;
+        self.state = RunState::Running;
+        self.scale = TimeScale::held();
+        Ok(())
+    }
+
+    /// Takes one command; a refused command changes nothing.
+    pub fn command(&mut self, command: Command) -> Result<(), ExecError> {
+        let result = self.apply(command);
+        if let Err(e) = &result {
+            self.error = Some(e.to_string());
+        }
+        result
+    }
+
+    fn apply(&mut self, command: Command) -> Result<(), ExecError> {
+        match command {
+            Command::Load { program } => {
+                if self.state != RunState::Idle {
+                    return Err(self.busy("load"));
+                }
+                let moves = tezgah_gcode::program_moves(&program, self.gcode.clone())
+                    .map_err(|e| ExecError::Gcode(e.to_string()))?;
+                self.program = Some(moves);
+                self.mode = Mode::Auto;
+                Ok(())
+            }
+            Command::CycleStart | Command::Resume => match self.state {
+                RunState::Idle => {
+                    let moves = self.program.clone().ok_or(ExecError::NoProgram)?;
+                    self.start_job(moves, Mode::Auto)
+                }
+                RunState::Held | RunState::Paused { .. } | RunState::Holding => {
+                    self.state = RunState::Running;
+                    Ok(())
+                }
+                RunState::Running => Ok(()),
+                _ => Err(self.busy("cycle start")),
+            },
+            Command::FeedHold => match self.state {
+                RunState::Running => {
+                    self.state = RunState::Holding;
+                    Ok(())
+                }
+                RunState::Holding | RunState::Held | RunState::Paused { .. } => Ok(()),
+                _ => Err(self.busy("feed hold")),
+            },
+            Command::Abort => {
+                match self.state {
+                    RunState::Running | RunState::Holding => self.state = RunState::Aborting,
+                    RunState::Aborting => {}
+                    _ => self.drop_job(),
+                }
+                self.error = None;
+                Ok(())
+            }
+            Command::FeedOverride { percent } => {
+                if !(0.0..=200.0).contains(&percent) {
+                    return Err(ExecError::Override(percent));
+                }
+                self.override_pct = percent;
+                Ok(())
+            }
+            Command::SingleBlock { on } => {
+                self.single_block = on;
+                Ok(())
+            }
+            Command::OptionalStop { on } => {
+                self.optional_stop = on;
+                Ok(())
+            }
+            Command::Mdi { block } => {
+                if self.state != RunState::Idle {
+                    return Err(self.busy("MDI"));
+                }
+                let here = self.program_pose();
+                if here.0 != self.mdi_at.0 {
+                    self.mdi.sync(&here)?;
+                    self.mdi_at = here;
+                }
+                let moves = self.mdi.block(&block)?;
+                if let Some(end) = moves.iter().rev().find_map(|m| move_end(&m.kind)) {
+                    self.mdi_at = end;
+                }
+                let mut job = self.mdi_modal.clone();
+                for m in moves {
+                    if is_modal(&m.kind) {
+                        let d = std::mem::discriminant(&m.kind);
+                        self.mdi_modal
+                            .retain(|k| std::mem::discriminant(&k.kind) != d);
+                        self.mdi_modal.push(m.clone());
+                    }
+                    job.push(m);
+                }
+                self.start_job(job, Mode::Mdi)
+            }
+            Command::RestartFrom { line } => {
+                if self.state != RunState::Idle {
+                    return Err(self.busy("restart"));
+                }
+                let program = self.program.as_ref().ok_or(ExecError::NoProgram)?;
+                let moves = restart_moves(program, line)?;
+                self.start_job(moves, Mode::Auto)
+            }
+        }
+    }
+
+    fn drop_job(&mut self) {
+        // The path run so far stays counted.
+        self.done_length += self.s;
+        self.s = 0.0;
+        self.job = None;
+        self.current = None;
+        self.peeked = None;
+        self.state = RunState::Idle;
+        self.scale = TimeScale::held();
+    }
+
+    /// The real-time side halted (underrun or drive fault) at `joints`: the job is lost.
+    pub fn fault(&mut self, joints: Joints, message: &str) {
+        // A job error that caused the halt stays the message.
+        let job_failed = self.state == RunState::Fault;
+        self.drop_job();
+        self.state = RunState::Fault;
+        if !job_failed {
+            self.error = Some(message.to_owned());
+        }
+        // The joints are the truth now; the tip follows where the model says (an underrun
+        // stop leaves the path by a little).
+        if let Ok(p) = tezgah_kinematics::Kinematics::forward(
+            &self.machine.model,
+            &joints,
+            &tezgah_kinematics::Tool::default(),
+        ) {
+            self.pose.tip = p.tip;
+        }
+        self.pose.joints = joints;
+        self.prev_joints = joints;
+        self.prev_velocity = Joints::zeros(joints.len());
+    }
+
+    fn target(&self, factor: f64) -> f64 {
+        match self.state {
+            RunState::Running => (self.override_pct / 100.0 / factor).min(1.0),
+            _ => 0.0,
+        }
+    }
+
+    /// The next period's set-point; `None` when nothing moves (idle, held, paused).
+    pub fn step(&mut self) -> Result<Option<Produced>, ExecError> {
+        if !matches!(
+            self.state,
+            RunState::Running | RunState::Holding | RunState::Aborting
+        ) {
+            return Ok(None);
+        }
+        match self.advance_one() {
+            Ok(p) => Ok(p),
+            Err(e) => {
+                // A job that fails mid-way (a pose out of reach: the program's pre-flight
+                // catches only what the interpreter sees) produces nothing more: the
+                // real-time side meets an empty ring while moving, an underrun, and brings
+                // the joints to rest jerk-limited — never the jump a rest set-point here
+                // would be.
+                self.drop_job();
+                self.state = RunState::Fault;
+                self.error = Some(e.to_string());
+                Ok(None)
+            }
+        }
+    }
+
+    fn advance_one(&mut self) -> Result<Option<Produced>, ExecError> {
+        let ts = self.options.period;
+        if self.passed.len() > 1 {
+            self.passed.drain(..self.passed.len() - 1);
+        }
+        if self.current.is_none() {
+            if let Some(ev) = self.fetch()? {
+                return Ok(self.finish_event(ev));
+            }
+        }
+        // The time scale moves with the plan's state where the tool is.
+        let factor = match &self.current {
+            Some(Current::Piece { factor, .. }) => *factor,
+            _ => 1.0,
+        };
+        let target = self.target(factor);
+        if matches!(self.current, Some(Current::Piece { .. })) && self.peeked.is_none() {
+            // The scale looks into the next piece (its limits may be lower).
+            let factor = (self.override_pct / 100.0).max(1.0);
+            if let Some(job) = self.job.as_mut() {
+                self.peeked = job.next(factor)?;
+            }
+        }
+        let next = match &self.peeked {
+            Some(PlannedItem {
+                item: Planned::Motion(p),
+                ..
+            }) => Some(PieceView {
+                profile: &p.profile,
+                limits: &p.limits,
+            }),
+            _ => None,
+        };
+        let dtau = match &self.current {
+            Some(Current::Piece { cursor, tau, .. }) => {
+                let p = cursor.piece();
+                let current = PieceView {
+                    profile: &p.profile,
+                    limits: &p.limits,
+                };
+                self.scale.step(target, current, next, *tau, ts).dtau
+            }
+            _ => {
+                // Standing still (a dwell): r may jump, nothing moves. A dwell is wall time
+                // (override does not stretch it, as on LinuxCNC); a hold or an abort stops it.
+                self.scale.r = target;
+                self.scale.rate = 0.0;
+                if target > 0.0 {
+                    ts
+                } else {
+                    0.0
+                }
+            }
+        };
+        let event = self.advance(dtau)?;
+        if let Event::Moving = event {
+            if self.scale.is_stopped() {
+                match self.state {
+                    RunState::Holding => {
+                        self.state = RunState::Held;
+                        return Ok(Some(self.emit(true, 0.0)));
+                    }
+                    RunState::Aborting => {
+                        self.drop_job();
+                        return Ok(Some(self.emit(true, 0.0)));
+                    }
+                    _ => {}
+                }
+            }
+            let feed = match &self.current {
+                Some(Current::Piece { cursor, tau, .. }) => {
+                    self.scale.r * cursor.piece().profile.state_at(*tau).v
+                }
+                _ => 0.0,
+            };
+            self.sample()?;
+            return Ok(Some(self.emit(false, feed)));
+        }
+        Ok(self.finish_event(event))
+    }
+
+    fn finish_event(&mut self, event: Event) -> Option<Produced> {
+        match event {
+            Event::Moving => None,
+            Event::Paused(reason) => {
+                self.state = if self.state == RunState::Aborting {
+                    self.drop_job();
+                    RunState::Idle
+                } else {
+                    RunState::Paused { reason }
+                };
+                self.scale = TimeScale::held();
+                Some(self.emit(true, 0.0))
+            }
+            Event::Done => {
+                self.drop_job();
+                Some(self.emit(true, 0.0))
+            }
+        }
+    }
+
+    /// Takes the next planned item as current; an event if the job pauses or ends there.
+    fn fetch(&mut self) -> Result<Option<Event>, ExecError> {
+        let factor = (self.override_pct / 100.0).max(1.0);
+        loop {
+            let Some(job) = self.job.as_mut() else {
+                return Ok(Some(Event::Done));
+            };
+            let next = match self.peeked.take() {
+                Some(p) => Some(p),
+                None => job.next(factor)?,
+            };
+            let Some(PlannedItem { item, factor }) = next else {
+                return Ok(Some(Event::Done));
+            };
+            match item {
+                Planned::Motion(piece) => {
+                    let cursor = PieceCursor::new(Arc::from(piece));
+                    self.current = Some(Current::Piece {
+                        cursor,
+                        tau: 0.0,
+                        factor,
+                    });
+                    return Ok(None);
+                }
+                Planned::Dwell { seconds, line } => {
+                    self.current = Some(Current::Dwell {
+                        left: seconds,
+                        line,
+                    });
+                    return Ok(None);
+                }
+                Planned::Stop { line } => {
+                    self.pose.line = line;
+                    match job.stop_kind(line) {
+                        StopKind::Pause | StopKind::PalletPause => {
+                            return Ok(Some(Event::Paused(PauseReason::ProgramStop)))
+                        }
+                        StopKind::OptionalPause if self.optional_stop => {
+                            return Ok(Some(Event::Paused(PauseReason::OptionalStop)))
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+
+    /// Moves `dtau` of planned time along the job.
+    fn advance(&mut self, mut left: f64) -> Result<Event, ExecError> {
+        loop {
+            if self.current.is_none() {
+                if let Some(ev) = self.fetch()? {
+                    return Ok(ev);
+                }
+            }
+            match self.current.as_mut() {
+                Some(Current::Piece { cursor, tau, .. }) => {
+                    let d = cursor.piece().profile.duration();
+                    if *tau + left < d {
+                        *tau += left;
+                        return Ok(Event::Moving);
+                    }
+                    left -= d - *tau;
+                    *tau = d;
+                    // The piece's exact end, and every segment passed on the way.
+                    let end = cursor.piece().length();
+                    self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
+                    self.done_length += end;
+                    self.s = 0.0;
+                    self.passed.extend(cursor.passed().iter().cloned());
+                    let stop = cursor
+                        .piece()
+                        .segments
+                        .last()
+                        .is_some_and(|s| s.end == Junction::Stop);
+                    self.current = None;
+                    if stop
+                        && self.single_block
+                        && self.mode == Mode::Auto
+                        && self.state == RunState::Running
+                    {
+                        return Ok(Event::Paused(PauseReason::SingleBlock));
+                    }
+                }
+                Some(Current::Dwell { left: dl, line }) => {
+                    self.pose.line = *line;
+                    if left < *dl {
+                        *dl -= left;
+                        return Ok(Event::Moving);
+                    }
+                    left -= *dl;
+                    self.current = None;
+                }
+                None => return Ok(Event::Done),
+            }
+        }
+    }
+
+    /// The pose at the current path time.
+    fn sample(&mut self) -> Result<(), ExecError> {
+        if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
+            let s = cursor.piece().profile.state_at(*tau).s;
+            self.s = s.clamp(0.0, cursor.piece().length());
+            self.pose = cursor.pose(&self.machine, s, &self.pose.joints)?;
+            // Segments passed inside this piece (its cursor keeps the current one).
+            for seg in cursor.passed() {
+                if !self.passed.last().is_some_and(|p| Arc::ptr_eq(p, seg)) {
+                    self.passed.push(seg.clone());
+                }
+            }
+            cursor.clear_passed();
+        }
+        Ok(())
+    }
+
+    /// The set-point at the current pose; velocity and acceleration by backward differences
+    /// (zero when `rest`: a stop is exact, and the real-time side must see the machine at rest
+    /// to idle without calling it an underrun).
+    fn emit(&mut self, rest: bool, feed: f64) -> Produced {
+        let ts = self.options.period;
+        let q = self.pose.joints;
+        let (velocity, acceleration) = if rest {
+            (Joints::zeros(q.len()), Joints::zeros(q.len()))
+        } else {
+            let v = sub(&q, &self.prev_joints, 1.0 / ts);
+            let a = sub(&v, &self.prev_velocity, 1.0 / ts);
+            (v, a)
+        };
+        self.prev_joints = q;
+        self.prev_velocity = velocity;
+        let setpoint = SetPoint {
+            index: self.k,
+            line: self.pose.line,
+            position: q,
+            velocity,
+            acceleration,
+        };
+        self.k += 1;
+        Produced {
+            setpoint,
+            tip: self.pose.tip,
+            rotary: self.pose.rotary,
+            feed,
+            path: self.done_length + self.s,
+        }
+    }
+}
+
+/// The moves that run a program from source line `line`: every modal move before it (feed,
+/// feed mode, path mode, smoothing, spindle speed, tool control), a rapid to where the line
+/// starts, then the program from the line on.
+pub fn restart_moves(program: &[Move], line: u32) -> Result<Vec<Move>, ExecError> {
+    let first = program
+        .iter()
+        .position(|m| m.line >= line && is_motion(&m.kind))
+        .ok_or(ExecError::NoSuchLine(line))?;
+    let mut out = Vec::new();
+    let mut start = None;
+    for m in &program[..first] {
+        if let Some(end) = move_end(&m.kind) {
+            start = Some(end);
+        } else if is_modal(&m.kind) {
+            out.push(m.clone());
+        }
+    }
+    if let Some(end) = start {
+        out.push(Move {
+            line,
+            kind: MoveKind::Rapid { end },
+        });
+        // Exactly there before the line runs (a dwell ends the path in a stop).
+        out.push(Move {
+            line,
+            kind: MoveKind::Dwell { seconds: 0.0 },
+        });
+    }
+    out.extend(program[first..].iter().cloned());
+    Ok(out)
+}
+
+fn is_motion(kind: &MoveKind) -> bool {
+    matches!(
+        kind,
+        MoveKind::Rapid { .. } | MoveKind::Feed { .. } | MoveKind::Arc(_) | MoveKind::Nurbs(_)
+    )
+}
+
+/// Moves that change a mode the path builder keeps (they move nothing).
+fn is_modal(kind: &MoveKind) -> bool {
+    matches!(
+        kind,
+        MoveKind::FeedRate { .. }
+            | MoveKind::FeedMode(_)
+            | MoveKind::SpindleSpeed { .. }
+            | MoveKind::PathMode(_)
+            | MoveKind::Smoothing(_)
+            | MoveKind::ToolControl { .. }
+    )
+}
+
+/// Where a motion move ends.
+fn move_end(kind: &MoveKind) -> Option<Pose> {
+    match kind {
+        MoveKind::Rapid { end } | MoveKind::Feed { end } => Some(*end),
+        MoveKind::Arc(a) => Some(a.end),
+        MoveKind::Nurbs(n) => Some(n.end),
+        _ => None,
+    }
+}

@@ -1,0 +1,322 @@
+//! Re-timing: the path-time scale r = dτ/dt between wall time t and the planned profile's
+//! time τ. Feed override sets the target r, feed hold drives it to 0, resume back; the path
+//! itself never changes (re-timed, not re-shaped).
+//!
+//! With the plan at τ giving speed v, acceleration a and jerk j along the path, the re-timed
+//! motion has ṡ = r·v, s̈ = ṙ·v + r²·a and s⃛ = r̈·v + 3r·ṙ·a + r³·j (chain rule). With
+//! 0 ≤ r ≤ 1 the speed stays within the plan's; each period r̈ is chosen so that
+//! |s̈| ≤ A and |s⃛| ≤ J of the piece's path limits hold — which keeps every joint within its
+//! limits, since the planner derived the path limits for any speed up to the piece's V.
+//!
+//! Why a look-ahead on r: the plan itself may use the whole jerk (r³j = J at r = 1), and then
+//! no r̈ can brake ṙ; a ramp that runs into such a stretch with ṙ ≠ 0 cannot stop in time and
+//! would overshoot r = 0 or 1 (an acceleration step). Holding r constant is always admissible
+//! (s̈ = r²a, s⃛ = r³j), so a state is kept only if from it ṙ can be braked to 0 within the
+//! limits against the plan's actual states ahead ([`TimeScale::can_settle`]). Each period takes
+//! the most direct of a few candidate r̈ (the square-root approach to the target, blended
+//! toward braking) that passes that test.
+
+use tezgah_motion::{Limits, Profile, State};
+
+/// Share of the path limits for the ramp's own rate and acceleration bounds (A/v, J/v); the
+/// checks against the plan's terms use the full limits either way. Half was tried first: holds
+/// then took 1.4× the time-optimal distance from cruise; the whole share reaches it (1.00×)
+/// with no more jerk (the checks, not this share, keep the limits).
+const RAMP_SHARE: f64 = 1.0;
+
+/// Largest change of r in one period.
+const MAX_SWING: f64 = 0.1;
+
+/// Slack on the limit checks for rounding.
+const SLACK: f64 = 1e-9;
+
+/// Periods the settling test looks ahead at most.
+const HORIZON: usize = 4000;
+
+/// The time scale and its rate.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeScale {
+    pub r: f64,
+    pub rate: f64,
+}
+
+impl Default for TimeScale {
+    fn default() -> Self {
+        TimeScale { r: 1.0, rate: 0.0 }
+    }
+}
+
+/// One period of the scale: how far τ moved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Advance {
+    /// Path time advanced, s of planned time.
+    pub dtau: f64,
+}
+
+/// One planned piece as the scale sees it: its profile and path limits.
+#[derive(Clone, Copy)]
+pub struct PieceView<'a> {
+    pub profile: &'a Profile,
+    pub limits: &'a Limits,
+}
+
+/// Where τ falls: the plan's state there and the limits in force, or past what is known.
+struct At<'a> {
+    state: State,
+    limits: &'a Limits,
+    /// Past the pieces known: the end state, jerk unknown.
+    unknown: bool,
+}
+
+/// The plan along the piece in hand and the next one if it is planned already; past them the
+/// end state with the jerk unknown (a ramp must settle before it gets there, see
+/// [`TimeScale::can_settle`]).
+struct Plan<'a> {
+    current: PieceView<'a>,
+    next: Option<PieceView<'a>>,
+}
+
+impl<'a> Plan<'a> {
+    fn at(&self, tau: f64) -> At<'a> {
+        let d = self.current.profile.duration();
+        if tau <= d {
+            return At {
+                state: self.current.profile.state_at(tau),
+                limits: self.current.limits,
+                unknown: false,
+            };
+        }
+        if let Some(n) = self.next {
+            if tau - d <= n.profile.duration() {
+                return At {
+                    state: n.profile.state_at(tau - d),
+                    limits: n.limits,
+                    unknown: false,
+                };
+            }
+        }
+        let last = self.next.unwrap_or(self.current);
+        let mut e = last.profile.end();
+        e.a = 0.0;
+        e.j = 0.0;
+        At {
+            state: e,
+            limits: last.limits,
+            unknown: true,
+        }
+    }
+
+    /// The r̈ interval over one period from τ that keeps |s⃛| ≤ J at five instants of it (the
+    /// plan's jerk may switch inside the period, and r, ṙ move): at a fraction f of the
+    /// period, r ≈ r₀ + ṙ₀fTs and ṙ = ṙ₀ + r̈fTs, so s⃛ = r̈(v + 3r·fTs·a) + 3rṙ₀a + r³j is
+    /// linear in r̈.
+    fn period_range(&self, r: f64, rd: f64, tau: f64, ts: f64) -> (f64, f64) {
+        let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
+        for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let rf = (r + rd * f * ts).clamp(0.0, 1.0);
+            let at = self.at(tau + f * rf * ts);
+            let (st, j_max) = (at.state, at.limits.max_jerk());
+            let c = st.v + 3.0 * rf * f * ts * st.a;
+            if c <= 0.0 {
+                continue;
+            }
+            let cross = 3.0 * rf * rd * st.a;
+            let (l, h) = if at.unknown {
+                let room = j_max * (1.0 - rf * rf * rf) - cross.abs();
+                (-room / c, room / c)
+            } else {
+                let rest = cross + rf * rf * rf * st.j;
+                ((-j_max - rest) / c, (j_max - rest) / c)
+            };
+            lo = lo.max(l);
+            hi = hi.min(h);
+        }
+        // Whatever the bounds allow, r̈ never swings r by more than MAX_SWING in a period:
+        // the checks above sample the period and assume r moves little within it.
+        let swing = MAX_SWING / (ts * ts);
+        (lo.max(-swing), hi.min(swing))
+    }
+
+    /// |s̈| ≤ A at rate rd.
+    fn acc_ok(r: f64, rd: f64, at: &At) -> bool {
+        (rd * at.state.v + r * r * at.state.a).abs() <= at.limits.max_acceleration() * (1.0 + SLACK)
+    }
+}
+
+fn integrate(r: f64, rd: f64, rdd: f64, ts: f64) -> (f64, f64, f64) {
+    (
+        r + rd * ts + rdd * ts * ts / 2.0,
+        rd + rdd * ts,
+        r * ts + rd * ts * ts / 2.0 + rdd * ts * ts * ts / 6.0,
+    )
+}
+
+impl TimeScale {
+    /// At rest (r = 0), as after a hold.
+    pub fn held() -> TimeScale {
+        TimeScale { r: 0.0, rate: 0.0 }
+    }
+
+    /// Whether r is 0 and stays there.
+    pub fn is_stopped(&self) -> bool {
+        self.r == 0.0 && self.rate == 0.0
+    }
+
+    /// Whether from (r, ṙ) at τ the rate can be braked to 0 within the limits against the
+    /// plan ahead, with r staying within [0, 1].
+    fn can_settle(plan: &Plan, mut r: f64, mut rd: f64, mut tau: f64, ts: f64) -> bool {
+        for _ in 0..HORIZON {
+            if rd == 0.0 {
+                return true;
+            }
+            let at = plan.at(tau);
+            if at.state.v <= 0.0 {
+                return true;
+            }
+            if at.unknown {
+                // The limits past the pieces known may be far lower: a ramp must have settled
+                // by then, unless the plan stops there.
+                return false;
+            }
+            if !Plan::acc_ok(r, rd, &at) {
+                return false;
+            }
+            let (lo, hi) = plan.period_range(r, rd, tau, ts);
+            if lo > hi {
+                return false;
+            }
+            let rdd = (-rd / ts).clamp(lo, hi);
+            // The last braking step lands on ṙ = 0 exactly.
+            let (r1, rd1, dtau) = integrate(r, rd, rdd, ts);
+            let rd1 = if rd1 * rd <= 0.0 { 0.0 } else { rd1 };
+            if !(-SLACK..=1.0 + SLACK).contains(&r1) {
+                return false;
+            }
+            r = r1.clamp(0.0, 1.0);
+            rd = rd1;
+            tau += dtau.max(0.0);
+        }
+        false
+    }
+
+    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) at path time `tau` of the
+    /// piece in hand (`next`: the following piece, if planned already).
+    pub fn step(
+        &mut self,
+        target: f64,
+        current: PieceView,
+        next: Option<PieceView>,
+        tau: f64,
+        ts: f64,
+    ) -> Advance {
+        let target = target.clamp(0.0, 1.0);
+        let plan = Plan { current, next };
+        let limits = current.limits;
+        let st = plan.at(tau).state;
+        let v = st.v.max(0.0);
+        if v == 0.0 && st.a == 0.0 {
+            // The plan is at rest here: r may jump (ṡ = s̈ = 0 whatever r is; s⃛ = r³j ≤ J).
+            self.r = target;
+            self.rate = 0.0;
+            return Advance { dtau: target * ts };
+        }
+        let (r, rd) = (self.r, self.rate);
+        let v_ref = v.max(1e-9);
+        // At low speed r could swing within a period; the plan's state is only sampled
+        // there, so r moves at most a few percent per period.
+        let rd_max = (RAMP_SHARE * limits.max_acceleration() / v_ref).min(MAX_SWING / ts);
+        let rdd_max = (RAMP_SHARE * limits.max_jerk() / v_ref).min(MAX_SWING / (4.0 * ts * ts));
+        let e = target - r;
+        // Discrete-time square-root approach: the rate from which braking at r̈_max in whole
+        // periods ends exactly at the target, ṙ = r̈Ts·(√(¼ + 2|e|/(r̈Ts²)) − ½).
+        let step = rdd_max * ts;
+        let brake_rate = step * ((0.25 + 2.0 * e.abs() / (step * ts)).sqrt() - 0.5);
+        let want = e.signum() * brake_rate.min(rd_max);
+        // Speeding the ramp up uses its share; slowing it down may use whatever the full
+        // limits leave (the range below), so a ramp never overshoots for want of braking.
+        let mut direct = (want - rd) / ts;
+        if direct * rd >= 0.0 || want * rd < 0.0 {
+            direct = direct.clamp(-rdd_max, rdd_max);
+        }
+        let (lo, hi) = plan.period_range(r, rd, tau, ts);
+        let brake = (-rd / ts).clamp(lo.min(hi), hi.max(lo));
+        let mut chosen = brake;
+        for lambda in [0.0, 0.25, 0.5, 0.75, 1.0] {
+            let rdd = (direct * (1.0 - lambda) + brake * lambda).clamp(lo.min(hi), hi.max(lo));
+            let (r1, rd1, dtau) = integrate(r, rd, rdd, ts);
+            if !(-SLACK..=1.0 + SLACK).contains(&r1) {
+                continue;
+            }
+            let at1 = plan.at(tau + dtau.max(0.0));
+            if Plan::acc_ok(r1, rd1, &at1)
+                && Self::can_settle(&plan, r1.clamp(0.0, 1.0), rd1, tau + dtau.max(0.0), ts)
+            {
+                chosen = rdd;
+                break;
+            }
+        }
+        let (mut r1, mut rd1, dtau) = integrate(r, rd, chosen, ts);
+        if (target - r1).abs() < 1e-9 && rd1.abs() < 1e-3 {
+            // Arrived (the approach lands with ṙ ≈ √(2r̈·1e-9): no step worth the name).
+            r1 = target;
+            rd1 = 0.0;
+        }
+        self.r = r1.clamp(0.0, 1.0);
+        self.rate = if self.r == r1 { rd1 } else { 0.0 };
+        Advance {
+            dtau: dtau.max(0.0),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use tezgah_motion::solve;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// On a cruise at the speed limit, targets switching at random periods: r stays in
+        /// [0, 1], reaches each target, and the re-timed path keeps A and J (third
+        /// differences at the period, as a drive sees them).
+        #[test]
+        fn ramps_keep_the_limits(v in 1.0..300.0f64, a in 100.0..5000.0f64, j in 1e3..1e6f64,
+                                 targets in proptest::collection::vec((0.0..=1.0f64, 1usize..400), 1..6)) {
+            let limits = Limits::new(v, a, j).unwrap();
+            let ts = 0.001;
+            let length = v * 10.0;
+            let profile = solve(length, v, v, &limits).unwrap();
+            let piece = PieceView { profile: &profile, limits: &limits };
+            let mut scale = TimeScale::default();
+            let mut tau = 0.0;
+            let mut s = vec![0.0];
+            for &(target, periods) in &targets {
+                for _ in 0..periods {
+                    tau += scale.step(target, piece, None, tau, ts).dtau;
+                    prop_assert!((0.0..=1.0).contains(&scale.r));
+                    s.push(profile.state_at(tau).s);
+                }
+            }
+            // Near a target held long enough (the stop from full speed takes at most
+            // v/A + A/J + the discrete tail). Short of r = 0 or 1 the discrete approach may
+            // circle a target by its smallest move, a period at r̈_max (r̈_max·Ts², r̈_max =
+            // min(J/v, MAX_SWING/4Ts²)): a speed ripple of that share, within the limits
+            // checked below. (A proportional end zone removed the circling but cost jerk
+            // elsewhere — 1.06 J on a random hold — and was left out.)
+            let (last, periods) = *targets.last().unwrap();
+            let resolution = (j / v).min(MAX_SWING / (4.0 * ts * ts)) * ts * ts;
+            if (periods as f64) * ts > 2.0 * (v / a + a / j) + 0.02 {
+                prop_assert!((scale.r - last).abs() <= resolution + 1e-9,
+                    "r {} target {last} resolution {resolution}", scale.r);
+            }
+            for w in s.windows(4) {
+                let acc = (w[3] - 2.0 * w[2] + w[1]) / (ts * ts);
+                let jerk = (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]) / (ts * ts * ts);
+                prop_assert!(acc.abs() <= a * 1.005 + 1e-6, "a {acc} of {a}");
+                prop_assert!(jerk.abs() <= j * 1.03 + 1e-3, "j {jerk} of {j}");
+            }
+        }
+    }
+}

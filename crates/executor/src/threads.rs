@@ -1,0 +1,233 @@
+//! The two threads: the planner thread ([`PlannerSide`]: commands, the executor, keeping the
+//! ring a few periods ahead, watching the real-time reports) and the real-time thread
+//! ([`crate::rt::RtLoop`] on a [`crate::rt::RealClock`]). [`spawn`] starts both; a front end
+//! (the `serve` command) talks to the [`Handle`]: commands in, status out.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use serde::Serialize;
+
+use crate::command::{Command, RunState, Status};
+use crate::drive::Drive;
+use crate::error::ExecError;
+use crate::executor::Executor;
+use crate::ring::{rings, Rings, RtReport, RtState, Slot};
+use crate::rt::{Jitter, RealClock, RtCounters, RtLoop, StopLimits};
+
+/// Set-points the ring holds by default: 32 ms at 1 ms — commands act within that.
+pub const DEFAULT_RING: usize = 32;
+
+/// How far the planner keeps ahead of the real-time thread, in set-points.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct Lead {
+    pub samples: u64,
+    pub min: usize,
+    pub max: usize,
+    pub sum: u64,
+}
+
+impl Lead {
+    fn record(&mut self, n: usize) {
+        if self.samples == 0 || n < self.min {
+            self.min = n;
+        }
+        self.max = self.max.max(n);
+        self.sum += n as u64;
+        self.samples += 1;
+    }
+
+    pub fn mean(&self) -> f64 {
+        if self.samples == 0 {
+            0.0
+        } else {
+            self.sum as f64 / self.samples as f64
+        }
+    }
+}
+
+/// The planner thread's side of the rings.
+pub struct PlannerSide {
+    exec: Executor,
+    rings: Rings,
+    capacity: usize,
+    last: Option<RtReport>,
+    lead: Lead,
+    /// A re-arm is on its way: reports still saying "halted" are older than it.
+    rearming: bool,
+    /// The executor has been told of the current halt.
+    halt_seen: bool,
+}
+
+impl PlannerSide {
+    /// `capacity` is the set-point ring's size the rings were made with.
+    pub fn new(exec: Executor, rings: Rings, capacity: usize) -> Self {
+        PlannerSide {
+            exec,
+            rings,
+            capacity,
+            last: None,
+            lead: Lead::default(),
+            rearming: false,
+            halt_seen: false,
+        }
+    }
+
+    pub fn executor(&self) -> &Executor {
+        &self.exec
+    }
+
+    /// The executor's status with what the real-time side reported last.
+    pub fn status(&self) -> Status {
+        let mut s = self.exec.status();
+        if let Some(r) = &self.last {
+            s.executing_line = r.line;
+            s.underruns = r.underruns;
+        }
+        s
+    }
+
+    /// The last real-time report read.
+    pub fn last_report(&self) -> Option<&RtReport> {
+        self.last.as_ref()
+    }
+
+    pub fn lead(&self) -> Lead {
+        self.lead
+    }
+
+    /// One command. An abort in a fault also re-arms the real-time side.
+    pub fn command(&mut self, command: Command) -> Result<(), ExecError> {
+        let rearm = command == Command::Abort && self.exec.state() == RunState::Fault;
+        self.exec.command(command)?;
+        if rearm {
+            // The ring has room: the real-time side discards set-points while halted.
+            let _ = self.rings.setpoints.push(Slot::Rearm);
+            self.rearming = true;
+            self.halt_seen = false;
+        }
+        Ok(())
+    }
+
+    /// Reads the reports, then tops the ring up; returns the set-points pushed.
+    pub fn pump(&mut self) -> usize {
+        while let Ok(r) = self.rings.reports.pop() {
+            self.last = Some(r);
+        }
+        if let Some(r) = self.last {
+            if self.rearming && r.state == RtState::Running {
+                self.rearming = false;
+            }
+            if r.state == RtState::Halted && !self.rearming && !self.halt_seen {
+                self.halt_seen = true;
+                let why = match r.fault {
+                    Some(f) => format!("drive fault {f:?}"),
+                    None => format!("set-point underrun ({} so far)", r.underruns),
+                };
+                self.exec.fault(r.commanded, &why);
+            }
+        }
+        self.lead
+            .record(self.capacity - self.rings.setpoints.slots());
+        let mut pushed = 0;
+        while self.rings.setpoints.slots() > 0 {
+            match self.exec.step() {
+                Ok(Some(p)) => {
+                    // Room was checked: the push cannot fail.
+                    let _ = self.rings.setpoints.push(Slot::Point(p.setpoint));
+                    pushed += 1;
+                }
+                _ => break,
+            }
+        }
+        pushed
+    }
+}
+
+/// What the running pair of threads answers with.
+pub struct Handle {
+    pub commands: mpsc::Sender<Command>,
+    /// The executor's status, refreshed by the planner thread.
+    pub status: Arc<Mutex<Status>>,
+    /// Errors of refused commands, in order.
+    pub errors: mpsc::Receiver<ExecError>,
+    quit: Arc<AtomicBool>,
+    planner: JoinHandle<Lead>,
+    rt: JoinHandle<(RtCounters, Jitter)>,
+}
+
+/// The threads' figures when they stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Figures {
+    pub rt: RtCounters,
+    pub jitter: Jitter,
+    pub lead: Lead,
+}
+
+impl Handle {
+    /// Stops both threads and returns their figures.
+    pub fn stop(self) -> Figures {
+        self.quit.store(true, Ordering::Relaxed);
+        let lead = self.planner.join().unwrap_or_default();
+        let (rt, jitter) = self.rt.join().unwrap_or_default();
+        Figures { rt, jitter, lead }
+    }
+}
+
+/// Starts the planner thread and the real-time thread (period from `exec`) with a ring of
+/// `capacity` set-points; the real-time loop starts at `exec`'s current joints.
+pub fn spawn<D: Drive + Send + 'static>(
+    exec: Executor,
+    drive: D,
+    limits: StopLimits,
+    capacity: usize,
+) -> Handle {
+    let period = exec.period();
+    let (planner_rings, rt_ends) = rings(capacity, 4 * capacity.max(64));
+    let start = tezgah_kinematics::Joints::from_slice(&exec.status().joints)
+        .unwrap_or_else(|_| tezgah_kinematics::Joints::zeros(0));
+    let quit = Arc::new(AtomicBool::new(false));
+    let status = Arc::new(Mutex::new(exec.status()));
+    let (tx, rx) = mpsc::channel::<Command>();
+    let (etx, erx) = mpsc::channel::<ExecError>();
+    let q = quit.clone();
+    let rt = std::thread::Builder::new()
+        .name("tezgah-rt".into())
+        .spawn(move || {
+            let mut rt = RtLoop::new(rt_ends, drive, period, limits, start);
+            rt.run(&mut RealClock::new(period), &q)
+        })
+        .expect("spawning the real-time thread");
+    let q = quit.clone();
+    let st = status.clone();
+    let planner = std::thread::Builder::new()
+        .name("tezgah-planner".into())
+        .spawn(move || {
+            let mut side = PlannerSide::new(exec, planner_rings, capacity);
+            while !q.load(Ordering::Relaxed) {
+                while let Ok(c) = rx.try_recv() {
+                    if let Err(e) = side.command(c) {
+                        let _ = etx.send(e);
+                    }
+                }
+                side.pump();
+                if let Ok(mut s) = st.lock() {
+                    *s = side.status();
+                }
+                // A quarter period: the ring (tens of periods) never runs dry on a sleep.
+                std::thread::sleep(Duration::from_secs_f64(period / 4.0));
+            }
+            side.lead()
+        })
+        .expect("spawning the planner thread");
+    Handle {
+        commands: tx,
+        status,
+        errors: erx,
+        quit,
+        planner,
+        rt,
+    }
+}

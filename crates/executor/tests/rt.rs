@@ -1,0 +1,252 @@
+//! The rings and the real-time loop on a virtual clock: every set-point delivered once, in
+//! order, equal to what the executor produced; an underrun is counted and becomes a
+//! jerk-limited stop within every joint limit, and after abort the machine goes on from
+//! where it stopped, without a jump.
+
+mod support;
+
+use support::*;
+use tezgah_executor::command::{Command, RunState};
+use tezgah_executor::drive::IdealDrive;
+use tezgah_executor::drive::{Drive, DriveStatus};
+use tezgah_executor::ring::{rings, RtState};
+use tezgah_executor::rt::{RtLoop, StopLimits};
+use tezgah_executor::threads::PlannerSide;
+use tezgah_executor::SetPoint;
+use tezgah_kinematics::Joints;
+
+/// The ideal drive, remembering what it was given.
+struct Recording {
+    seen: Vec<SetPoint>,
+}
+
+impl Drive for Recording {
+    fn apply(&mut self, sp: &SetPoint) -> DriveStatus {
+        self.seen.push(*sp);
+        IdealDrive.apply(sp)
+    }
+}
+
+fn rig(capacity: usize) -> (PlannerSide, RtLoop<Recording>) {
+    let exec = executor();
+    let limits = StopLimits::of(exec.machine());
+    let start = Joints::from_slice(&exec.status().joints).unwrap();
+    let period = exec.period();
+    let (p, r) = rings(capacity, 4096);
+    let rt = RtLoop::new(r, Recording { seen: vec![] }, period, limits, start);
+    (PlannerSide::new(exec, p, capacity), rt)
+}
+
+#[test]
+fn every_setpoint_once_in_order() {
+    let program = random_program(11, 20);
+    // What the executor produces on its own.
+    let mut alone = executor();
+    let mut trace = Trace::new(&alone);
+    run_program(&mut alone, &mut trace, &program);
+    let produced: Vec<SetPoint> = trace.out.iter().map(|p| p.setpoint).collect();
+
+    let (mut side, mut rt) = rig(24);
+    side.command(Command::Load { program }).unwrap();
+    side.command(Command::CycleStart).unwrap();
+    for k in 0..(produced.len() + 100) {
+        side.pump();
+        rt.tick();
+        if k == produced.len() / 2 {
+            // The machine executes the set-point the ring delivered this period; the
+            // planner is up to a ring ahead.
+            let s = side.status();
+            let applied = rt.last();
+            assert_eq!(s.executing_line, applied.line);
+            let ahead = s.index - applied.index;
+            assert!((1..=24).contains(&ahead), "{ahead}");
+        }
+    }
+    assert_eq!(side.executor().state(), RunState::Idle);
+    let c = rt.counters();
+    assert_eq!(c.underruns, 0);
+    assert_eq!(c.delivered as usize, produced.len());
+    // Idle periods repeat the last set-point; take the first of each index.
+    let mut seen: Vec<SetPoint> = rt.drive().seen.clone();
+    seen.dedup_by_key(|s| s.index);
+    // The first period ran before anything was pushed: the start at rest, index 0, then the
+    // program's set-points from index 0 on.
+    let seen: Vec<&SetPoint> = seen.iter().filter(|s| s.line != 0 || s.index > 0).collect();
+    assert_eq!(seen.len(), produced.len());
+    for (a, b) in seen.iter().zip(&produced) {
+        assert_eq!(**a, *b);
+    }
+    // The real-time side reports the executing line.
+    assert_eq!(
+        side.last_report().unwrap().line,
+        produced.last().unwrap().line
+    );
+}
+
+#[test]
+fn underrun_is_a_jerk_limited_stop() {
+    let (mut side, mut rt) = rig(16);
+    side.command(Command::Mdi {
+        block: "G21 G90 G1 X120 Y-40 Z10 F9000".into(),
+    })
+    .unwrap();
+    // Run into the move, then starve the ring.
+    for _ in 0..400 {
+        side.pump();
+        rt.tick();
+    }
+    let before = rt.drive().seen.len();
+    for _ in 0..600 {
+        rt.tick();
+    }
+    assert_eq!(rt.counters().underruns, 1);
+    assert_eq!(rt.state(), RtState::Halted);
+    let seen = &rt.drive().seen;
+    let m = side.executor().machine();
+    let ts = side.executor().period();
+    // Third differences of the commanded joints across the whole run, the stop included.
+    for w in seen.windows(4) {
+        for i in 0..3 {
+            let q = |k: usize| w[k].position.as_slice()[i];
+            let v = (q(3) - q(2)) / ts;
+            let a = (q(3) - 2.0 * q(2) + q(1)) / (ts * ts);
+            let j = (q(3) - 3.0 * q(2) + 3.0 * q(1) - q(0)) / (ts * ts * ts);
+            assert!(v.abs() <= m.max_velocity[i] * 1.005, "v {v}");
+            assert!(a.abs() <= m.max_acceleration[i] * 1.005, "a {a}");
+            assert!(j.abs() <= m.max_jerk[i] * 1.005, "j {j}");
+        }
+    }
+    // It came to rest and stays there.
+    let last = seen.last().unwrap();
+    assert!(seen.len() > before + 10);
+    assert_eq!(last.velocity, Joints::zeros(3));
+    // The planner side sees the halt: fault, then abort re-arms and motion goes on from the
+    // halted joints.
+    side.pump();
+    assert_eq!(side.executor().state(), RunState::Fault);
+    side.command(Command::Abort).unwrap();
+    side.command(Command::Mdi {
+        block: "G1 X0 Y0 Z0".into(),
+    })
+    .unwrap();
+    let halted = last.position;
+    for _ in 0..5000 {
+        side.pump();
+        rt.tick();
+    }
+    assert_eq!(rt.state(), RtState::Running);
+    let seen = &rt.drive().seen;
+    let resumed = seen
+        .iter()
+        .rposition(|s| s.position == halted)
+        .expect("the halted position is held until the new move");
+    for w in seen[resumed..].windows(2) {
+        let d = (0..3)
+            .map(|i| (w[1].position.as_slice()[i] - w[0].position.as_slice()[i]).abs())
+            .fold(0.0, f64::max);
+        assert!(d <= 200.0 * ts * 1.005, "jump of {d} mm");
+    }
+    let end = seen.last().unwrap();
+    assert!(
+        end.position.as_slice().iter().all(|q| q.abs() < 1e-9),
+        "{end:?} {:?}",
+        side.executor().status()
+    );
+}
+
+/// The two threads through their handle: an MDI move on the real clock, status back.
+#[test]
+fn spawned_threads_run_a_command() {
+    use std::time::{Duration, Instant};
+    use tezgah_executor::threads::{spawn, DEFAULT_RING};
+    let exec = executor();
+    let limits = StopLimits::of(exec.machine());
+    let handle = spawn(exec, IdealDrive, limits, DEFAULT_RING);
+    handle
+        .commands
+        .send(Command::Mdi {
+            block: "G21 G90 G0 X5 Y-3".into(),
+        })
+        .unwrap();
+    let t0 = Instant::now();
+    let mut done = false;
+    while t0.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+        let s = handle.status.lock().unwrap().clone();
+        if s.state == RunState::Fault {
+            // A stall of the shared machine longer than the ring (an underrun): abort, again.
+            handle.commands.send(Command::Abort).unwrap();
+            handle
+                .commands
+                .send(Command::Mdi {
+                    block: "G0 X5 Y-3".into(),
+                })
+                .unwrap();
+            continue;
+        }
+        if s.state == RunState::Idle
+            && (s.tip[0] - 5.0).abs() < 1e-9
+            && (s.tip[1] + 3.0).abs() < 1e-9
+        {
+            done = true;
+            break;
+        }
+    }
+    // A refused command comes back as an error.
+    handle
+        .commands
+        .send(Command::FeedOverride { percent: -1.0 })
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(50));
+    let refused = handle.errors.try_recv();
+    let figures = handle.stop();
+    assert!(done, "the move did not finish");
+    assert!(matches!(
+        refused,
+        Ok(tezgah_executor::error::ExecError::Override(_))
+    ));
+    assert!(figures.rt.delivered > 0);
+    assert!(figures.rt.periods >= figures.rt.delivered);
+}
+
+/// A job that fails while the machine moves (a pose beyond a joint limit: nothing before the
+/// sampling checks position limits, so it is met at X = 200.1 while moving) stops producing:
+/// the real-time side sees an underrun and stops jerk-limited; the executor reports the
+/// job's error with its line.
+#[test]
+fn a_job_error_in_motion_stops_like_an_underrun() {
+    let mut program = String::from("G21 G90 F6000\n");
+    for k in 0..150 {
+        program.push_str(if k % 2 == 0 { "G1 X10\n" } else { "G1 X0\n" });
+    }
+    program.push_str("G1 X250\nM2\n");
+    let (mut side, mut rt) = rig(16);
+    side.command(Command::Load { program }).unwrap();
+    side.command(Command::CycleStart).unwrap();
+    for _ in 0..60_000 {
+        side.pump();
+        rt.tick();
+        if rt.state() == RtState::Halted {
+            break;
+        }
+    }
+    assert_eq!(rt.state(), RtState::Halted);
+    assert_eq!(rt.counters().underruns, 1);
+    side.pump();
+    let s = side.status();
+    assert_eq!(s.state, RunState::Fault);
+    let error = s.error.unwrap();
+    assert!(error.contains("line 152"), "{error}");
+    let ts = side.executor().period();
+    let seen = &rt.drive().seen;
+    assert!(seen.len() > 1000, "it failed while moving, not before");
+    for w in seen.windows(4) {
+        let q = |k: usize| w[k].position.as_slice()[0];
+        let j = (q(3) - 3.0 * q(2) + 3.0 * q(1) - q(0)) / (ts * ts * ts);
+        let a = (q(3) - 2.0 * q(2) + q(1)) / (ts * ts);
+        assert!(
+            j.abs() <= 50_000.0 * 1.005 && a.abs() <= 2000.0 * 1.005,
+            "a {a} j {j}"
+        );
+    }
+}
