@@ -158,11 +158,17 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     // The smoothing builder: G64 compresses and blends within its shares of the tolerance,
     // G61 keeps corners, G61.1 stops at every block end.
-    let items = smooth::build(
-        moves.iter().cloned(),
-        &smooth_options(&machine.path, tolerance, start, &pm),
-    )
-    .map_err(|e| miette!("{e}"))?;
+    let opts = smooth_options(&machine.path, tolerance, start, &pm);
+    let mut smoother =
+        smooth::Smoother::new(moves.iter().cloned(), opts.clone()).map_err(|e| miette!("{e}"))?;
+    let items = smoother
+        .by_ref()
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| miette!("{e}"))?;
+    let axis = AxisFigures {
+        deviation_deg: smoother.stats().max_axis_deviation,
+        tolerance_deg: opts.angular_tolerance,
+    };
     let segments = items
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
@@ -243,7 +249,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     }
     let report = verifier.finish();
     if let Some(p) = &args.report {
-        let json = report_json(&machine, &report, duration, &name, period, tolerance);
+        let json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
         std::fs::write(
             p,
             serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
@@ -258,7 +264,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         println!("plots: {} files in {}", files, dir.display());
     }
     summary(
-        &machine, &report, duration, &name, segments, period, tolerance,
+        &machine, &report, duration, &name, segments, period, tolerance, &axis,
     );
     let over =
         report.joints.iter().any(|j| j.worst_ratio() > 1.005) || report.max_deviation > tolerance;
@@ -277,6 +283,13 @@ fn tcp_name(machine: &Machine) -> &'static str {
     }
 }
 
+/// The tool axis's figures (5-axis under TCP): the largest angle between a corner blend's axis
+/// and the programmed axis, and the angular tolerance in force, degrees.
+struct AxisFigures {
+    deviation_deg: f64,
+    tolerance_deg: f64,
+}
+
 fn report_json(
     machine: &Machine,
     r: &Report,
@@ -284,6 +297,7 @@ fn report_json(
     program: &str,
     period: f64,
     tolerance: f64,
+    axis: &AxisFigures,
 ) -> serde_json::Value {
     let joints: Vec<serde_json::Value> = r
         .joints
@@ -317,11 +331,14 @@ fn report_json(
         "samples": r.samples,
         "max_deviation_mm": r.max_deviation,
         "max_deviation_line": r.max_deviation_line,
+        "axis_tolerance_deg": axis.tolerance_deg,
+        "max_axis_deviation_deg": axis.deviation_deg,
         "joints": joints,
         "worst_lines": r.worst_lines.iter().map(|(l, x)| serde_json::json!({"line": l, "peak_over_limit": x})).collect::<Vec<_>>(),
     })
 }
 
+#[allow(clippy::too_many_arguments)]
 fn summary(
     machine: &Machine,
     r: &Report,
@@ -330,6 +347,7 @@ fn summary(
     segments: usize,
     period: f64,
     tolerance: f64,
+    axis: &AxisFigures,
 ) {
     println!(
         "{program} on {} ({}, TCP {}), period {} ms, tolerance {} mm",
@@ -359,4 +377,11 @@ fn summary(
         r.max_deviation_line,
         r.max_deviation <= tolerance
     );
+    if axis.deviation_deg > 0.0 {
+        println!(
+            "max tool-axis deviation {:.2e}° (corner blends), within angular tolerance: {}",
+            axis.deviation_deg,
+            axis.deviation_deg <= axis.tolerance_deg
+        );
+    }
 }
