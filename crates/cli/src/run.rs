@@ -49,6 +49,8 @@ pub struct BuiltPath {
     pub pm: PlanMachine,
     /// The program pose the machine starts from.
     pub start: Pose,
+    /// How far the blended tool axis strays from the programmed one.
+    pub axis: AxisFigures,
 }
 
 /// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
@@ -63,8 +65,17 @@ pub fn build_path(
 ) -> Result<BuiltPath> {
     let start = Pose::ZERO;
     let pm = PlanMachine::from_machine(machine).map_err(|e| miette!("{e}"))?;
-    let items = smooth::build(moves, &smooth_options(&machine.path, tolerance, start, &pm))
+    let opts = smooth_options(&machine.path, tolerance, start, &pm);
+    let mut smoother =
+        smooth::Smoother::new(moves.into_iter(), opts.clone()).map_err(|e| miette!("{e}"))?;
+    let items = smoother
+        .by_ref()
+        .collect::<Result<Vec<_>, _>>()
         .map_err(|e| miette!("{e}"))?;
+    let axis = AxisFigures {
+        deviation_deg: smoother.stats().max_axis_deviation,
+        tolerance_deg: opts.angular_tolerance,
+    };
     let start_joints = pm
         .joints(
             pm.initial,
@@ -76,7 +87,12 @@ pub fn build_path(
     tezgah_motion::preflight::check_path(&items, &pm, start_joints).map_err(|e| {
         crate::diagnostics::report_line(program, text, e.line, &e.source.to_string())
     })?;
-    Ok(BuiltPath { items, pm, start })
+    Ok(BuiltPath {
+        items,
+        pm,
+        start,
+        axis,
+    })
 }
 
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
@@ -184,7 +200,12 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
-    let BuiltPath { items, pm, start } = build_path(&path_name, &text, moves, &machine, tolerance)?;
+    let BuiltPath {
+        items,
+        pm,
+        start,
+        axis,
+    } = build_path(&path_name, &text, moves, &machine, tolerance)?;
     let segments = items
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
@@ -265,7 +286,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     }
     let report = verifier.finish();
     if let Some(p) = &args.report {
-        let json = report_json(&machine, &report, duration, &name, period, tolerance);
+        let json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
         std::fs::write(
             p,
             serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
@@ -280,7 +301,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         println!("plots: {} files in {}", files, dir.display());
     }
     summary(
-        &machine, &report, duration, &name, segments, period, tolerance,
+        &machine, &report, duration, &name, segments, period, tolerance, &axis,
     );
     let over =
         report.joints.iter().any(|j| j.worst_ratio() > 1.005) || report.max_deviation > tolerance;
@@ -299,6 +320,13 @@ fn tcp_name(machine: &Machine) -> &'static str {
     }
 }
 
+/// The tool axis's figures (5-axis under TCP): the largest angle between a corner blend's axis
+/// and the programmed axis, and the angular tolerance in force, degrees.
+pub struct AxisFigures {
+    deviation_deg: f64,
+    tolerance_deg: f64,
+}
+
 fn report_json(
     machine: &Machine,
     r: &Report,
@@ -306,6 +334,7 @@ fn report_json(
     program: &str,
     period: f64,
     tolerance: f64,
+    axis: &AxisFigures,
 ) -> serde_json::Value {
     let joints: Vec<serde_json::Value> = r
         .joints
@@ -339,11 +368,14 @@ fn report_json(
         "samples": r.samples,
         "max_deviation_mm": r.max_deviation,
         "max_deviation_line": r.max_deviation_line,
+        "axis_tolerance_deg": axis.tolerance_deg,
+        "max_axis_deviation_deg": axis.deviation_deg,
         "joints": joints,
         "worst_lines": r.worst_lines.iter().map(|(l, x)| serde_json::json!({"line": l, "peak_over_limit": x})).collect::<Vec<_>>(),
     })
 }
 
+#[allow(clippy::too_many_arguments)]
 fn summary(
     machine: &Machine,
     r: &Report,
@@ -352,6 +384,7 @@ fn summary(
     segments: usize,
     period: f64,
     tolerance: f64,
+    axis: &AxisFigures,
 ) {
     println!(
         "{program} on {} ({}, TCP {}), period {} ms, tolerance {} mm",
@@ -381,4 +414,11 @@ fn summary(
         r.max_deviation_line,
         r.max_deviation <= tolerance
     );
+    if axis.deviation_deg > 0.0 {
+        println!(
+            "max tool-axis deviation {:.2e}° (corner blends), within angular tolerance: {}",
+            axis.deviation_deg,
+            axis.deviation_deg <= axis.tolerance_deg
+        );
+    }
 }

@@ -134,6 +134,16 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
         "C turns"
     );
     assert_eq!(report["tcp"], "program");
+    // The tool axis is carried and blended at the ring's corners, within the blends' share
+    // (0.8) of table-ac's 0.1° angular tolerance.
+    assert_eq!(report["axis_tolerance_deg"].as_f64(), Some(0.1));
+    let axis = report["max_axis_deviation_deg"].as_f64().unwrap();
+    assert!(axis > 0.0 && axis <= 0.08, "{axis}");
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("within angular tolerance: true"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     for j in joints {
         for (peak, limit) in [
             ("peak_velocity", "max_velocity"),

@@ -24,6 +24,8 @@ pub enum ExecError {
     Kinematics { line: u32, message: String },
     #[error("machine: {0}")]
     Machine(String),
+    #[error("the executor's threads have stopped")]
+    Stopped,
 }
 
 impl From<tezgah_motion::interpolate::InterpolateError> for ExecError {

@@ -146,9 +146,14 @@ impl PlannerSide {
     }
 }
 
+/// A command with the channel its answer goes back on.
+type Request = (Command, mpsc::Sender<Result<(), ExecError>>);
+
 /// What the running pair of threads answers with.
 pub struct Handle {
     pub commands: mpsc::Sender<Command>,
+    /// Commands whose answers come back to the sender ([`Handle::request`]).
+    requests: mpsc::Sender<Request>,
     /// The executor's status, refreshed by the planner thread.
     pub status: Arc<Mutex<Status>>,
     /// Errors of refused commands, in order.
@@ -167,6 +172,16 @@ pub struct Figures {
 }
 
 impl Handle {
+    /// Hands a command to the planner thread and waits for its answer (within a period or
+    /// so): `Ok` once applied, or why it was refused (a refused command changes nothing).
+    pub fn request(&self, command: Command) -> Result<(), ExecError> {
+        let (reply, answer) = mpsc::channel();
+        self.requests
+            .send((command, reply))
+            .map_err(|_| ExecError::Stopped)?;
+        answer.recv().map_err(|_| ExecError::Stopped)?
+    }
+
     /// Stops both threads and returns their figures.
     pub fn stop(self) -> Figures {
         self.quit.store(true, Ordering::Relaxed);
@@ -192,6 +207,7 @@ pub fn spawn<D: Drive + Send + 'static>(
     let status = Arc::new(Mutex::new(exec.status()));
     let (tx, rx) = mpsc::channel::<Command>();
     let (etx, erx) = mpsc::channel::<ExecError>();
+    let (rtx, rrx) = mpsc::channel::<Request>();
     let q = quit.clone();
     let rt = std::thread::Builder::new()
         .name("tezgah-rt".into())
@@ -212,6 +228,9 @@ pub fn spawn<D: Drive + Send + 'static>(
                         let _ = etx.send(e);
                     }
                 }
+                while let Ok((c, reply)) = rrx.try_recv() {
+                    let _ = reply.send(side.command(c));
+                }
                 side.pump();
                 if let Ok(mut s) = st.lock() {
                     *s = side.status();
@@ -224,6 +243,7 @@ pub fn spawn<D: Drive + Send + 'static>(
         .expect("spawning the planner thread");
     Handle {
         commands: tx,
+        requests: rtx,
         status,
         errors: erx,
         quit,

@@ -1,10 +1,10 @@
 //! The tool axis along the smoothed path under tool-centre-point control (5-axis, reference
 //! 004 §2.3–2.4): reference 004's derived values for the two-curve blend, and properties on
-//! thousands of random 5-axis polylines on the table-ac trunnion — the axis is a unit vector
-//! everywhere, continuous at every joint (bit for bit), with continuous first and second
-//! derivatives by arc length at every smooth joint (measured, 1e-9), within the blend's share
-//! of the angular tolerance of the programmed axis (measured independently), exact at the
-//! programmed ends, never NaN.
+//! thousands of random 5-axis polylines and arc chains on the table-ac and table-bc
+//! trunnions — the axis is a unit vector everywhere, continuous at every joint (bit for bit),
+//! with continuous first and second derivatives by arc length at every smooth joint
+//! (measured, 1e-9), within the blend's share of the angular tolerance of the programmed axis
+//! (measured independently), exact at the programmed ends, never NaN.
 
 mod path_support;
 
@@ -28,6 +28,48 @@ const TCP: ToolControl = ToolControl::CentrePoint { tool_length: 35.0 };
 fn table_ac_axis(a_deg: f64, c_deg: f64) -> Vec3 {
     let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
     Vec3::new(a.sin() * c.sin(), a.sin() * c.cos(), a.cos())
+}
+
+/// Table-bc's in closed form: `(−sin B cos C, sin B sin C, cos B)`.
+fn table_bc_axis(b_deg: f64, c_deg: f64) -> Vec3 {
+    let (b, c) = (b_deg.to_radians(), c_deg.to_radians());
+    Vec3::new(-b.sin() * c.cos(), b.sin() * c.sin(), b.cos())
+}
+
+/// A five-axis trunnion of the property test: its name, the program axis that tilts (A or B,
+/// index into A B C) and its tool axis in closed form.
+#[derive(Debug, Clone, Copy)]
+struct Trunnion {
+    name: &'static str,
+    tilt: usize,
+    axis: fn(f64, f64) -> Vec3,
+}
+
+const AC: Trunnion = Trunnion {
+    name: "table-ac",
+    tilt: 0,
+    axis: table_ac_axis,
+};
+const BC: Trunnion = Trunnion {
+    name: "table-bc",
+    tilt: 1,
+    axis: table_bc_axis,
+};
+
+impl Trunnion {
+    fn pose(&self, p: Vec3, tilt: f64, c: f64) -> Pose {
+        let mut pose = Pose::new(p.x, p.y, p.z, 0.0, 0.0, c);
+        pose.0[3 + self.tilt] = tilt;
+        pose
+    }
+    fn rotary(&self, tilt: f64, c: f64) -> [f64; 3] {
+        let mut r = [0.0, 0.0, c];
+        r[self.tilt] = tilt;
+        r
+    }
+    fn machine(&self) -> PlanMachine {
+        PlanMachine::from_machine(&Machine::builtin(self.name).unwrap()).unwrap()
+    }
 }
 
 fn machine() -> PlanMachine {
@@ -61,6 +103,11 @@ fn the_machine_gives_the_closed_form_axis() {
             .axis(TCP, &Vec3::new(10.0, -5.0, 3.0), &[a, 0.0, c])
             .unwrap();
         assert!((o - table_ac_axis(a, c)).norm() < 1e-15, "{a} {c}: {o}");
+        let bc = BC.machine();
+        let o = bc
+            .axis(TCP, &Vec3::new(10.0, -5.0, 3.0), &BC.rotary(a, c))
+            .unwrap();
+        assert!((o - table_bc_axis(a, c)).norm() < 1e-15, "B{a} C{c}: {o}");
     }
     // TCP off: the angles are joints, there is no axis to carry.
     assert_eq!(
@@ -172,6 +219,7 @@ fn step() -> impl Strategy<Value = Step> {
 }
 
 struct Program {
+    kind: Trunnion,
     moves: Vec<Move>,
     /// Programmed points with their A and C (start first).
     points: Vec<(Vec3, f64, f64)>,
@@ -185,7 +233,7 @@ fn rot(v: Vec3, a: f64) -> Vec3 {
     Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
 }
 
-fn program(steps: &[Step], tolerance: f64) -> Program {
+fn program(kind: Trunnion, steps: &[Step], tolerance: f64) -> Program {
     let start = (Vec3::new(5.0, -3.0, 2.0), 25.0, 10.0);
     let mut moves = vec![
         feed(1, 1200.0),
@@ -198,7 +246,7 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
         Move {
             line: 3,
             kind: MoveKind::Rapid {
-                end: Pose::new(start.0.x, start.0.y, start.0.z, start.1, 0.0, start.2),
+                end: kind.pose(start.0, start.1, start.2),
             },
         },
     ];
@@ -215,7 +263,12 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
         match s.arc {
             None => {
                 pos += heading * s.len + Vec3::new(0.0, 0.0, s.dz);
-                moves.push(g1ac(line, pos, a, c));
+                moves.push(Move {
+                    line,
+                    kind: MoveKind::Feed {
+                        end: kind.pose(pos, a, c),
+                    },
+                });
                 arcs.push(None);
             }
             Some(sweep) => {
@@ -226,7 +279,7 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
                     line,
                     kind: MoveKind::Arc(tezgah_geom::ArcMove {
                         plane: tezgah_geom::Plane::XY,
-                        end: Pose::new(end.x, end.y, end.z, a, 0.0, c),
+                        end: kind.pose(end, a, c),
                         center: [centre.x, centre.y],
                         turn: if sweep > 0.0 { 1 } else { -1 },
                     }),
@@ -239,6 +292,7 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
         points.push((pos, a, c));
     }
     Program {
+        kind,
         moves,
         points,
         arcs,
@@ -251,7 +305,8 @@ fn program(steps: &[Step], tolerance: f64) -> Program {
 fn programmed(prog: &Program, m: usize, q: &Vec3) -> (f64, Vec3) {
     let (p0, a0, c0) = prog.points[m - 1];
     let (p1, a1, c1) = prog.points[m];
-    let g = GreatCircle::new(table_ac_axis(a0, c0), table_ac_axis(a1, c1)).unwrap();
+    let axis = prog.kind.axis;
+    let g = GreatCircle::new(axis(a0, c0), axis(a1, c1)).unwrap();
     let Some((centre, sweep)) = prog.arcs[m] else {
         let d = p1 - p0;
         let t = ((q - p0).dot(&d) / d.norm_squared()).clamp(0.0, 1.0);
@@ -351,7 +406,7 @@ fn check(prog: &Program, items: &[PathItem], pm: &PlanMachine, angular: f64) -> 
     // Programmed ends exactly: the machine's axis of the last programmed angles.
     let last = segs.last().ok_or("no segments")?;
     let &(p, a, c) = prog.points.last().unwrap();
-    let want = pm.axis(TCP, &p, &[a, 0.0, c]).unwrap();
+    let want = pm.axis(TCP, &p, &prog.kind.rotary(a, c)).unwrap();
     if last.axis.unwrap().ends()[1] != want {
         return Err(format!(
             "end axis {:?} vs {want}",
@@ -369,9 +424,10 @@ proptest! {
         steps in proptest::collection::vec(step(), 1..12),
         tol in prop_oneof![Just(0.01), Just(0.002), Just(0.1)],
         angular in prop_oneof![Just(0.1), Just(0.01), Just(1.0)],
+        kind in prop_oneof![Just(AC), Just(BC)],
     ) {
-        let pm = machine();
-        let prog = program(&steps, tol);
+        let pm = kind.machine();
+        let prog = program(kind, &steps, tol);
         let items = build(prog.moves.clone(), &options(&pm, 0.01, angular)).unwrap();
         if let Err(e) = check(&prog, &items, &pm, angular) {
             return Err(TestCaseError::fail(e));

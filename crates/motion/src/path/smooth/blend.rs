@@ -109,6 +109,16 @@ impl Curve for Blend {
         }
         d
     }
+    /// Position only (the deviation measures' integrand): one Horner instead of four.
+    fn point(&self, u: f64) -> Vec3 {
+        if u.is_nan() || u <= 0.0 {
+            return self.start;
+        }
+        if u >= 1.0 {
+            return self.end;
+        }
+        horner(&self.q.coefficients(), u)
+    }
     /// Velocity only (the arc-length quadrature's integrand): one Horner instead of four.
     fn d1(&self, u: f64) -> Vec3 {
         let t = if u.is_nan() { 0.0 } else { u.clamp(0.0, 1.0) };
@@ -118,6 +128,11 @@ impl Curve for Blend {
     fn speed(&self, u: f64) -> f64 {
         self.d1(u).norm()
     }
+}
+
+/// `Σ c_k u^k` by Horner's rule.
+pub(crate) fn horner(c: &[Vec3; 6], u: f64) -> Vec3 {
+    ((((c[5] * u + c[4]) * u + c[3]) * u + c[2]) * u + c[1]) * u + c[0]
 }
 
 fn gl8(f: &impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
