@@ -11,6 +11,7 @@ pub mod arclen;
 mod banded;
 pub mod basis;
 pub mod bezier;
+mod bezier_spans;
 pub mod curvature;
 pub mod curve;
 pub mod deviation;

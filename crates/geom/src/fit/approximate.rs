@@ -15,7 +15,6 @@
 //! polyline instead of running out of data (the plain A9.7 stalls at interpolation).
 
 use super::params::{check_points, parameters, Parameterisation};
-use super::pieces::Pieces;
 use crate::banded::Banded;
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
 use crate::curve::{Curve, Vec3};
@@ -122,11 +121,8 @@ fn refine(
             Err(_) if lambda > 0.0 => least_squares(&data, &interior, p, 0.0)?,
             Err(e) => return Err(e),
         };
-        let fast = Pieces::new(&curve);
-        let check = |quick| match &fast {
-            Some(f) => measure(f, points, t, &interior, tolerance, quick),
-            None => measure(&curve, points, t, &interior, tolerance, quick),
-        };
+        // (The curve evaluates from its Bézier span cache: cubic, non-rational.)
+        let check = |quick| measure(&curve, points, t, &interior, tolerance, quick);
         // A samples-only pass finds the violations of the early rounds at a fraction of the
         // cost; only when it finds none does the refined check (the one that can accept) run.
         let (mut worst, mut worst_in_span) = check(true);
