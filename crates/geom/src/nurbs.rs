@@ -8,7 +8,7 @@
 use nalgebra::Vector4;
 
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
-use crate::bezier_spans::{self, Span};
+use crate::bezier_spans::{self, BezierSpans};
 use crate::curve::{clamp_param, Curve, Vec3};
 use crate::error::CurveError;
 
@@ -24,9 +24,9 @@ pub struct Nurbs {
     /// First and last non-empty span of the domain (for A2.1 at the domain ends).
     first: usize,
     last: usize,
-    /// Non-rational curves of degree ≤ 3: span `first + i` in Bézier form (empty spans hold
-    /// zeros), a cache for fast evaluation ([`bezier_spans`]); empty otherwise.
-    spans: Vec<Span>,
+    /// Non-rational curves of degree ≤ 3: the non-empty spans in Bézier form, a cache for
+    /// fast evaluation ([`bezier_spans`]).
+    spans: Option<BezierSpans>,
 }
 
 impl Nurbs {
@@ -89,7 +89,7 @@ impl Nurbs {
             cw,
             first,
             last,
-            spans: Vec::new(),
+            spans: None,
         }
         .with_spans())
     }
@@ -99,32 +99,33 @@ impl Nurbs {
         if self.degree > 3 || self.cw.iter().any(|c| c.w != 1.0) {
             return self;
         }
-        self.spans = (self.first..=self.last)
-            .map(|s| {
-                let (a, b) = (self.knots[s], self.knots[s + 1]);
-                if b <= a {
-                    return [Vec3::zeros(); 4];
-                }
-                let [ca, da, ..] = self.rat_derivs_in(s, a, 1);
-                let [cb, db, ..] = self.rat_derivs_in(s, b, 1);
-                bezier_spans::from_hermite((ca, da), (cb, db), b - a)
-            })
-            .collect();
+        let parts = (self.first..=self.last).filter_map(|s| {
+            let (a, b) = (self.knots[s], self.knots[s + 1]);
+            if b <= a {
+                return None;
+            }
+            let [ca, da, ..] = self.rat_derivs_in(s, a, 1);
+            let [cb, db, ..] = self.rat_derivs_in(s, b, 1);
+            Some((a, b, bezier_spans::from_hermite((ca, da), (cb, db), b - a)))
+        });
+        self.spans = Some(BezierSpans::new(parts));
         self
+    }
+
+    /// An upper bound of the convex function `f` (a distance to a point, segment or other
+    /// convex set) over the piece `u` in `[u0, u1]`, from the convex hull of the piece's Bézier
+    /// control points; `None` for curves without the Bézier cache (rational, degree > 3).
+    pub fn hull_max(&self, u0: f64, u1: f64, f: impl Fn(&Vec3) -> f64) -> Option<f64> {
+        self.spans.as_ref().map(|s| s.hull_max(u0, u1, f))
     }
 
     /// The cached span holding `u` (clamped), `u`'s place `t` in it and `1 / width`; `None`
     /// when the curve has no cache.
     #[inline]
-    fn bezier_at(&self, u: f64) -> Option<(&Span, f64, f64)> {
-        if self.spans.is_empty() {
-            return None;
-        }
-        let (span, u) = self.span(u);
-        let (a, b) = (self.knots[span], self.knots[span + 1]);
-        let iw = 1.0 / (b - a);
-        let t = if u >= b { 1.0 } else { (u - a) * iw };
-        Some((&self.spans[span - self.first], t, iw))
+    fn bezier_at(&self, u: f64) -> Option<(&bezier_spans::Span, f64, f64)> {
+        let spans = self.spans.as_ref()?;
+        let (a, b) = self.domain();
+        Some(spans.locate(clamp_param(u, a, b)))
     }
 
     /// A non-rational B-spline (all weights 1).
@@ -231,7 +232,7 @@ impl Nurbs {
             cw,
             first,
             last,
-            spans: Vec::new(),
+            spans: None,
         }
         .with_spans()
     }
@@ -450,7 +451,7 @@ mod tests {
                 }
             }
             let c = Nurbs::bspline(p, &pts, knots.clone()).unwrap();
-            assert!(!c.spans.is_empty());
+            assert!(c.spans.is_some());
             let (a, b) = c.domain();
             let mut us: Vec<f64> = (0..=200).map(|i| a + (b - a) * i as f64 / 200.0).collect();
             us.extend(knots.iter().copied().filter(|&k| k >= a && k <= b));
@@ -488,13 +489,13 @@ mod tests {
         ];
         let w = [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0];
         let quarter = Nurbs::new(2, &pts, &w, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0]).unwrap();
-        assert!(quarter.spans.is_empty());
+        assert!(quarter.spans.is_none());
         for i in 0..=20 {
             let r = quarter.point(i as f64 / 20.0).norm();
             assert!((r - 1.0).abs() < 1e-14, "{r}");
         }
         let pts5: Vec<Vec3> = (0..6).map(|i| Vec3::new(i as f64, 0.0, 0.0)).collect();
         let knots = [vec![0.0; 6], vec![1.0; 6]].concat();
-        assert!(Nurbs::bspline(5, &pts5, knots).unwrap().spans.is_empty());
+        assert!(Nurbs::bspline(5, &pts5, knots).unwrap().spans.is_none());
     }
 }

@@ -53,7 +53,9 @@ pub struct Approximation {
     pub curve: Nurbs,
     /// Parameter of each input point (segment `k` corresponds to `[params[k], params[k+1]]`).
     pub params: Vec<f64>,
-    /// Largest measured distance over all points and segments (≤ the tolerance).
+    /// Largest measured distance over all points and segments (≤ the tolerance); where the
+    /// control polygon proved a piece inside the tolerance, its bound counts instead (≥ the
+    /// true distance).
     pub max_deviation: f64,
     /// Least-squares solves it took.
     pub rounds: usize,
@@ -172,10 +174,11 @@ fn span_bounds(interior: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Largest deviation over all pieces and points, and the worst violation `(distance, u)` in
-/// each knot span (None where the span is within tolerance).
-fn measure<C: Curve>(
-    curve: &C,
+/// Largest deviation over all pieces and points (or its convex-hull bound where that proves
+/// a piece inside), and the worst violation `(distance, u)` in each knot span (None where the
+/// span is within tolerance).
+fn measure(
+    curve: &Nurbs,
     points: &[Vec3],
     t: &[f64],
     interior: &[f64],
@@ -218,6 +221,16 @@ fn measure<C: Curve>(
             }
             d
         };
+        // The piece lies in the convex hull of its Bézier control points and the distance to
+        // segment k is convex, so the largest vertex distance bounds the piece's distance from
+        // above (and the distance to the three segments is at most that to segment k): when it
+        // is inside the tolerance no sample can find a violation, and the bound is recorded.
+        if let Some(h) = curve.hull_max(t[k], t[k + 1], |q| point_segment_distance(q, a, b)) {
+            if h <= tolerance {
+                note(h, t[k]);
+                continue;
+            }
+        }
         let d = if quick {
             sampled_max(dist, t[k], t[k + 1], samples)
         } else {
