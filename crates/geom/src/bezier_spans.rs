@@ -22,6 +22,8 @@ pub(crate) struct BezierSpans {
     /// `1 / width` of each span.
     inv: Vec<f64>,
     spans: Vec<Span>,
+    /// Spans per unit parameter, for the interpolation guess in [`Self::index`].
+    density: f64,
 }
 
 impl BezierSpans {
@@ -31,6 +33,7 @@ impl BezierSpans {
             starts: Vec::new(),
             inv: Vec::new(),
             spans: Vec::new(),
+            density: 0.0,
         };
         let mut end = 0.0;
         for (a, b, sp) in parts {
@@ -40,15 +43,49 @@ impl BezierSpans {
             end = b;
         }
         out.starts.push(end);
+        let width = end - out.starts[0];
+        out.density = if width > 0.0 {
+            out.spans.len() as f64 / width
+        } else {
+            0.0
+        };
         out
+    }
+
+    /// The last span whose start is at or before `u` (the first span for `u` before it):
+    /// `starts.partition_point(|x| x <= u).clamp(1, n) − 1`. Knots of fits and programs are
+    /// spread roughly evenly, so the span in proportion to `u` is a guess a few steps from the
+    /// answer (interpolation search); far off, binary search.
+    #[inline]
+    fn index(&self, u: f64) -> usize {
+        const WALK: usize = 4;
+        let n = self.spans.len();
+        let guess = (u - self.starts[0]) * self.density;
+        let mut k = if guess >= 0.0 {
+            (guess as usize).min(n - 1)
+        } else {
+            0
+        };
+        for _ in 0..WALK {
+            if self.starts[k] > u {
+                if k == 0 {
+                    return 0;
+                }
+                k -= 1;
+            } else if k + 1 < n && self.starts[k + 1] <= u {
+                k += 1;
+            } else {
+                return k;
+            }
+        }
+        self.starts.partition_point(|&x| x <= u).clamp(1, n) - 1
     }
 
     /// The span holding `u` (already clamped to the domain; a knot belongs to the span it
     /// starts, the domain end to the last), `u`'s place `t` in it and `1 / width`.
     #[inline]
     pub(crate) fn locate(&self, u: f64) -> (&Span, f64, f64) {
-        let n = self.spans.len();
-        let k = self.starts.partition_point(|&x| x <= u).clamp(1, n) - 1;
+        let k = self.index(u);
         let b = self.starts[k + 1];
         let t = if u >= b {
             1.0
@@ -66,7 +103,7 @@ impl BezierSpans {
         let n = self.spans.len();
         let (lo, hi) = (self.starts[0], self.starts[n]);
         let (u0, u1) = (u0.clamp(lo, hi), u1.clamp(lo, hi));
-        let mut k = self.starts.partition_point(|&x| x <= u0).clamp(1, n) - 1;
+        let mut k = self.index(u0);
         let mut worst = f64::NEG_INFINITY;
         loop {
             let (a, b) = (self.starts[k], self.starts[k + 1]);
@@ -141,6 +178,29 @@ pub(crate) fn derivs(b: &Span, t: f64, inv_width: f64) -> [Vec3; 4] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn index_is_the_binary_search() {
+        // Uneven spans (one long, many short, a cluster): the interpolation guess plus the
+        // walk must give what the plain binary search gives, for every u including knots.
+        let mut starts = vec![0.0, 10.0];
+        let mut x: f64 = 10.0;
+        for i in 0..60 {
+            x += if i % 7 == 0 { 1e-6 } else { 0.01 + 0.1 * (i % 5) as f64 };
+            starts.push(x);
+        }
+        let z = [Vec3::zeros(); 4];
+        let spans = BezierSpans::new(starts.windows(2).map(|w| (w[0], w[1], z)));
+        let n = starts.len() - 1;
+        let mut us: Vec<f64> = starts.clone();
+        us.extend((0..=5000).map(|i| x * i as f64 / 5000.0));
+        us.extend(starts.iter().map(|s| s - 1e-12));
+        for u in us {
+            let u = u.clamp(0.0, x);
+            let want = starts.partition_point(|&s| s <= u).clamp(1, n) - 1;
+            assert_eq!(spans.index(u), want, "u = {u}");
+        }
+    }
 
     #[test]
     fn sub_span_is_the_same_curve() {
