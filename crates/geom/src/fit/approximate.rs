@@ -18,7 +18,7 @@ use super::params::{check_points, parameters, Parameterisation};
 use crate::banded::Banded;
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
 use crate::curve::{Curve, Vec3};
-use crate::deviation::{closest_point, maximise, point_segment_distance, Deviation};
+use crate::deviation::{closest_point, maximise, Deviation};
 use crate::error::CurveError;
 use crate::nurbs::Nurbs;
 
@@ -201,8 +201,21 @@ fn measure(
             }
         }
     };
+    // Each segment once, with its inverse squared length: the distance tests below run
+    // several times per piece and round, and a division and square root each was their cost.
+    let segs: Vec<Segment> = points.windows(2).map(|w| Segment::new(&w[0], &w[1])).collect();
+    let tol2 = tolerance * tolerance;
     for k in 0..m {
-        let (a, b) = (&points[k], &points[k + 1]);
+        // The piece lies in the convex hull of its Bézier control points and the distance to
+        // segment k is convex, so the largest vertex distance bounds the piece's distance from
+        // above (and the distance to the three segments is at most that to segment k): when it
+        // is inside the tolerance no sample can find a violation, and the bound is recorded.
+        if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
+            if h2 <= tol2 {
+                note(h2.sqrt(), t[k]);
+                continue;
+            }
+        }
         // More samples where knots fall inside the piece: each span may bend on its own.
         let inside =
             interior.partition_point(|&x| x < t[k + 1]) - interior.partition_point(|&x| x <= t[k]);
@@ -212,25 +225,15 @@ fn measure(
             // The piece belongs to segment k, but a little tangential drift of the
             // parameter across a vertex is no deviation from the path: measure to the
             // segments around it.
-            let mut d = point_segment_distance(&c, a, b);
+            let mut d2 = segs[k].distance2(&c);
             if k > 0 {
-                d = d.min(point_segment_distance(&c, &points[k - 1], a));
+                d2 = d2.min(segs[k - 1].distance2(&c));
             }
-            if k + 2 <= m {
-                d = d.min(point_segment_distance(&c, b, &points[k + 2]));
+            if k + 1 < m {
+                d2 = d2.min(segs[k + 1].distance2(&c));
             }
-            d
+            d2.sqrt()
         };
-        // The piece lies in the convex hull of its Bézier control points and the distance to
-        // segment k is convex, so the largest vertex distance bounds the piece's distance from
-        // above (and the distance to the three segments is at most that to segment k): when it
-        // is inside the tolerance no sample can find a violation, and the bound is recorded.
-        if let Some(h) = curve.hull_max(t[k], t[k + 1], |q| point_segment_distance(q, a, b)) {
-            if h <= tolerance {
-                note(h, t[k]);
-                continue;
-            }
-        }
         let d = if quick {
             sampled_max(dist, t[k], t[k + 1], samples)
         } else {
@@ -253,6 +256,34 @@ fn measure(
         }
     }
     (worst, worst_in_span)
+}
+
+/// A programmed segment `a + t·ab`, `t` in `[0, 1]`, for repeated distance queries.
+struct Segment {
+    a: Vec3,
+    ab: Vec3,
+    /// `1 / |ab|²`, 0 for a zero-length segment (then the distance is to `a`).
+    inv_len2: f64,
+}
+
+impl Segment {
+    fn new(a: &Vec3, b: &Vec3) -> Self {
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        Segment {
+            a: *a,
+            ab,
+            inv_len2: if len2 > 0.0 { 1.0 / len2 } else { 0.0 },
+        }
+    }
+
+    /// Squared distance from `p` (as [`crate::deviation::point_segment_distance`], squared).
+    #[inline]
+    fn distance2(&self, p: &Vec3) -> f64 {
+        let ap = p - self.a;
+        let t = (ap.dot(&self.ab) * self.inv_len2).clamp(0.0, 1.0);
+        (ap - self.ab * t).norm_squared()
+    }
 }
 
 /// The largest of `samples + 1` equally spaced values: a lower bound of the maximum, enough
