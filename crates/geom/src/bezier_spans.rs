@@ -125,8 +125,16 @@ impl BezierSpans {
 /// parameter per level; Ramshaw 1989).
 fn sub_span(b: &Span, t0: f64, t1: f64) -> Span {
     let lerp = |p: &Vec3, q: &Vec3, t: f64| p * (1.0 - t) + q * t;
-    let a1 = [lerp(&b[0], &b[1], t0), lerp(&b[1], &b[2], t0), lerp(&b[2], &b[3], t0)];
-    let b1 = [lerp(&b[0], &b[1], t1), lerp(&b[1], &b[2], t1), lerp(&b[2], &b[3], t1)];
+    let a1 = [
+        lerp(&b[0], &b[1], t0),
+        lerp(&b[1], &b[2], t0),
+        lerp(&b[2], &b[3], t0),
+    ];
+    let b1 = [
+        lerp(&b[0], &b[1], t1),
+        lerp(&b[1], &b[2], t1),
+        lerp(&b[2], &b[3], t1),
+    ];
     let aa = [lerp(&a1[0], &a1[1], t0), lerp(&a1[1], &a1[2], t0)];
     let ab = [lerp(&a1[0], &a1[1], t1), lerp(&a1[1], &a1[2], t1)];
     let bb = [lerp(&b1[0], &b1[1], t1), lerp(&b1[1], &b1[2], t1)];
@@ -186,7 +194,11 @@ mod tests {
         let mut starts = vec![0.0, 10.0];
         let mut x: f64 = 10.0;
         for i in 0..60 {
-            x += if i % 7 == 0 { 1e-6 } else { 0.01 + 0.1 * (i % 5) as f64 };
+            x += if i % 7 == 0 {
+                1e-6
+            } else {
+                0.01 + 0.1 * (i % 5) as f64
+            };
             starts.push(x);
         }
         let z = [Vec3::zeros(); 4];
@@ -238,7 +250,13 @@ mod tests {
         ];
         let spans = BezierSpans::new([(0.0, 0.5, s0), (0.5, 1.0, s1)].into_iter());
         let f = |p: &Vec3| (p.y * p.y + p.z * p.z).sqrt();
-        for (u0, u1) in [(0.0, 1.0), (0.1, 0.2), (0.4, 0.6), (0.5, 0.5001), (0.45, 0.5)] {
+        for (u0, u1) in [
+            (0.0, 1.0),
+            (0.1, 0.2),
+            (0.4, 0.6),
+            (0.5, 0.5001),
+            (0.45, 0.5),
+        ] {
             let bound = spans.hull_max(u0, u1, f);
             let mut sampled = 0.0f64;
             for i in 0..=1000 {
@@ -246,7 +264,10 @@ mod tests {
                 let (sp, t, _) = spans.locate(u);
                 sampled = sampled.max(f(&point(sp, t)));
             }
-            assert!(bound >= sampled - 1e-15, "[{u0}, {u1}]: {bound} < {sampled}");
+            assert!(
+                bound >= sampled - 1e-15,
+                "[{u0}, {u1}]: {bound} < {sampled}"
+            );
             if u1 - u0 < 1e-3 {
                 assert!(bound - sampled < 1e-5, "[{u0}, {u1}]: {bound} vs {sampled}");
             }

@@ -170,7 +170,11 @@ fn main() {
     }
     let pm = PlanMachine::from_machine(&machine).unwrap_or_else(|e| panic!("{e}"));
     if stage == "plan" {
-        black_box(plan_all(items, pm, plan_options(&machine)).map(|p| p.len()).ok());
+        black_box(
+            plan_all(items, pm, plan_options(&machine))
+                .map(|p| p.len())
+                .ok(),
+        );
         return;
     }
     let mut n = 0u64;
