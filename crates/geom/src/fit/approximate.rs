@@ -187,32 +187,31 @@ fn measure(
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
     let bounds = span_bounds(interior);
-    let mut worst_in_span: Vec<Option<(f64, f64)>> = vec![None; bounds.len() - 1];
-    let mut worst = 0.0f64;
-    let mut note = |d: f64, u: f64| {
-        worst = worst.max(d);
-        if d > tolerance {
-            let s = bounds
-                .partition_point(|&x| x <= u)
-                .clamp(1, bounds.len() - 1)
-                - 1;
-            if worst_in_span[s].is_none_or(|(w, _)| d > w) {
-                worst_in_span[s] = Some((d, u));
-            }
-        }
+    let mut marks = Marks {
+        worst_in_span: vec![None; bounds.len() - 1],
+        bounds,
+        worst: 0.0,
+        tolerance,
     };
     // Each segment once, with its inverse squared length: the distance tests below run
     // several times per piece and round, and a division and square root each was their cost.
     let segs: Vec<Segment> = points.windows(2).map(|w| Segment::new(&w[0], &w[1])).collect();
     let tol2 = tolerance * tolerance;
+    let mut span = 0;
     for k in 0..m {
+        // Only which knot spans hold a violation decides the next knots: a piece wholly
+        // inside a span already marked can add nothing, so it is not measured again.
+        span = marks.advance(span, t[k]);
+        if t[k + 1] <= marks.bounds[span + 1] && marks.worst_in_span[span].is_some() {
+            continue;
+        }
         // The piece lies in the convex hull of its Bézier control points and the distance to
         // segment k is convex, so the largest vertex distance bounds the piece's distance from
         // above (and the distance to the three segments is at most that to segment k): when it
         // is inside the tolerance no sample can find a violation, and the bound is recorded.
         if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
             if h2 <= tol2 {
-                note(h2.sqrt(), t[k]);
+                marks.note(h2.sqrt(), t[k]);
                 continue;
             }
         }
@@ -239,12 +238,17 @@ fn measure(
         } else {
             maximise(dist, t[k], t[k + 1], samples)
         };
-        note(d.distance, d.u);
+        marks.note(d.distance, d.u);
     }
     if quick {
-        return (worst, worst_in_span);
+        return (marks.worst, marks.worst_in_span);
     }
+    let mut span = 0;
     for k in 1..m {
+        span = marks.advance(span, t[k - 1]);
+        if t[k + 1] <= marks.bounds[span + 1] && marks.worst_in_span[span].is_some() {
+            continue;
+        }
         // The point at its own parameter bounds the distance; refine only when needed.
         let direct = (curve.point(t[k]) - points[k]).norm();
         if direct > tolerance {
@@ -252,10 +256,43 @@ fn measure(
                 - interior.partition_point(|&x| x <= t[k - 1]);
             let samples = 2 * SAMPLES + 4 * inside;
             let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], samples);
-            note(d.distance, d.u);
+            marks.note(d.distance, d.u);
         }
     }
-    (worst, worst_in_span)
+    (marks.worst, marks.worst_in_span)
+}
+
+/// What a measurement found: the largest deviation, and the worst violation per knot span.
+struct Marks {
+    /// `[0, interior knots…, 1]`.
+    bounds: Vec<f64>,
+    worst_in_span: Vec<Option<(f64, f64)>>,
+    worst: f64,
+    tolerance: f64,
+}
+
+impl Marks {
+    fn note(&mut self, d: f64, u: f64) {
+        self.worst = self.worst.max(d);
+        if d > self.tolerance {
+            let s = self
+                .bounds
+                .partition_point(|&x| x <= u)
+                .clamp(1, self.bounds.len() - 1)
+                - 1;
+            if self.worst_in_span[s].is_none_or(|(w, _)| d > w) {
+                self.worst_in_span[s] = Some((d, u));
+            }
+        }
+    }
+
+    /// The knot span holding `u`, searching forward from span `from` (`u` never decreases).
+    fn advance(&self, mut from: usize, u: f64) -> usize {
+        while from + 2 < self.bounds.len() && self.bounds[from + 1] <= u {
+            from += 1;
+        }
+        from
+    }
 }
 
 /// A programmed segment `a + t·ab`, `t` in `[0, 1]`, for repeated distance queries.
