@@ -100,21 +100,28 @@ impl BezierSpans {
     /// points are found by blossoming, and the part lies in their convex hull (Piegl & Tiller
     /// §1.4), where a convex function takes its maximum at a vertex.
     pub(crate) fn hull_max(&self, u0: f64, u1: f64, f: impl Fn(&Vec3) -> f64) -> f64 {
+        let mut worst = f64::NEG_INFINITY;
+        self.hull_points(u0, u1, |q| worst = worst.max(f(q)));
+        worst
+    }
+
+    /// Calls `f` with the Bézier control points of the piece `u` in `[u0, u1]` cut at the
+    /// knots (blossoming): the piece lies in their convex hull (Piegl & Tiller §1.4).
+    pub(crate) fn hull_points(&self, u0: f64, u1: f64, mut f: impl FnMut(&Vec3)) {
         let n = self.spans.len();
         let (lo, hi) = (self.starts[0], self.starts[n]);
         let (u0, u1) = (u0.clamp(lo, hi), u1.clamp(lo, hi));
         let mut k = self.index(u0);
-        let mut worst = f64::NEG_INFINITY;
         loop {
             let (a, b) = (self.starts[k], self.starts[k + 1]);
             let t0 = ((u0.max(a) - a) * self.inv[k]).clamp(0.0, 1.0);
             let t1 = ((u1.min(b) - a) * self.inv[k]).clamp(0.0, 1.0);
             for q in sub_span(&self.spans[k], t0, t1) {
-                worst = worst.max(f(&q));
+                f(&q);
             }
             k += 1;
             if k >= n || self.starts[k] >= u1 {
-                return worst;
+                return;
             }
         }
     }

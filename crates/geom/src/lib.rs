@@ -34,7 +34,7 @@ pub use line::Line;
 pub use moves::{
     ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, StopKind, ToolControl, Turn,
 };
-pub use nurbs::Nurbs;
+pub use nurbs::{BoundingBox, Nurbs};
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};
 pub use surface::{

@@ -12,6 +12,22 @@ use crate::bezier_spans::{self, BezierSpans};
 use crate::curve::{clamp_param, Curve, Vec3};
 use crate::error::CurveError;
 
+/// An axis-aligned box, `min ≤ max` componentwise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingBox {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl BoundingBox {
+    /// Distance from `q` to the box (0 inside).
+    pub fn distance(&self, q: &Vec3) -> f64 {
+        let below = self.min - q;
+        let above = q - self.max;
+        below.sup(&above).sup(&Vec3::zeros()).norm()
+    }
+}
+
 /// `C(u) = Σ N_{i,p}(u) w_i P_i / Σ N_{i,p}(u) w_i`, `u` in `[knots[p], knots[n+1]]`.
 ///
 /// Control points are stored homogeneous (`w·x, w·y, w·z, w`), as A4.2 works on them. The
@@ -117,6 +133,22 @@ impl Nurbs {
     /// control points; `None` for curves without the Bézier cache (rational, degree > 3).
     pub fn hull_max(&self, u0: f64, u1: f64, f: impl Fn(&Vec3) -> f64) -> Option<f64> {
         self.spans.as_ref().map(|s| s.hull_max(u0, u1, f))
+    }
+
+    /// The axis-aligned box around the Bézier control points of the piece `u` in `[u0, u1]`:
+    /// it holds the piece (convex hull property), so its distance to a point bounds the
+    /// piece's from below. `None` for curves without the Bézier cache.
+    pub fn hull_box(&self, u0: f64, u1: f64) -> Option<BoundingBox> {
+        let spans = self.spans.as_ref()?;
+        let mut b = BoundingBox {
+            min: Vec3::repeat(f64::INFINITY),
+            max: Vec3::repeat(f64::NEG_INFINITY),
+        };
+        spans.hull_points(u0, u1, |q| {
+            b.min = b.min.inf(q);
+            b.max = b.max.sup(q);
+        });
+        Some(b)
     }
 
     /// The cached span holding `u` (clamped), `u`'s place `t` in it and `1 / width`; `None`
@@ -476,6 +508,28 @@ mod tests {
                 // The ends of a clamped curve are its end control points, bit for bit.
                 assert_eq!(c.point(a), pts[0]);
                 assert_eq!(c.point(b), pts[n - 1]);
+            }
+        }
+    }
+
+    #[test]
+    fn hull_box_bounds_the_distance_from_below() {
+        let mut r = rng(0x5eed_0002);
+        for _ in 0..50 {
+            let pts: Vec<Vec3> = (0..9)
+                .map(|_| Vec3::new(10.0 * r(), 10.0 * r(), r()))
+                .collect();
+            let knots = vec![0., 0., 0., 0., 0.1, 0.3, 0.35, 0.6, 0.9, 1., 1., 1., 1.];
+            let c = Nurbs::bspline(3, &pts, knots).unwrap();
+            let (u0, u1) = (0.5 * r(), 0.5 + 0.5 * r());
+            let b = c.hull_box(u0, u1).unwrap();
+            let q = Vec3::new(20.0 * r() - 5.0, 20.0 * r() - 5.0, 4.0 * r() - 2.0);
+            let lb = b.distance(&q);
+            for i in 0..=400 {
+                let p = c.point(u0 + (u1 - u0) * i as f64 / 400.0);
+                // Inside up to the rounding of the blossom (a few ulp of the coordinates).
+                assert!(b.distance(&p) <= 1e-13, "{p} outside {b:?}");
+                assert!((p - q).norm() >= lb - 1e-13, "{} < {lb}", (p - q).norm());
             }
         }
     }

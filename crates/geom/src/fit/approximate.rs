@@ -195,7 +195,10 @@ fn measure(
     };
     // Each segment once, with its inverse squared length: the distance tests below run
     // several times per piece and round, and a division and square root each was their cost.
-    let segs: Vec<Segment> = points.windows(2).map(|w| Segment::new(&w[0], &w[1])).collect();
+    let segs: Vec<Segment> = points
+        .windows(2)
+        .map(|w| Segment::new(&w[0], &w[1]))
+        .collect();
     let tol2 = tolerance * tolerance;
     let mut span = 0;
     for k in 0..m {
