@@ -32,7 +32,7 @@ impl BoundingBox {
 ///
 /// Control points are stored homogeneous (`w·x, w·y, w·z, w`), as A4.2 works on them. The
 /// knot vector need not be clamped: the domain is always `[u_p, u_{n+1}]` (P&T §2.2).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Nurbs {
     degree: usize,
     knots: Vec<f64>,
@@ -43,6 +43,20 @@ pub struct Nurbs {
     /// Non-rational curves of degree ≤ 3: the non-empty spans in Bézier form, a cache for
     /// fast evaluation ([`bezier_spans`]).
     spans: Option<BezierSpans>,
+}
+
+/// The curve's data, without the evaluation cache (as before the cache existed: printed
+/// moves and error messages stay readable).
+impl std::fmt::Debug for Nurbs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Nurbs")
+            .field("degree", &self.degree)
+            .field("knots", &self.knots)
+            .field("cw", &self.cw)
+            .field("first", &self.first)
+            .field("last", &self.last)
+            .finish()
+    }
 }
 
 impl Nurbs {
