@@ -11,6 +11,7 @@ pub mod arclen;
 mod banded;
 pub mod basis;
 pub mod bezier;
+mod bezier_spans;
 pub mod curvature;
 pub mod curve;
 pub mod deviation;
@@ -33,7 +34,7 @@ pub use line::Line;
 pub use moves::{
     ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, StopKind, ToolControl, Turn,
 };
-pub use nurbs::Nurbs;
+pub use nurbs::{BoundingBox, Nurbs};
 pub use pose::{Axis, Pose};
 pub use quintic::{Quintic, State};
 pub use surface::{

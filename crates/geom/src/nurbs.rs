@@ -8,14 +8,31 @@
 use nalgebra::Vector4;
 
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
+use crate::bezier_spans::{self, BezierSpans};
 use crate::curve::{clamp_param, Curve, Vec3};
 use crate::error::CurveError;
+
+/// An axis-aligned box, `min ≤ max` componentwise.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoundingBox {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl BoundingBox {
+    /// Distance from `q` to the box (0 inside).
+    pub fn distance(&self, q: &Vec3) -> f64 {
+        let below = self.min - q;
+        let above = q - self.max;
+        below.sup(&above).sup(&Vec3::zeros()).norm()
+    }
+}
 
 /// `C(u) = Σ N_{i,p}(u) w_i P_i / Σ N_{i,p}(u) w_i`, `u` in `[knots[p], knots[n+1]]`.
 ///
 /// Control points are stored homogeneous (`w·x, w·y, w·z, w`), as A4.2 works on them. The
 /// knot vector need not be clamped: the domain is always `[u_p, u_{n+1}]` (P&T §2.2).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Clone, PartialEq)]
 pub struct Nurbs {
     degree: usize,
     knots: Vec<f64>,
@@ -23,6 +40,23 @@ pub struct Nurbs {
     /// First and last non-empty span of the domain (for A2.1 at the domain ends).
     first: usize,
     last: usize,
+    /// Non-rational curves of degree ≤ 3: the non-empty spans in Bézier form, a cache for
+    /// fast evaluation ([`bezier_spans`]).
+    spans: Option<BezierSpans>,
+}
+
+/// The curve's data, without the evaluation cache (as before the cache existed: printed
+/// moves and error messages stay readable).
+impl std::fmt::Debug for Nurbs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Nurbs")
+            .field("degree", &self.degree)
+            .field("knots", &self.knots)
+            .field("cw", &self.cw)
+            .field("first", &self.first)
+            .field("last", &self.last)
+            .finish()
+    }
 }
 
 impl Nurbs {
@@ -85,7 +119,59 @@ impl Nurbs {
             cw,
             first,
             last,
-        })
+            spans: None,
+        }
+        .with_spans())
+    }
+
+    /// Fill the Bézier span cache when the curve qualifies (non-rational, degree ≤ 3).
+    fn with_spans(mut self) -> Self {
+        if self.degree > 3 || self.cw.iter().any(|c| c.w != 1.0) {
+            return self;
+        }
+        let parts = (self.first..=self.last).filter_map(|s| {
+            let (a, b) = (self.knots[s], self.knots[s + 1]);
+            if b <= a {
+                return None;
+            }
+            let [ca, da, ..] = self.rat_derivs_in(s, a, 1);
+            let [cb, db, ..] = self.rat_derivs_in(s, b, 1);
+            Some((a, b, bezier_spans::from_hermite((ca, da), (cb, db), b - a)))
+        });
+        self.spans = Some(BezierSpans::new(parts));
+        self
+    }
+
+    /// An upper bound of the convex function `f` (a distance to a point, segment or other
+    /// convex set) over the piece `u` in `[u0, u1]`, from the convex hull of the piece's Bézier
+    /// control points; `None` for curves without the Bézier cache (rational, degree > 3).
+    pub fn hull_max(&self, u0: f64, u1: f64, f: impl Fn(&Vec3) -> f64) -> Option<f64> {
+        self.spans.as_ref().map(|s| s.hull_max(u0, u1, f))
+    }
+
+    /// The axis-aligned box around the Bézier control points of the piece `u` in `[u0, u1]`:
+    /// it holds the piece (convex hull property), so its distance to a point bounds the
+    /// piece's from below. `None` for curves without the Bézier cache.
+    pub fn hull_box(&self, u0: f64, u1: f64) -> Option<BoundingBox> {
+        let spans = self.spans.as_ref()?;
+        let mut b = BoundingBox {
+            min: Vec3::repeat(f64::INFINITY),
+            max: Vec3::repeat(f64::NEG_INFINITY),
+        };
+        spans.hull_points(u0, u1, |q| {
+            b.min = b.min.inf(q);
+            b.max = b.max.sup(q);
+        });
+        Some(b)
+    }
+
+    /// The cached span holding `u` (clamped), `u`'s place `t` in it and `1 / width`; `None`
+    /// when the curve has no cache.
+    #[inline]
+    fn bezier_at(&self, u: f64) -> Option<(&bezier_spans::Span, f64, f64)> {
+        let spans = self.spans.as_ref()?;
+        let (a, b) = self.domain();
+        Some(spans.locate(clamp_param(u, a, b)))
     }
 
     /// A non-rational B-spline (all weights 1).
@@ -192,7 +278,9 @@ impl Nurbs {
             cw,
             first,
             last,
+            spans: None,
         }
+        .with_spans()
     }
 
     fn from_homogeneous(
@@ -210,8 +298,13 @@ impl Nurbs {
 
     /// C and its derivatives up to `nd` (higher ones left zero).
     fn rat_derivs(&self, u: f64, nd: usize) -> [Vec3; 4] {
-        let p = self.degree;
         let (span, u) = self.span(u);
+        self.rat_derivs_in(span, u, nd)
+    }
+
+    /// [`Self::rat_derivs`] with the polynomial of span `span` (a one-sided limit at its ends).
+    fn rat_derivs_in(&self, span: usize, u: f64, nd: usize) -> [Vec3; 4] {
+        let p = self.degree;
         let mut nders = [[0.0; W]; MAX_DER + 1];
         ders_basis_funs(&self.knots, span, u, p, nd, &mut nders);
         // Derivatives of the homogeneous curve Cw (A3.2 on the 4-D points).
@@ -300,6 +393,9 @@ impl Curve for Nurbs {
     }
 
     fn point(&self, u: f64) -> Vec3 {
+        if let Some((b, t, _)) = self.bezier_at(u) {
+            return bezier_spans::point(b, t);
+        }
         let p = self.degree;
         let (span, u) = self.span(u);
         let mut n = [0.0; W];
@@ -312,10 +408,21 @@ impl Curve for Nurbs {
     }
 
     fn derivs(&self, u: f64) -> [Vec3; 4] {
+        if let Some((b, t, iw)) = self.bezier_at(u) {
+            let mut d = bezier_spans::derivs(b, t, iw);
+            // Above the degree the derivatives are zero, not the rounding of the cubic form.
+            for v in d.iter_mut().skip(self.degree + 1) {
+                *v = Vec3::zeros();
+            }
+            return d;
+        }
         self.rat_derivs(u, MAX_DER)
     }
 
     fn d1(&self, u: f64) -> Vec3 {
+        if let Some((b, t, iw)) = self.bezier_at(u) {
+            return bezier_spans::d1(b, t, iw);
+        }
         // The arc-length quadrature only needs C'; skip the higher basis derivatives.
         self.rat_derivs(u, 1)[1]
     }
@@ -330,5 +437,133 @@ impl Curve for Nurbs {
         }
         out.push(b);
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Deterministic pseudo-random numbers in [0, 1) (xorshift64*).
+    fn rng(seed: u64) -> impl FnMut() -> f64 {
+        let mut x = seed;
+        move || {
+            x ^= x >> 12;
+            x ^= x << 25;
+            x ^= x >> 27;
+            (x.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn bezier_spans_match_the_basis_recurrences() {
+        // Degrees 1–3, uneven knots with interior multiplicities up to the degree (where
+        // derivatives jump), clamped and unclamped: the cached Bézier form must give the same
+        // point and derivatives as A2.3 + A4.2 on the same span, everywhere including knots.
+        let mut r = rng(0x5eed_0001);
+        for case in 0..300 {
+            let p = 1 + case % 3;
+            let n = p + 1 + (r() * 9.0) as usize;
+            let pts: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(100.0 * r() - 50.0, 10.0 * r(), r() - 0.5))
+                .collect();
+            let clamped = case % 4 != 3;
+            let mut knots: Vec<f64> = Vec::new();
+            let interior = n - p - 1;
+            let mut v: f64 = 0.0;
+            if clamped {
+                knots.extend(std::iter::repeat_n(0.0, p + 1));
+            } else {
+                for _ in 0..=p {
+                    knots.push(v);
+                    v += 0.1 + r();
+                }
+                v = *knots.last().unwrap_or(&0.0);
+            }
+            let mut k = 0;
+            while k < interior {
+                v += 0.01 + r();
+                let mult = (1 + (r() * p as f64) as usize).min(interior - k);
+                knots.extend(std::iter::repeat_n(v, mult));
+                k += mult;
+            }
+            v += 0.01 + r();
+            if clamped {
+                knots.extend(std::iter::repeat_n(v, p + 1));
+            } else {
+                for _ in 0..=p {
+                    knots.push(v);
+                    v += 0.1 + r();
+                }
+            }
+            let c = Nurbs::bspline(p, &pts, knots.clone()).unwrap();
+            assert!(c.spans.is_some());
+            let (a, b) = c.domain();
+            let mut us: Vec<f64> = (0..=200).map(|i| a + (b - a) * i as f64 / 200.0).collect();
+            us.extend(knots.iter().copied().filter(|&k| k >= a && k <= b));
+            for u in us {
+                let fast = c.derivs(u);
+                let slow = c.rat_derivs(u, MAX_DER);
+                for d in 0..=p {
+                    let scale = 1.0 + slow[d].norm();
+                    assert!(
+                        (fast[d] - slow[d]).norm() <= 1e-9 * scale,
+                        "case {case} p {p} u {u} d {d}: {} vs {}",
+                        fast[d],
+                        slow[d]
+                    );
+                }
+                // Above the degree: exactly zero (the recurrences leave rounding there).
+                assert!(fast[p + 1..].iter().all(|v| *v == Vec3::zeros()));
+                assert!((c.point(u) - slow[0]).norm() <= 1e-12 * (1.0 + slow[0].norm()));
+                assert!((c.d1(u) - slow[1]).norm() <= 1e-9 * (1.0 + slow[1].norm()));
+            }
+            if clamped {
+                // The ends of a clamped curve are its end control points, bit for bit.
+                assert_eq!(c.point(a), pts[0]);
+                assert_eq!(c.point(b), pts[n - 1]);
+            }
+        }
+    }
+
+    #[test]
+    fn hull_box_bounds_the_distance_from_below() {
+        let mut r = rng(0x5eed_0002);
+        for _ in 0..50 {
+            let pts: Vec<Vec3> = (0..9)
+                .map(|_| Vec3::new(10.0 * r(), 10.0 * r(), r()))
+                .collect();
+            let knots = vec![0., 0., 0., 0., 0.1, 0.3, 0.35, 0.6, 0.9, 1., 1., 1., 1.];
+            let c = Nurbs::bspline(3, &pts, knots).unwrap();
+            let (u0, u1) = (0.5 * r(), 0.5 + 0.5 * r());
+            let b = c.hull_box(u0, u1).unwrap();
+            let q = Vec3::new(20.0 * r() - 5.0, 20.0 * r() - 5.0, 4.0 * r() - 2.0);
+            let lb = b.distance(&q);
+            for i in 0..=400 {
+                let p = c.point(u0 + (u1 - u0) * i as f64 / 400.0);
+                // Inside up to the rounding of the blossom (a few ulp of the coordinates).
+                assert!(b.distance(&p) <= 1e-13, "{p} outside {b:?}");
+                assert!((p - q).norm() >= lb - 1e-13, "{} < {lb}", (p - q).norm());
+            }
+        }
+    }
+
+    #[test]
+    fn rational_and_high_degree_curves_keep_the_recurrences() {
+        let pts = [
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ];
+        let w = [1.0, std::f64::consts::FRAC_1_SQRT_2, 1.0];
+        let quarter = Nurbs::new(2, &pts, &w, vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0]).unwrap();
+        assert!(quarter.spans.is_none());
+        for i in 0..=20 {
+            let r = quarter.point(i as f64 / 20.0).norm();
+            assert!((r - 1.0).abs() < 1e-14, "{r}");
+        }
+        let pts5: Vec<Vec3> = (0..6).map(|i| Vec3::new(i as f64, 0.0, 0.0)).collect();
+        let knots = [vec![0.0; 6], vec![1.0; 6]].concat();
+        assert!(Nurbs::bspline(5, &pts5, knots).unwrap().spans.is_none());
     }
 }

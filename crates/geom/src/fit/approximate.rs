@@ -15,11 +15,10 @@
 //! polyline instead of running out of data (the plain A9.7 stalls at interpolation).
 
 use super::params::{check_points, parameters, Parameterisation};
-use super::pieces::Pieces;
 use crate::banded::Banded;
 use crate::basis::{basis_funs, ders_basis_funs, find_span, MAX_DEGREE, MAX_DER, W};
 use crate::curve::{Curve, Vec3};
-use crate::deviation::{closest_point, maximise, point_segment_distance, Deviation};
+use crate::deviation::{closest_point, maximise, Deviation};
 use crate::error::CurveError;
 use crate::nurbs::Nurbs;
 
@@ -54,7 +53,9 @@ pub struct Approximation {
     pub curve: Nurbs,
     /// Parameter of each input point (segment `k` corresponds to `[params[k], params[k+1]]`).
     pub params: Vec<f64>,
-    /// Largest measured distance over all points and segments (≤ the tolerance).
+    /// Largest measured distance over all points and segments (≤ the tolerance); where the
+    /// control polygon proved a piece inside the tolerance, its bound counts instead (≥ the
+    /// true distance).
     pub max_deviation: f64,
     /// Least-squares solves it took.
     pub rounds: usize,
@@ -122,11 +123,8 @@ fn refine(
             Err(_) if lambda > 0.0 => least_squares(&data, &interior, p, 0.0)?,
             Err(e) => return Err(e),
         };
-        let fast = Pieces::new(&curve);
-        let check = |quick| match &fast {
-            Some(f) => measure(f, points, t, &interior, tolerance, quick),
-            None => measure(&curve, points, t, &interior, tolerance, quick),
-        };
+        // (The curve evaluates from its Bézier span cache: cubic, non-rational.)
+        let check = |quick| measure(&curve, points, t, &interior, tolerance, quick);
         // A samples-only pass finds the violations of the early rounds at a fraction of the
         // cost; only when it finds none does the refined check (the one that can accept) run.
         let (mut worst, mut worst_in_span) = check(true);
@@ -176,10 +174,11 @@ fn span_bounds(interior: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Largest deviation over all pieces and points, and the worst violation `(distance, u)` in
-/// each knot span (None where the span is within tolerance).
-fn measure<C: Curve>(
-    curve: &C,
+/// Largest deviation over all pieces and points (or its convex-hull bound where that proves
+/// a piece inside), and the worst violation `(distance, u)` in each knot span (None where the
+/// span is within tolerance).
+fn measure(
+    curve: &Nurbs,
     points: &[Vec3],
     t: &[f64],
     interior: &[f64],
@@ -188,22 +187,37 @@ fn measure<C: Curve>(
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
     let bounds = span_bounds(interior);
-    let mut worst_in_span: Vec<Option<(f64, f64)>> = vec![None; bounds.len() - 1];
-    let mut worst = 0.0f64;
-    let mut note = |d: f64, u: f64| {
-        worst = worst.max(d);
-        if d > tolerance {
-            let s = bounds
-                .partition_point(|&x| x <= u)
-                .clamp(1, bounds.len() - 1)
-                - 1;
-            if worst_in_span[s].is_none_or(|(w, _)| d > w) {
-                worst_in_span[s] = Some((d, u));
+    let mut marks = Marks {
+        worst_in_span: vec![None; bounds.len() - 1],
+        bounds,
+        worst: 0.0,
+        tolerance,
+    };
+    // Each segment once, with its inverse squared length: the distance tests below run
+    // several times per piece and round, and a division and square root each was their cost.
+    let segs: Vec<Segment> = points
+        .windows(2)
+        .map(|w| Segment::new(&w[0], &w[1]))
+        .collect();
+    let tol2 = tolerance * tolerance;
+    let mut span = 0;
+    for k in 0..m {
+        // Only which knot spans hold a violation decides the next knots: a piece wholly
+        // inside a span already marked can add nothing, so it is not measured again.
+        span = marks.advance(span, t[k]);
+        if t[k + 1] <= marks.bounds[span + 1] && marks.worst_in_span[span].is_some() {
+            continue;
+        }
+        // The piece lies in the convex hull of its Bézier control points and the distance to
+        // segment k is convex, so the largest vertex distance bounds the piece's distance from
+        // above (and the distance to the three segments is at most that to segment k): when it
+        // is inside the tolerance no sample can find a violation, and the bound is recorded.
+        if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
+            if h2 <= tol2 {
+                marks.note(h2.sqrt(), t[k]);
+                continue;
             }
         }
-    };
-    for k in 0..m {
-        let (a, b) = (&points[k], &points[k + 1]);
         // More samples where knots fall inside the piece: each span may bend on its own.
         let inside =
             interior.partition_point(|&x| x < t[k + 1]) - interior.partition_point(|&x| x <= t[k]);
@@ -213,26 +227,31 @@ fn measure<C: Curve>(
             // The piece belongs to segment k, but a little tangential drift of the
             // parameter across a vertex is no deviation from the path: measure to the
             // segments around it.
-            let mut d = point_segment_distance(&c, a, b);
+            let mut d2 = segs[k].distance2(&c);
             if k > 0 {
-                d = d.min(point_segment_distance(&c, &points[k - 1], a));
+                d2 = d2.min(segs[k - 1].distance2(&c));
             }
-            if k + 2 <= m {
-                d = d.min(point_segment_distance(&c, b, &points[k + 2]));
+            if k + 1 < m {
+                d2 = d2.min(segs[k + 1].distance2(&c));
             }
-            d
+            d2.sqrt()
         };
         let d = if quick {
             sampled_max(dist, t[k], t[k + 1], samples)
         } else {
             maximise(dist, t[k], t[k + 1], samples)
         };
-        note(d.distance, d.u);
+        marks.note(d.distance, d.u);
     }
     if quick {
-        return (worst, worst_in_span);
+        return (marks.worst, marks.worst_in_span);
     }
+    let mut span = 0;
     for k in 1..m {
+        span = marks.advance(span, t[k - 1]);
+        if t[k + 1] <= marks.bounds[span + 1] && marks.worst_in_span[span].is_some() {
+            continue;
+        }
         // The point at its own parameter bounds the distance; refine only when needed.
         let direct = (curve.point(t[k]) - points[k]).norm();
         if direct > tolerance {
@@ -240,10 +259,71 @@ fn measure<C: Curve>(
                 - interior.partition_point(|&x| x <= t[k - 1]);
             let samples = 2 * SAMPLES + 4 * inside;
             let d = closest_point(&curve, &points[k], t[k - 1], t[k + 1], samples);
-            note(d.distance, d.u);
+            marks.note(d.distance, d.u);
         }
     }
-    (worst, worst_in_span)
+    (marks.worst, marks.worst_in_span)
+}
+
+/// What a measurement found: the largest deviation, and the worst violation per knot span.
+struct Marks {
+    /// `[0, interior knots…, 1]`.
+    bounds: Vec<f64>,
+    worst_in_span: Vec<Option<(f64, f64)>>,
+    worst: f64,
+    tolerance: f64,
+}
+
+impl Marks {
+    fn note(&mut self, d: f64, u: f64) {
+        self.worst = self.worst.max(d);
+        if d > self.tolerance {
+            let s = self
+                .bounds
+                .partition_point(|&x| x <= u)
+                .clamp(1, self.bounds.len() - 1)
+                - 1;
+            if self.worst_in_span[s].is_none_or(|(w, _)| d > w) {
+                self.worst_in_span[s] = Some((d, u));
+            }
+        }
+    }
+
+    /// The knot span holding `u`, searching forward from span `from` (`u` never decreases).
+    fn advance(&self, mut from: usize, u: f64) -> usize {
+        while from + 2 < self.bounds.len() && self.bounds[from + 1] <= u {
+            from += 1;
+        }
+        from
+    }
+}
+
+/// A programmed segment `a + t·ab`, `t` in `[0, 1]`, for repeated distance queries.
+struct Segment {
+    a: Vec3,
+    ab: Vec3,
+    /// `1 / |ab|²`, 0 for a zero-length segment (then the distance is to `a`).
+    inv_len2: f64,
+}
+
+impl Segment {
+    fn new(a: &Vec3, b: &Vec3) -> Self {
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        Segment {
+            a: *a,
+            ab,
+            inv_len2: if len2 > 0.0 { 1.0 / len2 } else { 0.0 },
+        }
+    }
+
+    /// Squared distance from `p` (as [`crate::deviation::point_segment_distance`], squared).
+    #[inline]
+    fn distance2(&self, p: &Vec3) -> f64 {
+        let ap = p - self.a;
+        let t = (ap.dot(&self.ab) * self.inv_len2).clamp(0.0, 1.0);
+        (ap - self.ab * t).norm_squared()
+    }
 }
 
 /// The largest of `samples + 1` equally spaced values: a lower bound of the maximum, enough

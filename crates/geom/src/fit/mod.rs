@@ -6,7 +6,6 @@
 mod approximate;
 mod interpolate;
 mod params;
-mod pieces;
 
 pub use approximate::{approximate, Approximation};
 pub use interpolate::interpolate;

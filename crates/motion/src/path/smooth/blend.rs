@@ -187,19 +187,32 @@ pub(crate) struct Placed {
     pub speed: f64,
 }
 
-/// Distance from `q` to the piece's geometry over `[u0, u1]`; `cuts` are the piece's knots
-/// in that range with both ends ([`cuts`]), found once per leg rather than per sample: a
+/// `min(best, distance from q to the piece's geometry over [u0, u1])`; `cuts` are the piece's
+/// knots in that range with both ends ([`cuts`]), found once per leg rather than per sample: a
 /// spline's knot vector has hundreds of entries and the blend measure calls this ~50 times.
-fn distance_to(p: &Piece, q: &Vec3, cuts: &[f64]) -> f64 {
+/// A knot span whose control points' box is already `best` or farther from `q` cannot lower
+/// the minimum (the span lies in the box) and is not searched.
+fn distance_to(p: &Piece, q: &Vec3, cuts: &[f64], best: f64) -> f64 {
     let (u0, u1) = (cuts[0], cuts[cuts.len() - 1]);
     match &p.geo {
-        Geo::Line(_) => point_segment_distance(q, &p.geo.point(u0), &p.geo.point(u1)),
-        Geo::Arc(a) => crate::path::deviation::arc_distance(a, q, u0, u1)
-            .unwrap_or_else(|| closest_point(a.as_ref(), q, u0, u1, 8).distance),
-        g => cuts
-            .windows(2)
-            .map(|w| closest_point(g, q, w[0], w[1], 8).distance)
-            .fold(f64::INFINITY, f64::min),
+        Geo::Line(_) => best.min(point_segment_distance(
+            q,
+            &p.geo.point(u0),
+            &p.geo.point(u1),
+        )),
+        Geo::Arc(a) => best.min(
+            crate::path::deviation::arc_distance(a, q, u0, u1)
+                .unwrap_or_else(|| closest_point(a.as_ref(), q, u0, u1, 8).distance),
+        ),
+        Geo::Spline(n) => cuts.windows(2).fold(best, |best, w| {
+            if n.hull_box(w[0], w[1])
+                .is_some_and(|b| b.distance(q) >= best)
+            {
+                best
+            } else {
+                best.min(closest_point(&p.geo, q, w[0], w[1], 8).distance)
+            }
+        }),
     }
 }
 
@@ -295,7 +308,13 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             let away = maximise(
                 |u| {
                     let q = curve.point(u);
-                    distance_to(a, &q, &ca).min(distance_to(b, &q, &cb))
+                    // The cheaper neighbour first (a spline is searched, a line or arc is
+                    // closed form): its distance lets the spline skip knot spans.
+                    if matches!(a.geo, Geo::Spline(_)) {
+                        distance_to(a, &q, &ca, distance_to(b, &q, &cb, f64::INFINITY))
+                    } else {
+                        distance_to(b, &q, &cb, distance_to(a, &q, &ca, f64::INFINITY))
+                    }
                 },
                 0.0,
                 1.0,

@@ -1,0 +1,150 @@
+//! `tezgah serve`: the executor behind a WebSocket on localhost, so a panel or a script can
+//! drive the machine. Each text message in is one JSON command; each reply and the status
+//! stream go out as JSON (schema in the README). The executor runs on its own threads
+//! (`tezgah_executor::threads`); this module only carries messages.
+
+use std::io::ErrorKind;
+use std::net::{TcpListener, TcpStream};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use miette::{miette, IntoDiagnostic, Result, WrapErr};
+use serde::{Deserialize, Serialize};
+use tezgah_executor::command::{Command, Status};
+use tezgah_executor::drive::IdealDrive;
+use tezgah_executor::executor::{ExecOptions, Executor};
+use tezgah_executor::rt::StopLimits;
+use tezgah_executor::threads::{spawn, Handle};
+use tezgah_geom::Pose;
+use tungstenite::{Message, WebSocket};
+
+/// Options of `tezgah serve`.
+pub struct ServeArgs {
+    pub machine: Option<String>,
+    pub listen: String,
+    /// Set-points kept ahead of the real-time thread (the ring's length), ms.
+    pub lead_ms: f64,
+    /// Interval of the status stream, ms.
+    pub status_ms: u64,
+}
+
+/// A message from a client: a command with an optional id that its reply echoes.
+#[derive(Debug, Deserialize)]
+struct Request {
+    #[serde(default)]
+    id: Option<u64>,
+    #[serde(flatten)]
+    command: Command,
+}
+
+/// What the server sends.
+#[derive(Debug, Serialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+enum Outgoing<'a> {
+    /// The answer to one request.
+    Reply {
+        id: Option<u64>,
+        ok: bool,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        error: Option<String>,
+    },
+    /// The periodic status.
+    Status(&'a Status),
+}
+
+/// Runs the server until the process is stopped.
+pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
+    let machine = crate::run::load_machine(args.machine.as_deref())?;
+    let options = ExecOptions::for_machine(&machine);
+    let period = options.period;
+    if !(args.lead_ms.is_finite() && args.lead_ms > 0.0) {
+        return Err(miette!("--lead-ms must be > 0, got {}", args.lead_ms));
+    }
+    let ring = ((args.lead_ms / 1000.0 / period).ceil() as usize).max(2);
+    let executor = Executor::new(&machine, options, Pose::ZERO).map_err(|e| miette!("{e}"))?;
+    let limits = StopLimits::of(executor.machine());
+    // Shared by the connections; a request holds it for the period or so its answer takes.
+    let host = Arc::new(Mutex::new(spawn(executor, IdealDrive, limits, ring)));
+
+    let listener = TcpListener::bind(&args.listen)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot listen on {}", args.listen))?;
+    let addr = listener.local_addr().into_diagnostic()?;
+    // The first line tells a script (or a test started with port 0) where to connect.
+    println!(
+        "tezgah serve: machine {}, listening on ws://{addr}",
+        machine.name
+    );
+    use std::io::Write;
+    let _ = std::io::stdout().flush();
+    let interval = Duration::from_millis(args.status_ms.max(1));
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else { continue };
+        let host = Arc::clone(&host);
+        std::thread::spawn(move || {
+            if let Err(e) = session(stream, &host, interval) {
+                eprintln!("tezgah serve: connection closed: {e}");
+            }
+        });
+    }
+    Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// One client: commands in, replies and the status stream out, until it closes.
+fn session(stream: TcpStream, host: &Mutex<Handle>, interval: Duration) -> Result<(), String> {
+    let mut ws = tungstenite::accept(stream).map_err(|e| e.to_string())?;
+    // Reads wait at most a little, so the status stream keeps its pace.
+    ws.get_mut()
+        .set_read_timeout(Some(Duration::from_millis(5)))
+        .map_err(|e| e.to_string())?;
+    let mut next_status = Instant::now();
+    loop {
+        match ws.read() {
+            Ok(Message::Text(text)) => {
+                let reply = answer(host, text.as_str());
+                send(&mut ws, &reply)?;
+            }
+            Ok(Message::Close(_)) => return Ok(()),
+            Ok(_) => {}
+            Err(tungstenite::Error::Io(e))
+                if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(tungstenite::Error::ConnectionClosed | tungstenite::Error::AlreadyClosed) => {
+                return Ok(())
+            }
+            Err(e) => return Err(e.to_string()),
+        }
+        if Instant::now() >= next_status {
+            next_status += interval;
+            let status = host
+                .lock()
+                .ok()
+                .and_then(|h| h.status.lock().ok().map(|s| s.clone()))
+                .ok_or_else(|| "the executor has stopped".to_owned())?;
+            send(&mut ws, &Outgoing::Status(&status))?;
+        }
+    }
+}
+
+/// The reply to one text message.
+fn answer(host: &Mutex<Handle>, text: &str) -> Outgoing<'static> {
+    let (id, result) = match serde_json::from_str::<Request>(text) {
+        Ok(request) => (
+            request.id,
+            match host.lock() {
+                Ok(h) => h.request(request.command).map_err(|e| e.to_string()),
+                Err(_) => Err("the executor has stopped".to_owned()),
+            },
+        ),
+        Err(e) => (None, Err(format!("not a command: {e}"))),
+    };
+    Outgoing::Reply {
+        id,
+        ok: result.is_ok(),
+        error: result.err(),
+    }
+}
+
+fn send(ws: &mut WebSocket<TcpStream>, message: &Outgoing) -> Result<(), String> {
+    let text = serde_json::to_string(message).map_err(|e| e.to_string())?;
+    ws.send(Message::text(text)).map_err(|e| e.to_string())
+}
