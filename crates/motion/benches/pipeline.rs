@@ -12,86 +12,20 @@
 //! Run briefly with `cargo bench -p tezgah-motion --bench pipeline -- --warm-up-time 1
 //! --measurement-time 3`. Each program first prints its duration and one timed run per stage.
 
-use std::fmt::Write;
 use std::hint::black_box;
 use std::time::Instant;
 
+#[path = "common/mod.rs"]
+mod common;
+
+use common::{lines_and_arcs, parse, plan_options, smooth_items, surfacing};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use tezgah_geom::{Move, Pose, Vec3};
+use tezgah_geom::Vec3;
 use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::run;
-use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::lookahead::plan_all;
-use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::plan::PlanMachine;
 use tezgah_motion::PathItem;
-
-/// Dense 3-axis surfacing: zig-zag passes of 0.05–0.3 mm segments over a smooth bump.
-fn surfacing() -> String {
-    let mut s = String::from("G21 G90 G94 G64\nF3000\nG0 X0 Y0 Z2\nG1 Z0\n");
-    let mut seed: u64 = 12345;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let z = |x: f64, y: f64| 2.0 * (-(x - 30.0).powi(2) / 400.0 - (y - 5.0).powi(2) / 100.0).exp();
-    for pass in 0..20 {
-        let y = pass as f64 * 0.5;
-        let (mut x, dir) = if pass % 2 == 0 {
-            (0.0, 1.0)
-        } else {
-            (60.0, -1.0)
-        };
-        let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
-        while (0.0..=60.0).contains(&x) {
-            x += dir * (0.05 + 0.25 * next());
-            let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
-        }
-    }
-    s.push_str("G0 Z5\nM2\n");
-    s
-}
-
-/// Long lines and arcs: a pocket outline of 100 mm lines and R10 corners, several depths.
-fn lines_and_arcs() -> String {
-    let mut s = String::from("G21 G90 G94 G17 G64\nF2400\nG0 X-50 Y-60 Z2\n");
-    for k in 0..10 {
-        let d = -0.5 * (k + 1) as f64;
-        let _ = writeln!(
-            s,
-            "G1 Z{d}\nG1 X50\nG3 X60 Y-50 R10\nG1 Y50\nG3 X50 Y60 R10\nG1 X-50\nG3 X-60 Y50 R10\n\
-             G1 Y-50\nG3 X-50 Y-60 R10"
-        );
-    }
-    s.push_str("G0 Z5\nM2\n");
-    s
-}
-
-fn parse(text: &str) -> Vec<Move> {
-    tezgah_gcode::program_moves(text, tezgah_gcode::Config::default()).unwrap()
-}
-
-/// The smoothing builder as `tezgah run` sets it up.
-fn smooth_items(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
-    smooth::build(
-        moves.iter().cloned(),
-        &SmoothOptions {
-            tolerance: machine.motion.tolerance_mm,
-            start: Pose::ZERO,
-            ..SmoothOptions::default()
-        },
-    )
-    .unwrap()
-}
-
-fn plan_options(machine: &Machine) -> PlanOptions {
-    PlanOptions {
-        period: machine.motion.period_s,
-        chord_share: smooth::CHORD_SHARE,
-        ..PlanOptions::default()
-    }
-}
 
 /// Plan, interpolate and solve the inverse kinematics; returns (program duration, samples).
 fn plan_interpolate(items: Vec<PathItem>, machine: &Machine) -> (f64, u64) {
