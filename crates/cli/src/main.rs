@@ -151,21 +151,7 @@ enum Command {
     /// List the built-in machine definitions.
     Machines,
     /// Run the executor behind a WebSocket (JSON commands in, replies and status out).
-    Serve {
-        /// A built-in machine name (see `tezgah machines`) or a machine file.
-        #[arg(long)]
-        machine: Option<String>,
-        /// Address to listen on (port 0 picks a free port; the first line printed names it).
-        #[arg(long, default_value = "127.0.0.1:7878")]
-        listen: String,
-        /// Set-points kept ahead of the real-time thread, ms: more rides out a busy computer,
-        /// less makes hold and override act sooner.
-        #[arg(long, default_value_t = 32.0)]
-        lead_ms: f64,
-        /// Interval of the status stream, ms.
-        #[arg(long, default_value_t = 50)]
-        status_ms: u64,
-    },
+    Serve(serve::ServeArgs),
 }
 
 fn main() -> ExitCode {
@@ -245,17 +231,7 @@ fn main() -> ExitCode {
             face,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
-        Command::Serve {
-            machine,
-            listen,
-            lead_ms,
-            status_ms,
-        } => serve::serve(serve::ServeArgs {
-            machine,
-            listen,
-            lead_ms,
-            status_ms,
-        }),
+        Command::Serve(args) => serve::serve(args),
     };
     match result {
         Ok(code) => code,

@@ -19,12 +19,20 @@ use tezgah_geom::Pose;
 use tungstenite::{Message, WebSocket};
 
 /// Options of `tezgah serve`.
+#[derive(clap::Args)]
 pub struct ServeArgs {
+    /// A built-in machine name (see `tezgah machines`) or a machine file.
+    #[arg(long)]
     pub machine: Option<String>,
+    /// Address to listen on (port 0 picks a free port; the first line printed names it).
+    #[arg(long, default_value = "127.0.0.1:7878")]
     pub listen: String,
-    /// Set-points kept ahead of the real-time thread (the ring's length), ms.
+    /// Set-points kept ahead of the real-time thread (the ring's length), ms: more rides out a
+    /// busy computer, less makes hold and override act sooner.
+    #[arg(long, default_value_t = 32.0)]
     pub lead_ms: f64,
     /// Interval of the status stream, ms.
+    #[arg(long, default_value_t = 50)]
     pub status_ms: u64,
 }
 
