@@ -24,6 +24,16 @@ pub enum ExecError {
     Kinematics { line: u32, message: String },
     #[error("machine: {0}")]
     Machine(String),
+    #[error("{0}")]
+    Manual(#[from] crate::manual::ManualError),
+    #[error(
+        "{command} needs the machine homed first (the machine file sets motion.home_required)"
+    )]
+    NotHomed { command: &'static str },
+    #[error("no jog in progress")]
+    NotJogging,
+    #[error("line {line}: out of reach before anything moves: {message}")]
+    Preflight { line: u32, message: String },
 }
 
 impl From<tezgah_motion::interpolate::InterpolateError> for ExecError {
