@@ -459,16 +459,20 @@ impl Executor {
                     self.mdi_at = end;
                 }
                 let mut job = self.mdi_modal.clone();
+                let mut modal = self.mdi_modal.clone();
                 for m in moves {
                     if is_modal(&m.kind) {
                         let d = std::mem::discriminant(&m.kind);
-                        self.mdi_modal
-                            .retain(|k| std::mem::discriminant(&k.kind) != d);
-                        self.mdi_modal.push(m.clone());
+                        modal.retain(|k| std::mem::discriminant(&k.kind) != d);
+                        modal.push(m.clone());
                     }
                     job.push(m);
                 }
-                self.start_job(job, Mode::Mdi)
+                // A block the pre-flight refuses leaves the modal moves as they were (the
+                // interpreter's position is re-synchronised before the next block anyway).
+                self.start_job(job, Mode::Mdi)?;
+                self.mdi_modal = modal;
+                Ok(())
             }
             Command::RestartFrom { line } => {
                 if self.state != RunState::Idle {

@@ -512,3 +512,110 @@ fn manual_commands_round_trip_as_json() {
     let home: Command = serde_json::from_str(r#"{"command":"home"}"#).unwrap();
     assert_eq!(home, Command::Home);
 }
+
+/// One step of a random manual session.
+#[derive(Debug, Clone)]
+enum Press {
+    /// Jog `joint` one way at `speed`, override changes at chosen periods, stop after `hold`.
+    Jog {
+        joint: usize,
+        plus: bool,
+        speed: f64,
+        overrides: Vec<(usize, f64)>,
+        hold: usize,
+    },
+    Inc {
+        joint: usize,
+        plus: bool,
+        step: f64,
+    },
+}
+
+fn press() -> impl Strategy<Value = Press> {
+    prop_oneof![
+        (
+            0usize..3,
+            any::<bool>(),
+            1.0..250.0f64,
+            proptest::collection::vec((0usize..400, 0.0..200.0f64), 0..4),
+            0usize..600
+        )
+            .prop_map(|(joint, plus, speed, overrides, hold)| Press::Jog {
+                joint,
+                plus,
+                speed,
+                overrides,
+                hold
+            }),
+        (0usize..3, any::<bool>(), 0.0001..0.1f64).prop_map(|(joint, plus, step)| Press::Inc {
+            joint,
+            plus,
+            step
+        }),
+    ]
+}
+
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Random jogs (speeds, override steps, stops, soft limits met on the way) and increments
+    /// from a random start: every joint within its limits at every period, never past a soft
+    /// limit, the stream consecutive, idle after every press, increments exact.
+    #[test]
+    fn random_manual_sessions_keep_the_limits(
+        start in (-150.0..150.0f64, -100.0..100.0f64, -60.0..60.0f64),
+        presses in proptest::collection::vec(press(), 1..6),
+    ) {
+        let m = Machine::default_machine();
+        let mut exec = Executor::new(
+            &m,
+            ExecOptions::for_machine(&m),
+            Pose::new(start.0, start.1, start.2, 0.0, 0.0, 0.0),
+        )
+        .unwrap();
+        let first = joints(&exec);
+        let mut all = Vec::new();
+        for p in presses {
+            let dir = |plus: bool| if plus { Direction::Plus } else { Direction::Minus };
+            match p {
+                Press::Jog { joint, plus, speed, overrides, hold } => {
+                    if exec.command(Command::Jog { joint, direction: dir(plus), speed: Some(speed) }).is_err() {
+                        continue; // on the limit already
+                    }
+                    all.extend(play(&mut exec, 1_000_000, |k, e| {
+                        for &(at, pct) in &overrides {
+                            if k == at {
+                                e.command(Command::JogOverride { percent: pct }).unwrap();
+                            }
+                        }
+                        if k == hold {
+                            e.command(Command::JogStop).unwrap();
+                        }
+                    }));
+                    exec.command(Command::JogOverride { percent: 100.0 }).unwrap();
+                }
+                Press::Inc { joint, plus, step } => {
+                    let before = exec.status().joints[joint];
+                    if exec.command(Command::Increment { joint, direction: dir(plus), step }).is_err() {
+                        continue; // past a soft limit
+                    }
+                    all.extend(play(&mut exec, 10_000, |_, _| {}));
+                    let want = before + if plus { step } else { -step };
+                    prop_assert_eq!(exec.status().joints[joint], want);
+                }
+            }
+            prop_assert_eq!(exec.state(), RunState::Idle);
+        }
+        if !all.is_empty() {
+            check_stream(&exec, &first, &all);
+        }
+        for p in &all {
+            for (j, q) in p.setpoint.position.as_slice().iter().enumerate() {
+                let joint = &m.joints[j];
+                prop_assert!(*q >= joint.min && *q <= joint.max, "joint {} at {}", j, q);
+            }
+        }
+    }
+}
