@@ -2,7 +2,9 @@
 //! the plan into set-points. It runs on the planner thread (or a test's virtual clock): every
 //! [`Executor::step`] produces the next period's set-point, which the thread pushes into the
 //! ring. Feed override and hold act on the time scale ([`crate::scale`]) here, where samples
-//! are produced, so a command reaches the machine after the ring's few periods.
+//! are produced, so a command reaches the machine after the ring's few periods. JOG, INC and
+//! HOME ([`crate::manual`]) feed the same stream while idle; homing's offsets (drive minus
+//! machine frame) are added to every set-point once found.
 
 use std::sync::Arc;
 
