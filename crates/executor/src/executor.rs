@@ -18,11 +18,13 @@ use tezgah_motion::{Junction, Segment};
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
 use crate::job::{Job, JobOptions, PlannedItem};
-use crate::manual::active::{JointStop, ManualMotion};
-use crate::manual::{default_jog_speed, Home, HomeSwitches, Inc, IncStep, Jog, SimulatedSwitches};
+use crate::manual::active::ManualMotion;
+use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::SetPoint;
+
+mod manual;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -491,190 +493,16 @@ impl Executor {
                 joint,
                 direction,
                 speed,
-            } => {
-                if self.state != RunState::Idle {
-                    return Err(self.busy("jog"));
-                }
-                let speed = match speed {
-                    Some(v) => v,
-                    None => default_jog_speed(self.joint_kind(joint)?),
-                };
-                let mut jog = Jog::new(
-                    &self.machine_file,
-                    joint,
-                    &self.pose.joints,
-                    direction,
-                    speed,
-                    self.k,
-                )?;
-                jog.set_override(self.jog_override)?;
-                self.start_manual(ManualMotion::Jog(jog), Mode::Jog);
-                Ok(())
-            }
-            Command::JogStop => match &mut self.manual {
-                Some(ManualMotion::Jog(jog)) => {
-                    jog.stop();
-                    Ok(())
-                }
-                // Released after the jog ended (at a soft limit): nothing to do.
-                None if self.state == RunState::Idle => Ok(()),
-                _ => Err(ExecError::NotJogging),
-            },
-            Command::JogOverride { percent } => {
-                if !(0.0..=crate::manual::MAX_OVERRIDE_PERCENT).contains(&percent) {
-                    return Err(crate::manual::ManualError::Override { percent }.into());
-                }
-                if let Some(ManualMotion::Jog(jog)) = &mut self.manual {
-                    jog.set_override(percent)?;
-                }
-                self.jog_override = percent;
-                Ok(())
-            }
+            } => self.jog(joint, direction, speed),
+            Command::JogStop => self.jog_stop(),
+            Command::JogOverride { percent } => self.jog_override(percent),
             Command::Increment {
                 joint,
                 direction,
                 step,
-            } => {
-                if self.state != RunState::Idle {
-                    return Err(self.busy("increment"));
-                }
-                let step = IncStep::new(step)?;
-                let speed = default_jog_speed(self.joint_kind(joint)?);
-                let inc = Inc::new(
-                    &self.machine_file,
-                    joint,
-                    &self.pose.joints,
-                    direction,
-                    step,
-                    speed,
-                    self.k,
-                )?;
-                self.start_manual(ManualMotion::Inc(inc), Mode::Inc);
-                Ok(())
-            }
-            Command::Home => {
-                if self.state != RunState::Idle {
-                    return Err(self.busy("home"));
-                }
-                // Homing runs in the drives' frame; its offsets replace the old ones at the end.
-                let home = Home::new(&self.machine_file, &self.drive_joints(), self.k)?;
-                self.start_manual(ManualMotion::Home(Box::new(home)), Mode::Home);
-                Ok(())
-            }
+            } => self.increment(joint, direction, step),
+            Command::Home => self.home(),
         }
-    }
-
-    fn joint_kind(&self, joint: usize) -> Result<tezgah_kinematics::JointKind, ExecError> {
-        self.machine_file
-            .joints
-            .get(joint)
-            .map(|j| j.kind)
-            .ok_or_else(|| {
-                crate::manual::ManualError::NoSuchJoint {
-                    joint,
-                    count: self.machine_file.joints.len(),
-                }
-                .into()
-            })
-    }
-
-    fn start_manual(&mut self, motion: ManualMotion, mode: Mode) {
-        self.manual = Some(motion);
-        self.last_manual = None;
-        self.mode = mode;
-        self.state = RunState::Running;
-        self.error = None;
-    }
-
-    /// Ends the manual motion in hand jerk-limited: a jog by its own stop (the minimum
-    /// distance), INC and HOME by stopping every joint from its exact state (homing is then
-    /// not complete; the offsets in force stay).
-    fn stop_manual(&mut self) {
-        match &mut self.manual {
-            Some(ManualMotion::Jog(jog)) => jog.stop(),
-            Some(ManualMotion::Stop(_)) | None => {}
-            Some(_) => {
-                let last = self
-                    .last_manual
-                    .unwrap_or_else(|| SetPoint::at_rest(0, 0, self.pose.joints));
-                self.manual = Some(ManualMotion::Stop(JointStop::new(
-                    &last,
-                    &self.machine.max_acceleration,
-                    &self.machine.max_jerk,
-                    self.options.period,
-                )));
-            }
-        }
-    }
-
-    /// One period of the manual motion in hand.
-    fn step_manual(&mut self) -> Result<Option<Produced>, ExecError> {
-        let Some(manual) = self.manual.as_mut() else {
-            return Ok(None);
-        };
-        match manual.next(&*self.switches) {
-            Ok(Some(sp)) => {
-                let drive_frame = manual.in_drive_frame();
-                let position = if drive_frame {
-                    sub(&sp.position, &self.offset, 1.0)
-                } else {
-                    sp.position
-                };
-                self.last_manual = Some(SetPoint { position, ..sp });
-                let before = self.pose.tip;
-                self.set_joints(position);
-                let feed = (self.pose.tip - before).norm() / self.options.period;
-                let drive = if drive_frame {
-                    sp.position
-                } else {
-                    add(&position, &self.offset)
-                };
-                Ok(Some(self.emit_at(drive, false, feed)))
-            }
-            Ok(None) => {
-                if let Some(ManualMotion::Home(home)) = &self.manual {
-                    if let Some(offset) = home.offsets() {
-                        // The drives stay where they are (no jump); the machine frame moves.
-                        self.offset = offset;
-                        self.homed = true;
-                        self.set_joints(sub(&self.prev_joints, &offset, 1.0));
-                    }
-                }
-                self.manual = None;
-                self.last_manual = None;
-                self.state = RunState::Idle;
-                let at = self.prev_joints;
-                Ok(Some(self.emit_at(at, true, 0.0)))
-            }
-            Err(e) => {
-                // A homing that cannot go on (no switch found) stops where it is.
-                self.error = Some(e.to_string());
-                self.manual = None;
-                let last = self
-                    .last_manual
-                    .unwrap_or_else(|| SetPoint::at_rest(0, 0, self.pose.joints));
-                self.manual = Some(ManualMotion::Stop(JointStop::new(
-                    &last,
-                    &self.machine.max_acceleration,
-                    &self.machine.max_jerk,
-                    self.options.period,
-                )));
-                let error = self.error.clone();
-                let out = self.step_manual();
-                self.error = error;
-                out
-            }
-        }
-    }
-
-    /// The pose at machine-frame joints `q` (outside a program: line 0).
-    fn set_joints(&mut self, q: Joints) {
-        if let Ok((tip, rotary)) = self.machine.joint_mode_point(&q) {
-            self.pose.tip = tip;
-            self.pose.rotary = rotary;
-        }
-        self.pose.joints = q;
-        self.pose.line = 0;
     }
 
     fn drop_job(&mut self) {
