@@ -8,6 +8,7 @@ mod library;
 mod plot;
 mod run;
 mod serve;
+mod tracking;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -94,6 +95,10 @@ enum Command {
         /// Path tolerance, mm (default: the machine file's `tolerance_mm`; G64 P overrides).
         #[arg(long)]
         tolerance: Option<f64>,
+        /// The drive the samples go to: `ideal` (measured = commanded) or `servo` (the machine
+        /// file's servo model; the report adds tracking RMSE, following and contour errors).
+        #[arg(long, value_enum, default_value = "ideal")]
+        drive: tracking::DriveKind,
         #[command(flatten)]
         inputs: Inputs,
     },
@@ -181,6 +186,7 @@ fn main() -> ExitCode {
             plot,
             period,
             tolerance,
+            drive,
             inputs,
         } => run::run(run::RunArgs {
             program,
@@ -190,6 +196,7 @@ fn main() -> ExitCode {
             plot,
             period,
             tolerance,
+            drive,
             tool_table: inputs.tool_table,
             subroutine_path: inputs.subroutine_path,
             ini: inputs.ini,

@@ -14,6 +14,7 @@ use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::verify::{Report, Verifier};
 
 use crate::plot::Trace;
+use crate::tracking::{DriveKind, Tracker, Tracking};
 
 /// The built-in demo program (a rounded pocket outline with a helical entry).
 /// The smoothing options: the builder's defaults, then what the machine file's `[path]` table
@@ -110,6 +111,7 @@ pub struct RunArgs {
     pub plot: Option<PathBuf>,
     pub period: Option<f64>,
     pub tolerance: Option<f64>,
+    pub drive: crate::tracking::DriveKind,
     pub tool_table: Option<PathBuf>,
     pub subroutine_path: Vec<PathBuf>,
     pub ini: Option<PathBuf>,
@@ -233,6 +235,23 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         .map(|i| unit(&machine, i).1)
         .collect();
     let mut verifier = Verifier::new(&pm, period);
+    let mut tracker = match args.drive {
+        DriveKind::Ideal => None,
+        DriveKind::Servo => {
+            let start_joints = pm
+                .joints(
+                    pm.initial,
+                    &Vec3::from(start.xyz()),
+                    &[start.0[3], start.0[4], start.0[5]],
+                    &tezgah_kinematics::Joints::zeros(pm.joint_count()),
+                )
+                .map_err(|e| miette!("{e}"))?;
+            Some(
+                Tracker::new(&machine, pm.model.clone(), period, start_joints)
+                    .map_err(|e| miette!("--drive servo: {e}"))?,
+            )
+        }
+    };
     let mut trace = args.plot.as_ref().map(|_| Trace::new(machine.joints.len()));
     let bar = indicatif::ProgressBar::hidden();
     let mut write_error: Option<std::io::Error> = None;
@@ -240,6 +259,9 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let mut line_buf = String::with_capacity(256);
     let sink = |s: &Sample, seg: &[std::sync::Arc<tezgah_motion::Segment>]| {
         verifier.push(s, seg);
+        if let Some(t) = tracker.as_mut() {
+            t.push(s);
+        }
         if let Some(t) = trace.as_mut() {
             t.push(s, &scales);
         }
@@ -285,8 +307,16 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         w.flush().into_diagnostic()?;
     }
     let report = verifier.finish();
+    let tracking = tracker.map(Tracker::finish);
     if let Some(p) = &args.report {
-        let json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
+        let mut json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
+        json["drive"] = serde_json::json!(match args.drive {
+            DriveKind::Ideal => "ideal",
+            DriveKind::Servo => "servo",
+        });
+        if let Some(t) = &tracking {
+            json["tracking"] = tracking_json(&machine, t);
+        }
         std::fs::write(
             p,
             serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
@@ -303,13 +333,66 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     summary(
         &machine, &report, duration, &name, segments, period, tolerance, &axis,
     );
-    let over =
-        report.joints.iter().any(|j| j.worst_ratio() > 1.005) || report.max_deviation > tolerance;
+    if let Some(t) = &tracking {
+        tracking_summary(&machine, t);
+    }
+    let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
+        || report.max_deviation > tolerance
+        || tracking.as_ref().is_some_and(|t| t.fault.is_some());
     Ok(if over {
         std::process::ExitCode::FAILURE
     } else {
         std::process::ExitCode::SUCCESS
     })
+}
+
+/// The report's `tracking` section: file units per joint (mm or deg), contour in mm.
+fn tracking_json(machine: &Machine, t: &Tracking) -> serde_json::Value {
+    let joints: Vec<serde_json::Value> = (0..t.rmse.len())
+        .map(|i| {
+            let (u, k) = unit(machine, i);
+            serde_json::json!({
+                "name": machine.joints[i].name,
+                "unit": u,
+                "rmse": t.rmse[i] * k,
+                "max_following_error": t.max[i] * k,
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "joints": joints,
+        "contour_rmse_mm": t.contour.rmse,
+        "contour_max_mm": t.contour.max,
+        "contour_samples": t.contour.samples,
+        "fault": t.fault.map(|f| serde_json::json!({
+            "t": f.t,
+            "line": f.line,
+            "fault": format!("{:?}", f.fault),
+        })),
+    })
+}
+
+fn tracking_summary(machine: &Machine, t: &Tracking) {
+    println!("servo drive: joint   RMSE   max following error");
+    for i in 0..t.rmse.len() {
+        let (u, k) = unit(machine, i);
+        println!(
+            "{:<6} {:>12.3e} {u}  {:>12.3e} {u}",
+            machine.joints[i].name,
+            t.rmse[i] * k,
+            t.max[i] * k
+        );
+    }
+    println!(
+        "contour error RMSE {:.3e} mm, max {:.3e} mm",
+        t.contour.rmse, t.contour.max
+    );
+    if let Some(f) = t.fault {
+        println!(
+            "drive fault {:?} at t = {:.3} s (line {}): the figures after it are not tracking",
+            f.fault, f.t, f.line
+        );
+    }
 }
 
 /// The machine file's `kinematics.tcp`, as written there.

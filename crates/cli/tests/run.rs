@@ -260,3 +260,69 @@ fn pre_flight_refuses_a_program_past_a_joint_limit_before_any_output() {
         assert!(without.status.success(), "{name}");
     }
 }
+
+/// `--drive servo`: a straight move along x at 50 mm/s on mill3 with x's feed-forward off
+/// lags by the closed form v(1 + β/K_v)/K_p = 0.516528 mm at cruise (β = friction/inertia,
+/// K_p = 2π·20 Hz/1.2872 (the −3 dB bandwidth), K_v = 4K_p), all along the path: the contour error stays ~0; the
+/// joints that do not move have no error; the ideal drive reports no tracking section.
+#[test]
+fn servo_drive_reports_tracking_and_contour_errors() {
+    let mill3 = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../machines/mill3.toml"
+    ))
+    .unwrap();
+    let no_ff = mill3
+        .replace("velocity_feed_forward = 1.0", "velocity_feed_forward = 0.0")
+        .replace(
+            "acceleration_feed_forward = 1.0",
+            "acceleration_feed_forward = 0.0",
+        );
+    assert_ne!(no_ff, mill3);
+    let (machine, program) = (tmp("noff.toml"), tmp("line.ngc"));
+    std::fs::write(&machine, no_ff).unwrap();
+    std::fs::write(&program, "G21 G90 G1 X100 F3000\nM2\n").unwrap();
+    let run = |machine: &std::path::Path, drive: &str, json: &std::path::Path| {
+        let out = tezgah()
+            .arg("run")
+            .arg(&program)
+            .arg("--machine")
+            .arg(machine)
+            .args(["--drive", drive, "--report"])
+            .arg(json)
+            .output()
+            .unwrap();
+        let report = succeeded_with_report(&out, json);
+        (report, String::from_utf8_lossy(&out.stdout).into_owned())
+    };
+    let (r, stdout) = run(&machine, "servo", &tmp("servo.json"));
+    assert!(stdout.contains("contour error RMSE"), "{stdout}");
+    assert_eq!(r["drive"], "servo");
+    let t = &r["tracking"];
+    let joint = |i: usize, key: &str| t["joints"][i][key].as_f64().unwrap();
+    let kp = 2.0 * std::f64::consts::PI * 20.0 / tezgah_kinematics::machine::SERVO_BANDWIDTH_PER_KP;
+    let lag = 50.0 * (1.0 + (400.0 / 120.0) / (4.0 * kp)) / kp;
+    assert!((lag - 0.516528).abs() < 1e-6);
+    // The error rises to the cruise lag without overshoot (the loops are critically damped)
+    // and settles there in the 2 s of cruise; its RMSE is below the largest.
+    let (max_x, rmse_x) = (joint(0, "max_following_error"), joint(0, "rmse"));
+    assert!((max_x - lag).abs() < 1e-6, "max {max_x} vs {lag}");
+    assert!(rmse_x > 0.5 * lag && rmse_x < max_x, "rmse {rmse_x}");
+    for i in [1, 2] {
+        assert_eq!(joint(i, "max_following_error"), 0.0);
+    }
+    // A lag along a straight line is no contour error.
+    let contour = t["contour_max_mm"].as_f64().unwrap();
+    assert!(contour < 1e-6, "contour {contour}");
+    assert!(t["fault"].is_null());
+
+    // mill3 as shipped (full feed-forward) follows far closer; the ideal drive adds nothing.
+    let (full, _) = run(std::path::Path::new("mill3"), "servo", &tmp("full.json"));
+    let full_x = full["tracking"]["joints"][0]["max_following_error"]
+        .as_f64()
+        .unwrap();
+    assert!(full_x < 1e-2 * lag, "full feed-forward {full_x}");
+    let (ideal, _) = run(std::path::Path::new("mill3"), "ideal", &tmp("ideal.json"));
+    assert_eq!(ideal["drive"], "ideal");
+    assert!(ideal.get("tracking").is_none());
+}

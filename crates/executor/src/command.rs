@@ -28,7 +28,32 @@ pub enum Command {
     /// AUTO: run the loaded program from this source line (its modal state before it kept;
     /// the tool goes to the line's start point first).
     RestartFrom { line: u32 },
+    /// JOG (only while idle): move joint `joint` (0-based, machine-file order) continuously
+    /// until `jog_stop`, at `speed` (file units per second; default 50 mm/s or 20 °/s, capped
+    /// by the joint's limit) times the jog override; stops by itself at a soft limit.
+    Jog {
+        joint: usize,
+        direction: Direction,
+        #[serde(default)]
+        speed: Option<f64>,
+    },
+    /// End a jog: the joint comes to rest in the jerk-limited minimum distance.
+    JogStop,
+    /// Jog speed override, percent (0–200); acts on a jog in progress and the next ones.
+    JogOverride { percent: f64 },
+    /// INC (only while idle): move joint `joint` by `step` (0.0001–0.1 mm, or degrees) rest
+    /// to rest.
+    Increment {
+        joint: usize,
+        direction: Direction,
+        step: f64,
+    },
+    /// HOME (only while idle): the machine file's homing sequence, Z first; the homing
+    /// offsets take effect at its end.
+    Home,
 }
+
+pub use crate::manual::jog::Direction;
 
 /// The operating mode of the job in hand.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -36,6 +61,12 @@ pub enum Command {
 pub enum Mode {
     Auto,
     Mdi,
+    /// Continuous jog of one joint.
+    Jog,
+    /// One increment of one joint.
+    Inc,
+    /// The homing sequence.
+    Home,
 }
 
 /// Why the machine is paused in a program.
@@ -90,6 +121,10 @@ pub struct Status {
     pub single_block: bool,
     pub optional_stop: bool,
     pub program_loaded: bool,
+    /// Every joint homed (the homing offsets are in force).
+    pub homed: bool,
+    /// Jog speed override, percent.
+    pub jog_override_percent: f64,
     /// Commanded joints, machine-file order, internal units.
     pub joints: Vec<f64>,
     /// Tool tip, workpiece frame, mm.

@@ -26,6 +26,16 @@ pub enum ExecError {
     Machine(String),
     #[error("the executor's threads have stopped")]
     Stopped,
+    #[error("{0}")]
+    Manual(#[from] crate::manual::ManualError),
+    #[error(
+        "{command} needs the machine homed first (the machine file sets motion.home_required)"
+    )]
+    NotHomed { command: &'static str },
+    #[error("no jog in progress")]
+    NotJogging,
+    #[error("line {line}: out of reach before anything moves: {message}")]
+    Preflight { line: u32, message: String },
 }
 
 impl From<tezgah_motion::interpolate::InterpolateError> for ExecError {

@@ -2,7 +2,9 @@
 //! the plan into set-points. It runs on the planner thread (or a test's virtual clock): every
 //! [`Executor::step`] produces the next period's set-point, which the thread pushes into the
 //! ring. Feed override and hold act on the time scale ([`crate::scale`]) here, where samples
-//! are produced, so a command reaches the machine after the ring's few periods.
+//! are produced, so a command reaches the machine after the ring's few periods. JOG, INC and
+//! HOME ([`crate::manual`]) feed the same stream while idle; homing's offsets (drive minus
+//! machine frame) are added to every set-point once found.
 
 use std::sync::Arc;
 
@@ -16,9 +18,13 @@ use tezgah_motion::{Junction, Segment};
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
 use crate::job::{Job, JobOptions, PlannedItem};
+use crate::manual::active::ManualMotion;
+use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::SetPoint;
+
+mod manual;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,6 +92,8 @@ enum Event {
 /// The executor: modes, commands, the job in hand and its sampling.
 pub struct Executor {
     machine: PlanMachine,
+    /// The machine file (manual motion reads its joints and homing settings).
+    machine_file: Machine,
     options: ExecOptions,
     gcode: tezgah_gcode::Config,
     program: Option<Vec<Move>>,
@@ -116,12 +124,33 @@ pub struct Executor {
     /// Path length of the pieces finished, and where in the current one the tool is.
     done_length: f64,
     s: f64,
+    /// JOG, INC or HOME in hand (no job then).
+    manual: Option<ManualMotion>,
+    /// The manual generator's last set-point (machine frame, exact velocity and acceleration):
+    /// where a stop of it starts.
+    last_manual: Option<SetPoint>,
+    jog_override: f64,
+    /// Drive (power-on) frame minus machine frame per joint: set-points are `joints + offset`.
+    /// Zero until homing finds it.
+    offset: Joints,
+    homed: bool,
+    switches: Box<dyn HomeSwitches + Send>,
+    /// The program pose the loaded program was pre-flighted from.
+    checked_from: Option<Pose>,
 }
 
 fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
     let mut out = *a;
     for (o, y) in out.as_mut_slice().iter_mut().zip(b.as_slice()) {
         *o = (*o - y) * scale;
+    }
+    out
+}
+
+fn add(a: &Joints, b: &Joints) -> Joints {
+    let mut out = *a;
+    for (o, y) in out.as_mut_slice().iter_mut().zip(b.as_slice()) {
+        *o += y;
     }
     out
 }
@@ -143,8 +172,17 @@ impl Executor {
             ..tezgah_gcode::Config::default()
         };
         let n = pm.joint_count();
+        let switches = SimulatedSwitches::new(machine, &Joints::zeros(n))?;
         Ok(Executor {
             machine: pm,
+            machine_file: machine.clone(),
+            manual: None,
+            last_manual: None,
+            jog_override: 100.0,
+            offset: Joints::zeros(n),
+            homed: false,
+            switches: Box::new(switches),
+            checked_from: None,
             options,
             mdi: Mdi::new(gcode.clone()),
             mdi_modal: Vec::new(),
@@ -178,6 +216,28 @@ impl Executor {
 
     pub fn period(&self) -> f64 {
         self.options.period
+    }
+
+    /// The home switches homing reads (by default the machine file's, simulated, with the
+    /// power-on frame equal to the machine frame).
+    pub fn set_switches(&mut self, switches: Box<dyn HomeSwitches + Send>) {
+        self.switches = switches;
+    }
+
+    /// The joints as the drives see them (power-on frame): the status' joints plus the
+    /// homing offsets. A real-time side starts from these.
+    pub fn drive_joints(&self) -> Joints {
+        add(&self.pose.joints, &self.offset)
+    }
+
+    /// Drive (power-on) frame minus machine frame per joint, internal units (zero before
+    /// homing).
+    pub fn homing_offsets(&self) -> Joints {
+        self.offset
+    }
+
+    pub fn is_homed(&self) -> bool {
+        self.homed
     }
 
     pub fn state(&self) -> RunState {
@@ -214,6 +274,8 @@ impl Executor {
             single_block: self.single_block,
             optional_stop: self.optional_stop,
             program_loaded: self.program.is_some(),
+            homed: self.homed,
+            jog_override_percent: self.jog_override,
             joints: self.pose.joints.as_slice().to_vec(),
             tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
             time_scale: self.scale.r,
@@ -224,7 +286,12 @@ impl Executor {
     fn state_name(&self) -> &'static str {
         match self.state {
             RunState::Idle => "idle",
-            RunState::Running => "running",
+            RunState::Running => match self.mode {
+                Mode::Jog => "jogging",
+                Mode::Inc => "moving an increment",
+                Mode::Home => "homing",
+                Mode::Auto | Mode::Mdi => "running",
+            },
             RunState::Holding => "holding",
             RunState::Held => "held",
             RunState::Paused { .. } => "paused",
@@ -261,9 +328,41 @@ impl Executor {
         )
     }
 
+    /// Builds the whole path of `moves` from `start` with the executor's smoothing options
+    /// and checks every segment's joints against reach and limits (motion's pre-flight), so
+    /// a program that would leave the machine's work space is refused before anything moves.
+    fn preflight(&self, moves: &[Move], start: Pose) -> Result<(), ExecError> {
+        let options = SmoothOptions {
+            start,
+            control: self.machine.initial,
+            ..self.options.smooth.clone()
+        };
+        let items = tezgah_motion::path::smooth::build(moves.to_vec(), &options)
+            .map_err(ExecError::Path)?;
+        tezgah_motion::preflight::check_path(&items, &self.machine, self.pose.joints).map_err(|e| {
+            ExecError::Preflight {
+                line: e.line,
+                message: e.source.to_string(),
+            }
+        })
+    }
+
+    /// AUTO and MDI wait for homing if the machine file asks.
+    fn check_homed(&self, command: &'static str) -> Result<(), ExecError> {
+        if self.machine_file.motion.home_required && !self.homed {
+            return Err(ExecError::NotHomed { command });
+        }
+        Ok(())
+    }
+
     fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
-        let p = &self.pose;
         let start = self.program_pose();
+        // The loaded program was checked at load; again if the machine moved since.
+        let checked = mode == Mode::Auto && self.checked_from.is_some_and(|p| p.0 == start.0);
+        if !checked {
+            self.preflight(&moves, start)?;
+        }
+        let p = &self.pose;
         let job = Job::new(moves, &self.machine, &self.job_options(), start, p.joints)?;
         self.job = Some(job);
         self.current = None;
@@ -291,12 +390,16 @@ impl Executor {
                 }
                 let moves = tezgah_gcode::program_moves(&program, self.gcode.clone())
                     .map_err(|e| ExecError::Gcode(e.to_string()))?;
+                let here = self.program_pose();
+                self.preflight(&moves, here)?;
+                self.checked_from = Some(here);
                 self.program = Some(moves);
                 self.mode = Mode::Auto;
                 Ok(())
             }
             Command::CycleStart | Command::Resume => match self.state {
                 RunState::Idle => {
+                    self.check_homed("cycle start")?;
                     let moves = self.program.clone().ok_or(ExecError::NoProgram)?;
                     self.start_job(moves, Mode::Auto)
                 }
@@ -304,9 +407,14 @@ impl Executor {
                     self.state = RunState::Running;
                     Ok(())
                 }
+                RunState::Running if self.manual.is_some() => Err(self.busy("cycle start")),
                 RunState::Running => Ok(()),
                 _ => Err(self.busy("cycle start")),
             },
+            Command::FeedHold if self.manual.is_some() => {
+                self.stop_manual();
+                Ok(())
+            }
             Command::FeedHold => match self.state {
                 RunState::Running => {
                     self.state = RunState::Holding;
@@ -317,6 +425,7 @@ impl Executor {
             },
             Command::Abort => {
                 match self.state {
+                    RunState::Running if self.manual.is_some() => self.stop_manual(),
                     RunState::Running | RunState::Holding => self.state = RunState::Aborting,
                     RunState::Aborting => {}
                     _ => self.drop_job(),
@@ -343,6 +452,7 @@ impl Executor {
                 if self.state != RunState::Idle {
                     return Err(self.busy("MDI"));
                 }
+                self.check_homed("MDI")?;
                 let here = self.program_pose();
                 if here.0 != self.mdi_at.0 {
                     self.mdi.sync(&here)?;
@@ -353,25 +463,45 @@ impl Executor {
                     self.mdi_at = end;
                 }
                 let mut job = self.mdi_modal.clone();
+                let mut modal = self.mdi_modal.clone();
                 for m in moves {
                     if is_modal(&m.kind) {
                         let d = std::mem::discriminant(&m.kind);
-                        self.mdi_modal
-                            .retain(|k| std::mem::discriminant(&k.kind) != d);
-                        self.mdi_modal.push(m.clone());
+                        modal.retain(|k| std::mem::discriminant(&k.kind) != d);
+                        modal.push(m.clone());
                     }
                     job.push(m);
                 }
-                self.start_job(job, Mode::Mdi)
+                // A block the pre-flight refuses leaves the modal moves as they were (the
+                // interpreter's position is re-synchronised before the next block anyway).
+                self.start_job(job, Mode::Mdi)?;
+                self.mdi_modal = modal;
+                Ok(())
             }
             Command::RestartFrom { line } => {
                 if self.state != RunState::Idle {
                     return Err(self.busy("restart"));
                 }
+                self.check_homed("restart")?;
                 let program = self.program.as_ref().ok_or(ExecError::NoProgram)?;
                 let moves = restart_moves(program, line)?;
+                // A restart starts elsewhere than the program: check it whole.
+                self.checked_from = None;
                 self.start_job(moves, Mode::Auto)
             }
+            Command::Jog {
+                joint,
+                direction,
+                speed,
+            } => self.jog(joint, direction, speed),
+            Command::JogStop => self.jog_stop(),
+            Command::JogOverride { percent } => self.jog_override(percent),
+            Command::Increment {
+                joint,
+                direction,
+                step,
+            } => self.increment(joint, direction, step),
+            Command::Home => self.home(),
         }
     }
 
@@ -382,12 +512,16 @@ impl Executor {
         self.job = None;
         self.current = None;
         self.peeked = None;
+        self.manual = None;
+        self.last_manual = None;
         self.state = RunState::Idle;
         self.scale = TimeScale::held();
     }
 
-    /// The real-time side halted (underrun or drive fault) at `joints`: the job is lost.
-    pub fn fault(&mut self, joints: Joints, message: &str) {
+    /// The real-time side halted (underrun or drive fault) at `joints` (drive frame, as
+    /// commanded): the job is lost.
+    pub fn fault(&mut self, drive: Joints, message: &str) {
+        let joints = sub(&drive, &self.offset, 1.0);
         // A job error that caused the halt stays the message.
         let job_failed = self.state == RunState::Fault;
         self.drop_job();
@@ -405,7 +539,7 @@ impl Executor {
             self.pose.tip = p.tip;
         }
         self.pose.joints = joints;
-        self.prev_joints = joints;
+        self.prev_joints = drive;
         self.prev_velocity = Joints::zeros(joints.len());
     }
 
@@ -423,6 +557,9 @@ impl Executor {
             RunState::Running | RunState::Holding | RunState::Aborting
         ) {
             return Ok(None);
+        }
+        if self.manual.is_some() {
+            return self.step_manual();
         }
         match self.advance_one() {
             Ok(p) => Ok(p),
@@ -660,8 +797,13 @@ impl Executor {
     /// (zero when `rest`: a stop is exact, and the real-time side must see the machine at rest
     /// to idle without calling it an underrun).
     fn emit(&mut self, rest: bool, feed: f64) -> Produced {
+        let q = add(&self.pose.joints, &self.offset);
+        self.emit_at(q, rest, feed)
+    }
+
+    /// The set-point at drive-frame joints `q`.
+    fn emit_at(&mut self, q: Joints, rest: bool, feed: f64) -> Produced {
         let ts = self.options.period;
-        let q = self.pose.joints;
         let (velocity, acceleration) = if rest {
             (Joints::zeros(q.len()), Joints::zeros(q.len()))
         } else {

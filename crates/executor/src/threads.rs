@@ -201,8 +201,8 @@ pub fn spawn<D: Drive + Send + 'static>(
 ) -> Handle {
     let period = exec.period();
     let (planner_rings, rt_ends) = rings(capacity, 4 * capacity.max(64));
-    let start = tezgah_kinematics::Joints::from_slice(&exec.status().joints)
-        .unwrap_or_else(|_| tezgah_kinematics::Joints::zeros(0));
+    // The drive's frame (machine joints plus the homing offsets), where set-points live.
+    let start = exec.drive_joints();
     let quit = Arc::new(AtomicBool::new(false));
     let status = Arc::new(Mutex::new(exec.status()));
     let (tx, rx) = mpsc::channel::<Command>();

@@ -209,8 +209,12 @@ fn spawned_threads_run_a_command() {
     assert!(figures.rt.periods >= figures.rt.delivered);
 }
 
-/// A job that fails while the machine moves (a pose beyond a joint limit: nothing before the
-/// sampling checks position limits, so it is met at X = 200.1 while moving) stops producing:
+/// A job that fails while the machine moves (a pose beyond a joint limit that the pre-flight
+/// at load cannot see: a 0.2 mm circle bulging 0.003 mm past X = 200 between the points it
+/// checks 0.5 mm apart; a plain X250 is refused at load now; run at 1 mm/s, since on that
+/// circle at full feed the stop, which starts from the set-point's backward-difference
+/// velocity and acceleration, meets a lagging acceleration: 3 J by third differences) stops
+/// producing:
 /// the real-time side sees an underrun and stops jerk-limited; the executor reports the
 /// job's error with its line.
 #[test]
@@ -219,7 +223,7 @@ fn a_job_error_in_motion_stops_like_an_underrun() {
     for k in 0..150 {
         program.push_str(if k % 2 == 0 { "G1 X10\n" } else { "G1 X0\n" });
     }
-    program.push_str("G1 X250\nM2\n");
+    program.push_str("G1 X199.62 Y0\nG2 X199.62 Y0 I0.2 J0 F60\nG1 X0\nM2\n");
     let (mut side, mut rt) = rig(16);
     side.command(Command::Load { program }).unwrap();
     side.command(Command::CycleStart).unwrap();
@@ -236,7 +240,7 @@ fn a_job_error_in_motion_stops_like_an_underrun() {
     let s = side.status();
     assert_eq!(s.state, RunState::Fault);
     let error = s.error.unwrap();
-    assert!(error.contains("line 152"), "{error}");
+    assert!(error.contains("line 153"), "{error}");
     let ts = side.executor().period();
     let seen = &rt.drive().seen;
     assert!(seen.len() > 1000, "it failed while moving, not before");

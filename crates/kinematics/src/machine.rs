@@ -127,6 +127,7 @@ struct RawKinematics {
 struct RawMotion {
     period_s: f64,
     tolerance_mm: f64,
+    home_required: Option<bool>,
 }
 
 /// `[path]`: the smoothing builder's options (issue 4); every field optional.
@@ -190,6 +191,9 @@ pub struct Motion {
     pub period_s: f64,
     /// Path deviation allowed for smoothing, chord error and segmentation, mm.
     pub tolerance_mm: f64,
+    /// `home_required` (default false): the executor refuses AUTO and MDI until the machine
+    /// is homed.
+    pub home_required: bool,
 }
 
 /// The optional `[path]` table: smoothing options for this machine. `None` leaves the path
@@ -463,6 +467,7 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
     let motion = Motion {
         period_s: positive("motion.period_s", raw.motion.period_s)?,
         tolerance_mm: positive("motion.tolerance_mm", raw.motion.tolerance_mm)?,
+        home_required: raw.motion.home_required.unwrap_or(false),
     };
     let angle = |field: &str, v: Option<f64>| -> Result<Option<f64>, MachineError> {
         match v {

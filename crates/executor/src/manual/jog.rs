@@ -13,7 +13,8 @@ use super::{check_start, override_factor, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
 
 /// Which way a manual move goes along its joint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Direction {
     Plus,
     Minus,

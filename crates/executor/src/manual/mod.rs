@@ -27,6 +27,7 @@
 //! # }
 //! ```
 
+pub mod active;
 pub mod home;
 pub mod inc;
 pub mod jog;
