@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions, Posted};
 use tezgah_cam::step::Face;
-use tezgah_cam::verify::{self, Verification, VerifyOptions};
+use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{Cutter, CutterShape, Settings, StrategyKind, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::Machine;
@@ -271,7 +271,7 @@ impl Finished {
 }
 
 /// Post `path` and simulate the cut along the program as the machine moves it: dexels every
-/// twentieth of the step-over, poses close enough that the sweep error is a tenth of the
+/// twentieth of the step-over (coarser where the grid would not fit in memory), poses close enough that the sweep error is a tenth of the
 /// tolerance.
 pub fn finish(
     surface: &NurbsSurface,
@@ -287,13 +287,24 @@ pub fn finish(
     };
     // δ²/(8ρ) = tolerance/10.
     let spacing = (0.8 * rho * options.tolerance_mm).sqrt();
-    let verify_options = VerifyOptions {
+    let mut verify_options = VerifyOptions {
         cell_mm: step_over / 20.0,
         sweep_spacing_mm: spacing,
     };
     let poses = posted.sweep(machine, spacing).into_diagnostic()?;
-    let verification =
-        verify::simulate(surface, path, &poses, &verify_options).into_diagnostic()?;
+    // A surface whose parametric speed varies (STEP fits often run 5:1) needs its dexel grid
+    // at the largest speed everywhere; when that exceeds the simulation's memory guard the
+    // cell grows to fit under it (the grid bound, reported, grows with it).
+    let mut tries = 0;
+    let verification = loop {
+        match verify::simulate(surface, path, &poses, &verify_options) {
+            Err(verify::VerifyError::TooFine(count)) if tries < 4 => {
+                tries += 1;
+                verify_options.cell_mm *= (count as f64 / (0.95 * MAX_DEXELS as f64)).sqrt();
+            }
+            other => break other.into_diagnostic()?,
+        }
+    };
     Ok(Finished {
         posted,
         verification,
