@@ -328,6 +328,46 @@ mod tests {
     }
 
     #[test]
+    fn passing_beside_the_pole_keeps_the_branch_and_turns_c() {
+        // The axis sweeps past the pole at 0.75° (the free-form patch's pass 42 near its hill
+        // top): switching branch would send the tilt through zero, 0.75° off the path, which
+        // no inserted point can mend; the branch is kept and C turns about half a turn.
+        let o = Orienter {
+            pole_sin: (0.005 / 3.0_f64).min(1.0) * 0.5,
+            ..ac(-30.0, 120.0)
+        };
+        let miss = 0.75f64.to_radians();
+        let axes: Vec<Vec3> = (-6..=6)
+            .map(|i| {
+                let t = (i as f64 * 1.2).to_radians();
+                Vec3::new(t.sin(), miss.sin(), t.cos() * miss.cos()).normalize()
+            })
+            .collect();
+        assert!(!o.arc_meets_pole(&axes[5], &axes[6]));
+        let got = o.choose(&axes, ZERO).unwrap();
+        for (a, k) in got.iter().zip(&axes) {
+            assert!((o.axis(*a) - k).norm() < 1e-9);
+        }
+        let signs: Vec<bool> = got.iter().map(|a| a.tilt > 0.0).collect();
+        assert!(signs.iter().all(|&s| s == signs[0]), "{got:?}");
+        let turn = (got[12].c - got[0].c).abs().to_degrees();
+        assert!(turn > 150.0 && turn < 180.0, "{turn}");
+        // Through the pole itself the branch changes and C stays.
+        let through: Vec<Vec3> = (-6..=6)
+            .map(|i| {
+                let t = (i as f64 * 1.2 + 0.5).to_radians();
+                Vec3::new(t.sin(), 0.0, t.cos())
+            })
+            .collect();
+        assert!(o.arc_meets_pole(&through[5], &through[6]));
+        let got = o.choose(&through, ZERO).unwrap();
+        assert!(
+            got.windows(2).all(|w| (w[0].c - w[1].c).abs() < 1e-9),
+            "{got:?}"
+        );
+    }
+
+    #[test]
     fn c_unwraps_the_shortest_way_and_past_a_turn() {
         // The axis circles the pole twice at 30°: C grows continuously to 720°.
         let o = ac(-30.0, 120.0);
@@ -447,7 +487,21 @@ mod tests {
                     }
                 }
                 let ours: Vec<(f64, f64)> = got.iter().map(|a| (a.tilt, a.c)).collect();
-                prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+                // A change of branch (the tilt's sign) between two axes off the pole is only
+                // made where the arc between them passes through the pole cone (branch 0
+                // always fits here, so nothing forces one).
+                let bad_switch = |v: &[(f64, f64)]| {
+                    (1..v.len()).any(|i| {
+                        let (a, b) = (axes[i - 1], axes[i]);
+                        !o.at_pole(&a) && !o.at_pole(&b) && v[i - 1].0 * v[i].0 < 0.0
+                            && !o.arc_meets_pole(&a, &b)
+                    })
+                };
+                prop_assert!(!bad_switch(&ours));
+                // Among sequences that can be linearised, ours travels least.
+                if !bad_switch(&greedy) {
+                    prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+                }
             }
         }
     }

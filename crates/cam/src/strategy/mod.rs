@@ -668,6 +668,44 @@ mod tests {
     }
 
     #[test]
+    fn contacts_beyond_the_axis_tilt_limit_are_left_out_as_out_of_reach() {
+        // Sphere R 30 between latitudes 10° and 60°: normals 30°…80° from +Z. With the axis
+        // along the normal and at most 50° of lean, the band below latitude 40° is left out.
+        let (r, limit) = (30.0, 50.0_f64);
+        let surface = crate::testing::sphere(r);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+        for kind in [StrategyKind::ZigZag, StrategyKind::IsoScallop] {
+            let mut settings = Settings::new(kind, 0.2, 0.01);
+            settings.max_axis_tilt_deg = Some(limit);
+            let p = plan(&surface, &cutter, &settings).unwrap();
+            let cos = limit.to_radians().cos();
+            assert!(p.path.contact_count() > 100, "{kind}");
+            for cl in p.path.passes.iter().flat_map(|q| &q.points) {
+                assert!(cl.axis.normalize().z >= cos - 1e-9, "{kind}: {cl:?}");
+            }
+            assert!(!p.refused.is_empty(), "{kind}");
+            for f in &p.refused {
+                assert_eq!(f.refusal, Refusal::OutOfReach, "{kind}");
+                assert!(!f.refusal.is_gouge());
+                // Out of reach means the normal leans more than the limit: below z = r cos 50°.
+                assert!(f.contact.z < r * cos + 1e-6, "{kind}: {f:?}");
+            }
+            // The kept part reaches down to the limit (within a forward step of 5 mm).
+            let lowest = p
+                .path
+                .passes
+                .iter()
+                .flat_map(|q| &q.points)
+                .map(|c| c.contact.z)
+                .fold(f64::INFINITY, f64::min);
+            assert!(lowest < r * cos + 5.0, "{kind}: {lowest}");
+        }
+        let mut bad = Settings::new(StrategyKind::ZigZag, 0.2, 0.01);
+        bad.max_axis_tilt_deg = Some(f64::NAN);
+        assert!(bad.validate().is_err());
+    }
+
+    #[test]
     fn settings_out_of_range_are_refused() {
         let base = Settings::new(StrategyKind::ZigZag, 0.01, 0.01);
         assert!(base.validate().is_ok());

@@ -218,11 +218,7 @@ pub fn simulate(
     // across the other parameter): a surface whose parametric speed varies — STEP fits often
     // run 5:1 — gets nodes no denser than the cell where it is slow.
     let (us, lu) = arc_nodes(|u, v| surface.derivs(u, v).su.norm(), (u0, u1), (v0, v1));
-    let (vs, lv) = arc_nodes(
-        |v, u| surface.derivs(u, v).sv.norm(),
-        (v0, v1),
-        (u0, u1),
-    );
+    let (vs, lv) = arc_nodes(|v, u| surface.derivs(u, v).sv.norm(), (v0, v1), (u0, u1));
     let nu = ((lu / cell).ceil() as usize).max(1) + 1;
     let nv = ((lv / cell).ceil() as usize).max(1) + 1;
     let count = nu.saturating_mul(nv);
@@ -661,6 +657,32 @@ impl Buckets {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn grid_lines_at_equal_arc_length_keep_every_cell_within_the_spacing() {
+        // Speed 1 + 3t on [0, 1] (length 2.5), the same across: the nodes bunch where it is
+        // fast, and no step's true length ∫(1 + 3t) dt exceeds the cell.
+        let (samples, length) = arc_nodes(|t, _| 1.0 + 3.0 * t, (0.0, 1.0), (0.0, 1.0));
+        assert!(
+            length >= 2.5 * 1.05 && length < 2.5 * 1.05 * 1.01,
+            "{length}"
+        );
+        let cell = 0.05;
+        let n = (length / cell).ceil() as usize + 1;
+        let nodes = spread(&samples, n);
+        assert_eq!(nodes.len(), n);
+        assert_eq!((nodes[0], nodes[n - 1]), (0.0, 1.0));
+        let true_length = |a: f64, b: f64| (b - a) + 1.5 * (b * b - a * a);
+        let steps: Vec<f64> = nodes.windows(2).map(|w| true_length(w[0], w[1])).collect();
+        assert!(steps.iter().all(|&d| d > 0.0 && d <= cell), "{steps:?}");
+        // Nearly equal: a uniform grid would need the fast end's spacing everywhere (4 × 1.05
+        // / 0.05 = 84 steps instead of 53).
+        let (lo, hi) = steps
+            .iter()
+            .fold((f64::INFINITY, 0.0_f64), |(a, b), &d| (a.min(d), b.max(d)));
+        assert!(lo > 0.9 * hi, "{lo} {hi}");
+        assert!(n - 1 < 60, "{n}");
+    }
 
     fn dexel(foot: Vec3) -> Dexel {
         Dexel {
