@@ -152,6 +152,14 @@ enum Command {
         /// The STEP `#id` of the face to machine (needed when the file has several faces).
         #[arg(long)]
         face: Option<u64>,
+        /// The most the tool axis may lean from the part's +Z, degrees: contact points facing
+        /// further away are left out (default: 75°, or less if the machine's tilt range is).
+        #[arg(long)]
+        max_tilt: Option<f64>,
+        /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
+        /// step-over; coarser is faster and widens the reported grid bound).
+        #[arg(long)]
+        verify_cell: Option<f64>,
     },
     /// List the built-in machine definitions.
     Machines,
@@ -219,6 +227,8 @@ fn main() -> ExitCode {
             tool_table,
             tool_number,
             face,
+            max_tilt,
+            verify_cell,
         } => cam::cam(cam::CamArgs {
             surface,
             tool,
@@ -236,6 +246,8 @@ fn main() -> ExitCode {
             tool_table,
             tool_number,
             face,
+            max_tilt_deg: max_tilt,
+            verify_cell_mm: verify_cell,
         }),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
         Command::Serve(args) => serve::serve(args),

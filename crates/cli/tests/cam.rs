@@ -242,4 +242,28 @@ fn cam_refuses_bad_options_without_a_panic() {
         .unwrap();
     assert!(!out.status.success());
     assert!(!out_ngc.exists());
+    // Out-of-range reach and verification options are refused before any file is read.
+    for (flag, value, word) in [
+        ("--max-tilt", "95", "--max-tilt"),
+        ("--max-tilt", "0", "--max-tilt"),
+        ("--verify-cell", "0", "--verify-cell"),
+    ] {
+        let out = tezgah()
+            .args([
+                "cam",
+                "missing.stp",
+                "--tool",
+                "ball:3",
+                "--strategy",
+                "zigzag",
+            ])
+            .args(["--scallop", "0.1", "--tolerance", "0.01", flag, value, "-o"])
+            .arg(&out_ngc)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(!err.contains("panicked") && err.contains(word), "{err}");
+        assert!(!out_ngc.exists());
+    }
 }

@@ -56,6 +56,32 @@ impl Orienter {
         k.x.hypot(k.y) <= self.pole_sin && k.z > 0.0
     }
 
+    /// True when the great-circle arc from `a` to `b` (unit axes) comes inside the pole cone:
+    /// only there may the angles change branch between the two points. Elsewhere a change of
+    /// branch, (θ, C) → (−θ′, C′ + π), sends the linearly interpolated tilt through zero — the
+    /// axis through the pole — while the path's axis passes the pole at the arc's distance
+    /// from it, and no inserted point can shrink that: every split leaves one piece holding
+    /// the change.
+    pub fn arc_meets_pole(&self, a: &Vec3, b: &Vec3) -> bool {
+        if self.at_pole(a) || self.at_pole(b) {
+            return true;
+        }
+        let n = a.cross(b);
+        let len = n.norm();
+        if len < 1e-15 {
+            return false;
+        }
+        let n = n / len;
+        // The point of the arc's great circle nearest +Z lies along Z's projection on its
+        // plane; it is at sin(distance) = |n_z| from the pole.
+        let w = Vec3::z() - n * n.z;
+        if w.norm() < 1e-15 {
+            return false;
+        }
+        let inside = a.cross(&w).dot(&n) >= 0.0 && w.cross(b).dot(&n) >= 0.0;
+        inside && n.z.abs() <= self.pole_sin
+    }
+
     /// Both solutions away from the pole: branch 0 has tilt ≥ 0, branch 1 is (−tilt, C + π).
     pub fn solutions(&self, k: &Vec3) -> [TableAngles; 2] {
         let s = match self.tilt_axis {
@@ -95,8 +121,11 @@ impl Orienter {
     }
 
     /// Table angles for every axis of `axes` (unit vectors, part frame), starting from the
-    /// machine at `start`: the branch sequence of least rotary travel within the tilt limits,
-    /// C held at the pole, C unwrapped the shortest way within its limits.
+    /// machine at `start`: the branch sequence of least rotary travel within the tilt limits
+    /// that changes branch only where the path passes through the pole cone
+    /// ([`Orienter::arc_meets_pole`]; a change elsewhere is taken only when the tilt limits
+    /// leave no other way, and then the linearisation check reports it), C held at the pole,
+    /// C unwrapped the shortest way within its limits.
     pub fn choose(
         &self,
         axes: &[Vec3],
@@ -110,11 +139,14 @@ impl Orienter {
         // Viterbi over the two branches: cost, state values and back pointers per point.
         let mut states: Vec<[Option<TableAngles>; 2]> = Vec::with_capacity(axes.len());
         let mut back: Vec<[usize; 2]> = Vec::with_capacity(axes.len());
-        let mut cost = [0.0_f64; 2];
+        // Cost: (changes of branch off the pole, rotary travel), compared in that order.
+        let mut cost = [(0u32, 0.0_f64); 2];
         let mut before = [start, start];
         for (i, k) in axes.iter().enumerate() {
             let (cand, pole) = self.candidates(k, before);
-            let mut next_cost = [f64::INFINITY; 2];
+            let mut next_cost = [(u32::MAX, f64::INFINITY); 2];
+            let off_pole_pair = i > 0 && !pole && !self.at_pole(&axes[i - 1]);
+            let switch_ok = !off_pole_pair || self.arc_meets_pole(&axes[i - 1], k);
             let mut ptr = [0usize; 2];
             for (s, c) in cand.iter().enumerate() {
                 let Some(c) = c else { continue };
@@ -129,14 +161,20 @@ impl Orienter {
                         states[i - 1][p]
                     };
                     let Some(prev) = prev else { continue };
-                    let total = cost[p] + step(&prev, c);
-                    if total < next_cost[s] {
+                    if cost[p].1.is_infinite() {
+                        continue;
+                    }
+                    let bad = u32::from(off_pole_pair && p != s && !switch_ok);
+                    let total = (cost[p].0 + bad, cost[p].1 + step(&prev, c));
+                    if total.0 < next_cost[s].0
+                        || (total.0 == next_cost[s].0 && total.1 < next_cost[s].1)
+                    {
                         next_cost[s] = total;
                         ptr[s] = p;
                     }
                 }
             }
-            if next_cost.iter().all(|c| !c.is_finite()) {
+            if next_cost.iter().all(|c| !c.1.is_finite()) {
                 let tilt = if pole {
                     self.keeping_c(k, before[0].c).tilt
                 } else {
@@ -148,7 +186,7 @@ impl Orienter {
                 });
             }
             let values = [0, 1].map(|s| {
-                if next_cost[s].is_finite() {
+                if next_cost[s].1.is_finite() {
                     cand[s]
                 } else {
                     None
@@ -290,6 +328,46 @@ mod tests {
     }
 
     #[test]
+    fn passing_beside_the_pole_keeps_the_branch_and_turns_c() {
+        // The axis sweeps past the pole at 0.75° (the free-form patch's pass 42 near its hill
+        // top): switching branch would send the tilt through zero, 0.75° off the path, which
+        // no inserted point can mend; the branch is kept and C turns about half a turn.
+        let o = Orienter {
+            pole_sin: (0.005 / 3.0_f64).min(1.0) * 0.5,
+            ..ac(-30.0, 120.0)
+        };
+        let miss = 0.75f64.to_radians();
+        let axes: Vec<Vec3> = (-6..=6)
+            .map(|i| {
+                let t = (i as f64 * 1.2).to_radians();
+                Vec3::new(t.sin(), miss.sin(), t.cos() * miss.cos()).normalize()
+            })
+            .collect();
+        assert!(!o.arc_meets_pole(&axes[5], &axes[6]));
+        let got = o.choose(&axes, ZERO).unwrap();
+        for (a, k) in got.iter().zip(&axes) {
+            assert!((o.axis(*a) - k).norm() < 1e-9);
+        }
+        let signs: Vec<bool> = got.iter().map(|a| a.tilt > 0.0).collect();
+        assert!(signs.iter().all(|&s| s == signs[0]), "{got:?}");
+        let turn = (got[12].c - got[0].c).abs().to_degrees();
+        assert!(turn > 150.0 && turn < 180.0, "{turn}");
+        // Through the pole itself the branch changes and C stays.
+        let through: Vec<Vec3> = (-6..=6)
+            .map(|i| {
+                let t = (i as f64 * 1.2 + 0.5).to_radians();
+                Vec3::new(t.sin(), 0.0, t.cos())
+            })
+            .collect();
+        assert!(o.arc_meets_pole(&through[5], &through[6]));
+        let got = o.choose(&through, ZERO).unwrap();
+        assert!(
+            got.windows(2).all(|w| (w[0].c - w[1].c).abs() < 1e-9),
+            "{got:?}"
+        );
+    }
+
+    #[test]
     fn c_unwraps_the_shortest_way_and_past_a_turn() {
         // The axis circles the pole twice at 30°: C grows continuously to 720°.
         let o = ac(-30.0, 120.0);
@@ -409,7 +487,21 @@ mod tests {
                     }
                 }
                 let ours: Vec<(f64, f64)> = got.iter().map(|a| (a.tilt, a.c)).collect();
-                prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+                // A change of branch (the tilt's sign) between two axes off the pole is only
+                // made where the arc between them passes through the pole cone (branch 0
+                // always fits here, so nothing forces one).
+                let bad_switch = |v: &[(f64, f64)]| {
+                    (1..v.len()).any(|i| {
+                        let (a, b) = (axes[i - 1], axes[i]);
+                        !o.at_pole(&a) && !o.at_pole(&b) && v[i - 1].0 * v[i].0 < 0.0
+                            && !o.arc_meets_pole(&a, &b)
+                    })
+                };
+                prop_assert!(!bad_switch(&ours));
+                // Among sequences that can be linearised, ours travels least.
+                if !bad_switch(&greedy) {
+                    prop_assert!(travel(&ours) <= travel(&greedy) + 1e-9, "{} > {}", travel(&ours), travel(&greedy));
+                }
             }
         }
     }

@@ -112,6 +112,12 @@ pub struct Settings {
     /// every raised location is checked again). Raising the lead shrinks a flat or bull-nose
     /// cutter's effective radius, so the scallop there grows a little. `None`: no limit.
     pub max_lead_change_deg: Option<f64>,
+    /// The most the tool axis may lean from the part's +Z, degrees: what a table-tilting
+    /// machine reaches from above (its C axis is the part's Z; the tilt axis' range and the
+    /// retract to a safe plane bound the lean). Contact points whose axis would lean further
+    /// are left out as [`Refusal::OutOfReach`] and their passes split there — on a closed
+    /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
+    pub max_axis_tilt_deg: Option<f64>,
     pub gouge: GougeSettings,
 }
 
@@ -131,6 +137,7 @@ impl Settings {
             max_step: 5.0,
             reverse_normal: false,
             max_lead_change_deg: None,
+            max_axis_tilt_deg: None,
             gouge: GougeSettings::default(),
         }
     }
@@ -141,6 +148,15 @@ impl Settings {
         positive("max_step", self.max_step)?;
         if let Some(rate) = self.max_lead_change_deg {
             positive("max_lead_change", rate)?;
+        }
+        if let Some(t) = self.max_axis_tilt_deg {
+            if !(t.is_finite() && (0.0..=180.0).contains(&t)) {
+                return Err(CamError::Setting {
+                    name: "max_axis_tilt",
+                    want: "an angle from +Z in 0..=180 degrees",
+                    got: t,
+                });
+            }
         }
         let angle = |name, x: f64, lo: f64, hi: f64| {
             if x.is_finite() && x >= lo && x <= hi {
@@ -187,6 +203,17 @@ pub enum Refusal {
     NoNormal,
     /// The fixed tool axis points into the surface here.
     AxisBelowSurface,
+    /// The tool axis would lean further from +Z than [`Settings::max_axis_tilt_deg`]: the
+    /// machine cannot reach this point from above (not a gouge).
+    OutOfReach,
+}
+
+impl Refusal {
+    /// True for a gouge (the cutter would cut into the part here), false for a point the
+    /// machine cannot reach or where the surface has no normal.
+    pub fn is_gouge(&self) -> bool {
+        matches!(self, Refusal::Gouge(_) | Refusal::AxisBelowSurface)
+    }
 }
 
 /// One refused contact point: where, and why. The pass is split around it.
@@ -473,8 +500,16 @@ impl<'a> Context<'a> {
             angles.lead = min_lead;
             corrected = true;
         }
+        // cos of the largest lean from +Z (the axis' z component may not fall below it).
+        let min_axis_z = self
+            .settings
+            .max_axis_tilt_deg
+            .map(|t| t.to_radians().cos() - 1e-12);
         loop {
             let axis = self.axis_for(&local.frame, angles);
+            if min_axis_z.is_some_and(|z| axis.z < z) {
+                return Err(refuse(Refusal::OutOfReach));
+            }
             let margin = local_margin(shape, &local.frame, &axis, &local.curvature);
             let problem = if margin < -1e-9 {
                 Gouge::Local { margin }
@@ -630,6 +665,44 @@ mod tests {
             assert_eq!(name.parse::<StrategyKind>().unwrap().to_string(), name);
         }
         assert!("spiral".parse::<StrategyKind>().is_err());
+    }
+
+    #[test]
+    fn contacts_beyond_the_axis_tilt_limit_are_left_out_as_out_of_reach() {
+        // Sphere R 30 between latitudes 10° and 60°: normals 30°…80° from +Z. With the axis
+        // along the normal and at most 50° of lean, the band below latitude 40° is left out.
+        let (r, limit) = (30.0, 50.0_f64);
+        let surface = crate::testing::sphere(r);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+        for kind in [StrategyKind::ZigZag, StrategyKind::IsoScallop] {
+            let mut settings = Settings::new(kind, 0.2, 0.01);
+            settings.max_axis_tilt_deg = Some(limit);
+            let p = plan(&surface, &cutter, &settings).unwrap();
+            let cos = limit.to_radians().cos();
+            assert!(p.path.contact_count() > 100, "{kind}");
+            for cl in p.path.passes.iter().flat_map(|q| &q.points) {
+                assert!(cl.axis.normalize().z >= cos - 1e-9, "{kind}: {cl:?}");
+            }
+            assert!(!p.refused.is_empty(), "{kind}");
+            for f in &p.refused {
+                assert_eq!(f.refusal, Refusal::OutOfReach, "{kind}");
+                assert!(!f.refusal.is_gouge());
+                // Out of reach means the normal leans more than the limit: below z = r cos 50°.
+                assert!(f.contact.z < r * cos + 1e-6, "{kind}: {f:?}");
+            }
+            // The kept part reaches down to the limit (within a forward step of 5 mm).
+            let lowest = p
+                .path
+                .passes
+                .iter()
+                .flat_map(|q| &q.points)
+                .map(|c| c.contact.z)
+                .fold(f64::INFINITY, f64::min);
+            assert!(lowest < r * cos + 5.0, "{kind}: {lowest}");
+        }
+        let mut bad = Settings::new(StrategyKind::ZigZag, 0.2, 0.01);
+        bad.max_axis_tilt_deg = Some(f64::NAN);
+        assert!(bad.validate().is_err());
     }
 
     #[test]

@@ -1,0 +1,237 @@
+//! `tezgah cam` end to end from STEP files (issue 7's "done when"): the free-form patch
+//! (iso-scallop) and the cap of the rational sphere that a table-tilting machine reaches from
+//! above (zig-zag) are planned, posted and verified, then `tezgah check` accepts the programs
+//! and `tezgah run --machine table-ac` executes them within every joint limit and the path
+//! tolerance. Coarse scallops and verification cells keep it to seconds.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn tezgah() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tezgah"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tezgah-cam-step-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+const TOOLS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../cam/tests/fixtures")
+        .join(name)
+}
+
+/// Runs `tezgah cam` on `surface` with `extra` options; returns its report, the program text
+/// and its stderr. The run must succeed (exit 0 = verified).
+fn cam(name: &str, surface: &str, extra: &[&str]) -> (serde_json::Value, String, String) {
+    let (ngc, json) = (tmp(&format!("{name}.ngc")), tmp(&format!("{name}.json")));
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture(surface))
+        .args(["--tool", "ball:6", "--tolerance", "0.01"])
+        .args(["--tool-table", TOOLS, "--tool-number", "1"])
+        .args(extra)
+        .arg("-o")
+        .arg(&ngc)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        out.status.success(),
+        "cam {name}: {}{stderr}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    (report, std::fs::read_to_string(&ngc).unwrap(), stderr)
+}
+
+/// `tezgah check` accepts the program and `tezgah run --machine table-ac` executes it with
+/// every joint's peaks within 0.5 % of its limits and the path within 0.01 mm; the run report.
+fn check_and_run(name: &str) -> serde_json::Value {
+    let ngc = tmp(&format!("{name}.ngc"));
+    let out = tezgah()
+        .arg("check")
+        .arg(&ngc)
+        .args(["--tool-table", TOOLS])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "check {name}: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = tmp(&format!("{name}-run.json"));
+    let out = tezgah()
+        .arg("run")
+        .arg(&ngc)
+        .args(["--machine", "table-ac", "--tool-table", TOOLS, "--report"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "run {name}: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for j in report["joints"].as_array().unwrap() {
+        for q in ["velocity", "acceleration", "jerk"] {
+            let peak = j[format!("peak_{q}")].as_f64().unwrap();
+            let max = j[format!("max_{q}")].as_f64().unwrap();
+            assert!(peak <= 1.005 * max, "{name}: {j}");
+        }
+    }
+    assert!(
+        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{name}: {report}"
+    );
+    report
+}
+
+/// The tip (X Y Z, part frame under G43.4) of every feed block, G1 being modal.
+fn feed_points(program: &str) -> Vec<[f64; 3]> {
+    let mut feed = false;
+    let mut at = [0.0; 3];
+    let mut out = Vec::new();
+    for line in program.lines().filter(|l| !l.starts_with('(')) {
+        let mut moved = false;
+        for w in line.split_whitespace() {
+            match w {
+                "G0" => feed = false,
+                "G1" => feed = true,
+                _ => {
+                    let k = match w.as_bytes()[0] {
+                        b'X' => 0,
+                        b'Y' => 1,
+                        b'Z' => 2,
+                        _ => continue,
+                    };
+                    at[k] = w[1..].parse().unwrap();
+                    moved = true;
+                }
+            }
+        }
+        if feed && moved {
+            out.push(at);
+        }
+    }
+    out
+}
+
+fn f(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing in {v}"))
+}
+
+#[test]
+fn free_form_patch_iso_scallop_is_verified_and_runs_on_table_ac() {
+    let (h, tol) = (0.2, 0.01);
+    let (report, program, _) = cam(
+        "freeform",
+        "freeform_patch.stp",
+        &[
+            "--strategy",
+            "iso-scallop",
+            "--scallop",
+            "0.2",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    // The 100 × 100 mm patch at a 2 mm step-over: about fifty passes.
+    let passes = report["passes"].as_u64().unwrap();
+    assert!((40..=70).contains(&passes), "{report}");
+    let v = &report["verification"];
+    assert_eq!(v["uncut_dexels"], 0, "{report}");
+    // The scallop measured within its bounds meets the target plus the tolerance, and is not
+    // far below it (iso-scallop spaces passes to the target).
+    let scallop = f(&report, "max_scallop_mm");
+    assert!(
+        scallop - f(v, "sweep_bound_mm") <= h + tol && scallop > 0.75 * h,
+        "{report}"
+    );
+    assert!(f(&report, "gouge_depth_mm") <= tol, "{report}");
+    assert!(f(&report, "max_linearisation_mm") <= 0.5 * tol, "{report}");
+    // The cutting path covers the patch: at least its area over the step-over.
+    assert!(
+        f(&report, "path_length_mm") >= 100.0 * 100.0 / f(&report, "step_over_mm"),
+        "{report}"
+    );
+    let run = check_and_run("freeform");
+    // The run takes at least the cutting time at the programmed feed.
+    assert!(
+        f(&run, "cycle_time_s") >= f(&report, "machining_time_s"),
+        "{run}"
+    );
+    assert!(!feed_points(&program).is_empty());
+}
+
+#[test]
+fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
+    let (radius, max_tilt, tol) = (40.0_f64, 45.0_f64, 0.01);
+    let (report, program, stderr) = cam(
+        "sphere",
+        "rational_sphere.stp",
+        &[
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.3",
+            "--max-tilt",
+            "45",
+            "--verify-cell",
+            "1",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    assert!(
+        stderr.contains("face more than 45° away from +Z"),
+        "{stderr}"
+    );
+    // With the axis along the normal a ball's tip is its contact point: every feed point lies
+    // on or outside the sphere (no gouge) and none below the cap whose normals are within 45°
+    // of +Z; the cuts reach down to the cap's rim (within one forward step).
+    let points = feed_points(&program);
+    let rim = radius * max_tilt.to_radians().cos();
+    let mut lowest = f64::INFINITY;
+    for p in &points {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!(r >= radius - tol, "{p:?} inside the sphere");
+        assert!(p[2] >= rim - tol, "{p:?} below the cap");
+        lowest = lowest.min(p[2]);
+    }
+    assert!(lowest < rim + 2.0, "lowest cut {lowest}, rim {rim}");
+    assert!(f(&report, "gouge_depth_mm") <= tol, "{report}");
+    check_and_run("sphere");
+}
+
+#[test]
+fn a_surface_out_of_reach_from_above_is_refused_with_a_reason() {
+    // The NURBS cylinder's side stands vertical: every normal is horizontal.
+    let ngc = tmp("cylinder.ngc");
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture("nurbs_cylinder.stp"))
+        .args(["--face", "17", "--tool", "ball:6", "--strategy", "zigzag"])
+        .args(["--scallop", "0.2", "--tolerance", "0.01", "-o"])
+        .arg(&ngc)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("no contact point is left"), "{stderr}");
+    assert!(stderr.contains("more than 75° away from +Z"), "{stderr}");
+    assert!(!ngc.exists());
+}
