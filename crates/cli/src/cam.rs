@@ -15,28 +15,62 @@ use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
 
 /// The command line of `tezgah cam` (DESIGN.md "Command-line contract").
+#[derive(clap::Args)]
 pub struct CamArgs {
+    /// The surface (STEP file).
     pub surface: PathBuf,
+    /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm).
+    #[arg(long)]
     pub tool: String,
+    /// zigzag, zigzag-oneway or iso-scallop.
+    #[arg(long)]
     pub strategy: String,
+    /// Largest scallop height, mm.
+    #[arg(long)]
     pub scallop: f64,
+    /// Chord and linearisation tolerance, mm.
+    #[arg(long)]
     pub tolerance: f64,
+    /// Lead angle: the tool tilted from the normal toward the feed, degrees.
+    #[arg(long = "lead", default_value_t = 0.0, allow_hyphen_values = true)]
     pub lead_deg: f64,
+    /// Tilt angle: the tool tilted from the normal across the feed, degrees.
+    #[arg(long = "tilt", default_value_t = 0.0, allow_hyphen_values = true)]
     pub tilt_deg: f64,
+    /// Cutting feed, mm/min (the tip's speed on the part).
+    #[arg(long, default_value_t = 1000.0)]
     pub feed: f64,
+    /// Write feeds in inverse time (G93).
+    #[arg(long)]
     pub inverse_time: bool,
+    /// Write machine joints (G43, no tool-centre-point control) instead of G43.4 output.
+    #[arg(long)]
     pub joints: bool,
+    /// A table-tilting machine: built-in name or file (default table-ac).
+    #[arg(long)]
     pub machine: Option<String>,
+    /// The program to write.
+    #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    /// Write the report JSON here.
+    #[arg(long)]
     pub report: Option<PathBuf>,
+    /// A tool table in LinuxCNC's format (the tool's length).
+    #[arg(long)]
     pub tool_table: Option<PathBuf>,
+    /// The tool number for T and H words.
+    #[arg(long, default_value_t = 1)]
     pub tool_number: u32,
-    /// The STEP `#id` of the face to machine.
+    /// The STEP `#id` of the face to machine (needed when the file has several faces).
+    #[arg(long)]
     pub face: Option<u64>,
-    /// The most the tool axis may lean from the part's +Z, degrees (default: the machine's
-    /// tilt range, at most [`DEFAULT_MAX_TILT_DEG`]).
+    /// The most the tool axis may lean from the part's +Z, degrees: contact points facing
+    /// further away are left out (default: 75°, or less if the machine's tilt range is).
+    #[arg(long = "max-tilt")]
     pub max_tilt_deg: Option<f64>,
-    /// Dexel spacing of the verification, mm (default: a twentieth of the step-over).
+    /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
+    /// step-over; coarser is faster and widens the reported grid bound).
+    #[arg(long = "verify-cell")]
     pub verify_cell_mm: Option<f64>,
 }
 
@@ -272,12 +306,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
     let json = report_json(&args, &machine, &path, &done, scallop);
     if let Some(p) = &args.report {
-        std::fs::write(
-            p,
-            serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
-        )
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot write {}", p.display()))?;
+        crate::library::write_json(p, &json)?;
     }
     summary(&args, &done, scallop, tolerance);
     Ok(if done.verified(scallop, tolerance) {

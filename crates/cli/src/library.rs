@@ -30,26 +30,37 @@ pub struct ProgramInputs {
     pub parameters: Option<Arc<ParameterFile>>,
 }
 
-/// Read a LinuxCNC parameter file (`.var`).
+/// The text of a file; bytes that are not UTF-8 become U+FFFD (G-code is ASCII; a stray byte
+/// in a comment should not refuse the file).
+pub fn read_text(path: &Path) -> Result<String> {
+    std::fs::read(path)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot read {}", path.display()))
+        .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// Writes a report as pretty JSON with a final newline.
+pub fn write_json(path: &Path, json: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(json).into_diagnostic()? + "\n";
+    std::fs::write(path, text)
+        .into_diagnostic()
+        .wrap_err_with(|| format!("cannot write {}", path.display()))
+}
+
 /// The tool table at `path` (LinuxCNC's format), or an empty one without a path.
 pub fn load_tool_table(path: Option<&Path>) -> Result<tezgah_gcode::ToolTable> {
     let Some(path) = path else {
         return Ok(tezgah_gcode::ToolTable::default());
     };
-    let bytes = std::fs::read(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot read {}", path.display()))?;
-    tezgah_gcode::ToolTable::parse(&String::from_utf8_lossy(&bytes))
+    tezgah_gcode::ToolTable::parse(&read_text(path)?)
         .into_diagnostic()
         .wrap_err_with(|| format!("in {}", path.display()))
 }
 
+/// Read a LinuxCNC parameter file (`.var`).
 pub fn load_parameters(path: Option<&Path>) -> Result<Option<Arc<ParameterFile>>> {
     let Some(path) = path else { return Ok(None) };
-    let text = std::fs::read_to_string(path)
-        .into_diagnostic()
-        .wrap_err_with(|| format!("reading {}", path.display()))?;
-    let file = ParameterFile::parse(&text)
+    let file = ParameterFile::parse(&read_text(path)?)
         .into_diagnostic()
         .wrap_err_with(|| format!("in {}", path.display()))?;
     Ok(Some(Arc::new(file)))
@@ -65,10 +76,7 @@ pub fn program_inputs(
     let ini = match ini {
         None => None,
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .into_diagnostic()
-                .wrap_err_with(|| format!("reading {}", path.display()))?;
-            let file = IniFile::parse(&text)
+            let file = IniFile::parse(&read_text(path)?)
                 .into_diagnostic()
                 .wrap_err_with(|| format!("in {}", path.display()))?;
             Some((folder_of(path), Arc::new(file)))
@@ -99,5 +107,34 @@ fn folder_of(path: &Path) -> PathBuf {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
+    }
+}
+
+/// What a program may read besides its own text.
+#[derive(clap::Args)]
+pub struct Inputs {
+    /// A tool table in LinuxCNC's format.
+    #[arg(long)]
+    pub tool_table: Option<PathBuf>,
+    /// A folder of subroutine files `<name>.ngc` (repeatable; the program's folder first).
+    #[arg(long = "subroutine-path")]
+    pub subroutine_path: Vec<PathBuf>,
+    /// A LinuxCNC INI file: its `[RS274NGC] SUBROUTINE_PATH` and `#<_ini[section]name>` values.
+    #[arg(long)]
+    pub ini: Option<PathBuf>,
+    /// A LinuxCNC parameter file (`.var`): the work offsets, G92 offsets and other numbered
+    /// parameters the program starts with.
+    #[arg(long)]
+    pub params: Option<PathBuf>,
+}
+
+impl Inputs {
+    pub fn program_inputs(&self, program: Option<&Path>) -> Result<ProgramInputs> {
+        program_inputs(
+            program,
+            self.ini.as_deref(),
+            self.params.as_deref(),
+            &self.subroutine_path,
+        )
     }
 }

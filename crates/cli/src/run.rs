@@ -103,19 +103,35 @@ pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
 /// Samples after which a progress bar is shown (about a minute of machining at 1 ms).
 const PROGRESS_SAMPLES: u64 = 60_000;
 
+/// The command line of `tezgah run` (DESIGN.md "Command-line contract").
+#[derive(clap::Args)]
 pub struct RunArgs {
+    /// The G-code program (default: the built-in demo).
     pub program: Option<PathBuf>,
+    /// A built-in machine name (see `tezgah machines`) or a machine file.
+    #[arg(long)]
     pub machine: Option<String>,
+    /// Write every sample to this CSV file.
+    #[arg(long)]
     pub samples: Option<PathBuf>,
+    /// Write the verification report to this JSON file.
+    #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Write plots (SVG and PNG) of feed and joint v/a/j into this directory.
+    #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Interpolation period, s (default: the machine file's `period_s`).
+    #[arg(long)]
     pub period: Option<f64>,
+    /// Path tolerance, mm (default: the machine file's `tolerance_mm`; G64 P overrides).
+    #[arg(long)]
     pub tolerance: Option<f64>,
+    /// The drive the samples go to: `ideal` (measured = commanded) or `servo` (the machine
+    /// file's servo model; the report adds tracking RMSE, following and contour errors).
+    #[arg(long, value_enum, default_value = "ideal")]
     pub drive: crate::tracking::DriveKind,
-    pub tool_table: Option<PathBuf>,
-    pub subroutine_path: Vec<PathBuf>,
-    pub ini: Option<PathBuf>,
-    pub params: Option<PathBuf>,
+    #[command(flatten)]
+    pub inputs: crate::library::Inputs,
 }
 
 /// A machine by built-in name or file path.
@@ -156,27 +172,14 @@ fn unit(machine: &Machine, i: usize) -> (&'static str, f64) {
 pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let machine = load_machine(args.machine.as_deref())?;
     let (name, text) = match &args.program {
-        Some(p) => (
-            p.display().to_string(),
-            String::from_utf8_lossy(
-                &std::fs::read(p)
-                    .into_diagnostic()
-                    .wrap_err_with(|| format!("cannot read {}", p.display()))?,
-            )
-            .into_owned(),
-        ),
+        Some(p) => (p.display().to_string(), crate::library::read_text(p)?),
         None => ("built-in demo".to_owned(), DEMO.to_owned()),
     };
-    let table = match &args.tool_table {
+    let table = match &args.inputs.tool_table {
         None if args.program.is_none() => ToolTable::parse(DEMO_TOOLS).into_diagnostic()?,
         table => crate::library::load_tool_table(table.as_deref())?,
     };
-    let extra = crate::library::program_inputs(
-        args.program.as_deref(),
-        args.ini.as_deref(),
-        args.params.as_deref(),
-        &args.subroutine_path,
-    )?;
+    let extra = args.inputs.program_inputs(args.program.as_deref())?;
     let config = Config {
         tool_table: table,
         subroutines: extra.subroutines,
@@ -317,12 +320,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         if let Some(t) = &tracking {
             json["tracking"] = tracking_json(&machine, t);
         }
-        std::fs::write(
-            p,
-            serde_json::to_string_pretty(&json).into_diagnostic()? + "\n",
-        )
-        .into_diagnostic()
-        .wrap_err_with(|| format!("cannot write {}", p.display()))?;
+        crate::library::write_json(p, &json)?;
     }
     if let (Some(dir), Some(t)) = (&args.plot, &trace) {
         std::fs::create_dir_all(dir).into_diagnostic()?;
