@@ -3,24 +3,13 @@
 //! by `tezgah check` and executed by `tezgah run --machine table-ac` within every joint limit
 //! and the path tolerance. `tezgah cam` refuses bad options without a panic.
 
-use std::process::Command;
+mod common;
 
+use common::{assert_joints_within_limits, assert_success, read_json, tezgah, tmp, TOOLS};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions};
 use tezgah_cam::{Cutter, CutterLocation, CutterShape, Pass, ToolPath};
 use tezgah_geom::{NurbsSurface, Vec3};
 use tezgah_kinematics::Machine;
-
-fn tezgah() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tezgah"))
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("tezgah-cam-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
-const TOOLS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
 
 /// A convex cylinder ρ = 20 about Y (±25°, 12 mm long) and a ball D = 3 zig-zag around it
 /// (passes along the circumference, so A changes inside every pass and changes sign).
@@ -87,12 +76,7 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
         .args(["--tool-table", TOOLS])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "check: {}{}\n{program}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out, &format!("check\n{program}"));
     let json = tmp(&format!("{name}.json"));
     let csv = tmp(&format!("{name}.csv"));
     let out = tezgah()
@@ -104,28 +88,9 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
         .arg(&csv)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "run: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    for j in report["joints"].as_array().unwrap() {
-        for (peak, limit) in [
-            ("peak_velocity", "max_velocity"),
-            ("peak_acceleration", "max_acceleration"),
-            ("peak_jerk", "max_jerk"),
-        ] {
-            let (p, l) = (j[peak].as_f64().unwrap(), j[limit].as_f64().unwrap());
-            assert!(
-                p <= 1.005 * l,
-                "{name} {}: {peak} {p} > {limit} {l}",
-                j["name"]
-            );
-        }
-    }
+    assert_success(&out, "run");
+    let report = read_json(&json);
+    assert_joints_within_limits(&report, false, name);
     assert!(
         report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
         "{report}"

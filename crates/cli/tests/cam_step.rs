@@ -4,20 +4,11 @@
 //! and `tezgah run --machine table-ac` executes them within every joint limit and the path
 //! tolerance. Coarse scallops and verification cells keep it to seconds.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn tezgah() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tezgah"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tezgah-cam-step-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
-const TOOLS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
+use common::{assert_joints_within_limits, assert_success, read_json, tezgah, tmp, TOOLS};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -47,9 +38,11 @@ fn cam(name: &str, surface: &str, extra: &[&str]) -> (serde_json::Value, String,
         "cam {name}: {}{stderr}",
         String::from_utf8_lossy(&out.stdout)
     );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    (report, std::fs::read_to_string(&ngc).unwrap(), stderr)
+    (
+        read_json(&json),
+        std::fs::read_to_string(&ngc).unwrap(),
+        stderr,
+    )
 }
 
 /// `tezgah check` accepts the program and `tezgah run --machine table-ac` executes it with
@@ -62,12 +55,7 @@ fn check_and_run(name: &str) -> serde_json::Value {
         .args(["--tool-table", TOOLS])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "check {name}: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out, &format!("check {name}"));
     let json = tmp(&format!("{name}-run.json"));
     let out = tezgah()
         .arg("run")
@@ -76,21 +64,9 @@ fn check_and_run(name: &str) -> serde_json::Value {
         .arg(&json)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "run {name}: {}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    for j in report["joints"].as_array().unwrap() {
-        for q in ["velocity", "acceleration", "jerk"] {
-            let peak = j[format!("peak_{q}")].as_f64().unwrap();
-            let max = j[format!("max_{q}")].as_f64().unwrap();
-            assert!(peak <= 1.005 * max, "{name}: {j}");
-        }
-    }
+    assert_success(&out, &format!("run {name}"));
+    let report = read_json(&json);
+    assert_joints_within_limits(&report, false, name);
     assert!(
         report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
         "{name}: {report}"

@@ -1,28 +1,9 @@
 //! `tezgah run` and `tezgah machines` end to end through the binary: the demo on the default
 //! machine, the samples CSV and report JSON per DESIGN.md's contract, plots, and errors.
 
-use std::process::Command;
+mod common;
 
-fn tezgah() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tezgah"))
-}
-
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("tezgah-run-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
-}
-
-/// The run succeeded (else its output is shown) and its JSON report, read back.
-fn succeeded_with_report(out: &std::process::Output, json: &std::path::Path) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap()
-}
+use common::{assert_joints_within_limits, read_json, succeeded_with_report, tezgah, tmp, TOOLS};
 
 #[test]
 fn demo_run_writes_samples_report_and_plots() {
@@ -58,8 +39,7 @@ fn demo_run_writes_samples_report_and_plots() {
     // First and last rows at rest at the same place (the demo returns home with G28).
     assert_eq!(rows[0][2..], rows.last().unwrap()[2..]);
 
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let report = read_json(&json);
     assert_eq!(
         report["cycle_time_s"].as_f64().unwrap(),
         rows.last().unwrap()[0]
@@ -68,13 +48,7 @@ fn demo_run_writes_samples_report_and_plots() {
     let d = report["duration_s"].as_f64().unwrap();
     assert!(d <= report["cycle_time_s"].as_f64().unwrap() && d > 1.0);
     assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
-    for j in report["joints"].as_array().unwrap() {
-        for q in ["velocity", "acceleration", "jerk"] {
-            let peak = j[format!("peak_{q}")].as_f64().unwrap();
-            let max = j[format!("max_{q}")].as_f64().unwrap();
-            assert!(peak > 0.0 && peak <= 1.005 * max, "{j}");
-        }
-    }
+    assert_joints_within_limits(&report, true, "demo");
     for name in ["feed.svg", "feed.png", "x_jerk.svg", "z_acceleration.png"] {
         assert!(plots.join(name).exists(), "{name}");
     }
@@ -111,7 +85,6 @@ fn errors_are_reported_not_panics() {
 fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
     let json = tmp("r5.json");
     let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/five-axis.ngc");
-    let tools = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
     let out = tezgah()
         .args([
             "run",
@@ -119,7 +92,7 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
             "--machine",
             "table-ac",
             "--tool-table",
-            tools,
+            TOOLS,
         ])
         .arg("--report")
         .arg(&json)
@@ -144,20 +117,7 @@ fn five_axis_example_under_tcp_on_table_ac_holds_limits() {
         "{}",
         String::from_utf8_lossy(&out.stdout)
     );
-    for j in joints {
-        for (peak, limit) in [
-            ("peak_velocity", "max_velocity"),
-            ("peak_acceleration", "max_acceleration"),
-            ("peak_jerk", "max_jerk"),
-        ] {
-            let (p, l) = (j[peak].as_f64().unwrap(), j[limit].as_f64().unwrap());
-            assert!(
-                p > 0.0 && p <= 1.005 * l,
-                "{}: {peak} {p} > {limit} {l}",
-                j["name"]
-            );
-        }
-    }
+    assert_joints_within_limits(&report, true, "five-axis");
     // G43.4 H1 needs tool 1 in a tool table: without one the run stops at line 5.
     let out = tezgah()
         .args(["run", program, "--machine", "table-ac"])
@@ -194,13 +154,7 @@ fn spline_example_runs_within_tolerance_and_limits() {
     // verify: every sample within the tolerance of the programmed curves, limits held.
     let tolerance = report["tolerance_mm"].as_f64().unwrap();
     assert!(report["max_deviation_mm"].as_f64().unwrap() <= tolerance);
-    for j in report["joints"].as_array().unwrap() {
-        for q in ["velocity", "acceleration", "jerk"] {
-            let peak = j[format!("peak_{q}")].as_f64().unwrap();
-            let max = j[format!("max_{q}")].as_f64().unwrap();
-            assert!(peak <= 1.005 * max, "{j}");
-        }
-    }
+    assert_joints_within_limits(&report, false, "splines");
     // The thesis curve (19.0203 mm at F1200 = 20 mm/s) takes at least 0.951 s; its first
     // sample is at its start (the tool comes down there and stops).
     let text = std::fs::read_to_string(&csv).unwrap();

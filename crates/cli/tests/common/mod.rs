@@ -1,0 +1,58 @@
+//! What the binary's end-to-end tests share: the binary, a scratch folder, the example tool
+//! table, and the checks every run report must pass (success, joint peaks within limits).
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The example tool table (tool 1: a 6 mm ball, 28.5 mm long).
+pub const TOOLS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
+
+/// The `tezgah` binary under test.
+pub fn tezgah() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tezgah"))
+}
+
+/// A path in this test process's scratch folder.
+pub fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tezgah-cli-test-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// The command succeeded; else its output is shown under `what`.
+pub fn assert_success(out: &Output, what: &str) {
+    assert!(
+        out.status.success(),
+        "{what}: {}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A JSON report, read back.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The run succeeded (else its output is shown) and its JSON report, read back.
+pub fn succeeded_with_report(out: &Output, json: &Path) -> serde_json::Value {
+    assert_success(out, "run");
+    read_json(json)
+}
+
+/// Every joint's peak velocity, acceleration and jerk of a run report within 0.5 % of its
+/// limit (verify's finite differences at the period), and (with `moving`) above zero.
+pub fn assert_joints_within_limits(report: &serde_json::Value, moving: bool, what: &str) {
+    for j in report["joints"].as_array().unwrap() {
+        for q in ["velocity", "acceleration", "jerk"] {
+            let peak = j[format!("peak_{q}")].as_f64().unwrap();
+            let max = j[format!("max_{q}")].as_f64().unwrap();
+            assert!(
+                peak <= 1.005 * max && (!moving || peak > 0.0),
+                "{what} {}: peak {q} {peak}, limit {max}",
+                j["name"]
+            );
+        }
+    }
+}
