@@ -233,7 +233,7 @@ fn servo_drive_reports_tracking_and_contour_errors() {
             "acceleration_feed_forward = 0.0",
         );
     assert_ne!(no_ff, mill3);
-    let (machine, program) = (tmp("noff.toml"), tmp("line.ngc"));
+    let (machine, program) = (tmp("noff.toml"), tmp("servo-line.ngc"));
     std::fs::write(&machine, no_ff).unwrap();
     std::fs::write(&program, "G21 G90 G1 X100 F3000\nM2\n").unwrap();
     let run = |machine: &std::path::Path, drive: &str, json: &std::path::Path| {
