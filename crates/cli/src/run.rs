@@ -16,34 +16,6 @@ use tezgah_motion::verify::{Report, Verifier};
 use crate::plot::Trace;
 use crate::tracking::{DriveKind, Tracker, Tracking};
 
-/// The built-in demo program (a rounded pocket outline with a helical entry).
-/// The smoothing options: the builder's defaults, then what the machine file's `[path]` table
-/// sets.
-/// The machine itself gives the tool axis of the program angles (5-axis under TCP).
-fn smooth_options(
-    path: &tezgah_kinematics::machine::PathSettings,
-    tolerance: f64,
-    start: Pose,
-    machine: &PlanMachine,
-) -> SmoothOptions {
-    let d = SmoothOptions::default();
-    SmoothOptions {
-        tolerance,
-        start,
-        control: machine.initial,
-        orientation: Some(smooth::Orientation(std::sync::Arc::new(machine.clone()))),
-        angular_tolerance: path.axis_tolerance_deg.unwrap_or(d.angular_tolerance),
-        blend_max_angle: path
-            .blend_max_angle_deg
-            .map_or(d.blend_max_angle, f64::to_radians),
-        compress_corner_angle: path
-            .compress_corner_angle_deg
-            .map_or(d.compress_corner_angle, f64::to_radians),
-        short_segment: path.short_segment_mm.unwrap_or(d.short_segment),
-        ..d
-    }
-}
-
 /// The path a machine will follow, checked whole before anything moves.
 pub struct BuiltPath {
     pub items: Vec<tezgah_motion::PathItem>,
@@ -66,7 +38,7 @@ pub fn build_path(
 ) -> Result<BuiltPath> {
     let start = Pose::ZERO;
     let pm = PlanMachine::from_machine(machine).map_err(|e| miette!("{e}"))?;
-    let opts = smooth_options(&machine.path, tolerance, start, &pm);
+    let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
     let mut smoother =
         smooth::Smoother::new(moves.into_iter(), opts.clone()).map_err(|e| miette!("{e}"))?;
     let items = smoother

@@ -63,7 +63,7 @@ enum Outgoing<'a> {
 /// Runs the server until the process is stopped.
 pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     let machine = crate::run::load_machine(args.machine.as_deref())?;
-    let options = ExecOptions::for_machine(&machine);
+    let options = ExecOptions::for_machine(&machine).map_err(|e| miette!("{e}"))?;
     let period = options.period;
     if !(args.lead_ms.is_finite() && args.lead_ms > 0.0) {
         return Err(miette!("--lead-ms must be > 0, got {}", args.lead_ms));

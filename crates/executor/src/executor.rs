@@ -50,23 +50,25 @@ pub struct ExecOptions {
 }
 
 impl ExecOptions {
-    /// The machine file's period and tolerance, a short look-ahead (the planner thread works
-    /// only as far ahead as needed) and `tezgah run`'s tolerance split.
-    pub fn for_machine(machine: &Machine) -> ExecOptions {
+    /// The machine file's period, tolerance and `[path]` settings, and `tezgah run`'s
+    /// tolerance split: the executor follows the path `tezgah run` plans.
+    pub fn for_machine(machine: &Machine) -> Result<ExecOptions, ExecError> {
         let period = machine.motion.period_s;
-        ExecOptions {
+        let pm = PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
+        Ok(ExecOptions {
             period,
-            smooth: SmoothOptions {
-                tolerance: machine.motion.tolerance_mm,
-                window: 64,
-                ..SmoothOptions::default()
-            },
+            smooth: SmoothOptions::for_machine(
+                &machine.path,
+                &pm,
+                machine.motion.tolerance_mm,
+                Pose::ZERO,
+            ),
             plan: PlanOptions {
                 period,
                 chord_share: CHORD_SHARE,
                 ..PlanOptions::default()
             },
-        }
+        })
     }
 }
 

@@ -20,38 +20,93 @@ fn reference(program: &str) -> Vec<Produced> {
     out
 }
 
-/// At 100 % the executor plays the plan exactly as `tezgah run`'s interpolator samples it.
-#[test]
-fn full_feed_plays_the_interpolator_samples() {
+/// At 100 % the executor plays `program` on `machine` exactly as `tezgah run`'s interpolator
+/// samples it: the reference is built with the options `tezgah run` uses (the machine file's
+/// `[path]`, the tool axis carried under TCP), independently of the executor's job machinery.
+fn plays_the_interpolator_samples(machine: &tezgah_kinematics::Machine, program: &str) {
+    use tezgah_executor::executor::{ExecOptions, Executor};
     use tezgah_motion::interpolate::run;
-    use tezgah_motion::path::smooth;
-    let program = random_program(7, 30);
-    let mut exec = executor();
+    use tezgah_motion::path::smooth::{self, SmoothOptions};
+    use tezgah_motion::plan::PlanMachine;
+    let mut exec = Executor::new(
+        machine,
+        ExecOptions::for_machine(machine).unwrap(),
+        tezgah_geom::Pose::ZERO,
+    )
+    .unwrap();
     let mut trace = Trace::new(&exec);
-    run_program(&mut exec, &mut trace, &program);
+    run_program(&mut exec, &mut trace, program);
     let (out, report) = trace.report();
     assert_within_limits(&report);
     assert_continuous(&out);
-    let m = tezgah_kinematics::Machine::default_machine();
-    let opts = tezgah_executor::executor::ExecOptions::for_machine(&m);
-    let moves = tezgah_gcode::program_moves(&program, Default::default()).unwrap();
-    let items = smooth::build(moves, &opts.smooth).unwrap();
-    let pm = tezgah_motion::plan::PlanMachine::from_machine(&m).unwrap();
-    let mut tips = vec![];
-    let mut verifier = tezgah_motion::verify::Verifier::new(&pm, opts.period);
-    run(items, pm, opts.plan, (Vec3::zeros(), [0.0; 3]), |s, seg| {
+    let pm = PlanMachine::from_machine(machine).unwrap();
+    let opts = SmoothOptions::for_machine(
+        &machine.path,
+        &pm,
+        machine.motion.tolerance_mm,
+        tezgah_geom::Pose::ZERO,
+    );
+    let config = tezgah_gcode::Config {
+        tool_centre_point_always: machine.tcp == tezgah_kinematics::TcpSwitch::Always,
+        ..Default::default()
+    };
+    let moves = tezgah_gcode::program_moves(program, config).unwrap();
+    let items = smooth::build(moves, &opts).unwrap();
+    let plan = tezgah_motion::plan::PlanOptions {
+        period: machine.motion.period_s,
+        chord_share: smooth::CHORD_SHARE,
+        ..Default::default()
+    };
+    let mut samples = vec![];
+    let mut verifier = tezgah_motion::verify::Verifier::new(&pm, plan.period);
+    run(items, pm, plan, (Vec3::zeros(), [0.0; 3]), |s, seg| {
         verifier.push(s, seg);
-        tips.push(s.tip)
+        samples.push(*s)
     })
     .unwrap();
     assert_within_limits(&verifier.finish());
     // The interpolator's row 0 is the start at rest; the executor's first set-point is one
     // period into the motion.
-    assert_eq!(out.len() + 1, tips.len(), "sample counts");
+    assert_eq!(out.len() + 1, samples.len(), "sample counts");
     for (k, p) in out.iter().enumerate() {
-        let d = (p.tip - tips[k + 1]).norm();
-        assert!(d < 1e-9, "sample {k}: {d}");
+        let want = &samples[k + 1];
+        let d = (p.tip - want.tip).norm();
+        assert!(d < 1e-9, "sample {k}: tip {d}");
+        for (q, w) in p
+            .setpoint
+            .position
+            .as_slice()
+            .iter()
+            .zip(want.joints.as_slice())
+        {
+            assert!(
+                (q - w).abs() < 1e-9,
+                "sample {k}: joints {:?} vs {:?}",
+                p.setpoint.position,
+                want.joints
+            );
+        }
     }
+}
+
+#[test]
+fn full_feed_plays_the_interpolator_samples() {
+    plays_the_interpolator_samples(
+        &tezgah_kinematics::Machine::default_machine(),
+        &random_program(7, 30),
+    );
+}
+
+/// On a table-tilting machine under TCP (the machine file's `tcp = always`) the executor
+/// turns the tool axis as `tezgah run` does (carried on great circles and blended at the
+/// corners), joint for joint.
+#[test]
+fn five_axis_tcp_plays_the_interpolator_samples() {
+    let mut machine = tezgah_kinematics::Machine::builtin("table-ac").unwrap();
+    machine.tcp = tezgah_kinematics::TcpSwitch::Always;
+    let program = "G21 G90 G94 G64\nG1 X10 Y0 Z10 A10 C0 F900\nG1 X30 Y5 Z8 A25 C40\n\
+                   G1 X35 Y25 Z6 A20 C80\nG1 X15 Y30 Z8 A12 C100\nM2\n";
+    plays_the_interpolator_samples(&machine, program);
 }
 
 /// Holds at period `at`, checks the stop, resumes; returns the whole trace.

@@ -5,10 +5,10 @@
 
 use std::sync::Arc;
 
-use tezgah_geom::{Curve, Vec3};
+use tezgah_geom::Vec3;
 use tezgah_kinematics::Joints;
 
-use crate::interpolate::{InterpolateError, Param};
+use crate::interpolate::{segment_pose, InterpolateError, Param};
 use crate::path::Segment;
 use crate::plan::{Piece, PlanMachine};
 
@@ -83,30 +83,13 @@ impl PieceCursor {
             self.param = Param::new(&piece.segments[self.idx]);
         }
         let seg = &piece.segments[self.idx];
-        let local = s - piece.offsets[self.idx];
-        let len = if seg.rotary_only() {
-            seg.rotary_travel()
-        } else {
-            seg.length
-        };
-        let local = local.clamp(0.0, len);
-        let f = if len > 0.0 { local / len } else { 1.0 };
-        let (tip, rotary) = if local >= len {
-            // Block ends exactly: the curve returns its end point bit for bit.
-            (seg.curve.point(seg.curve.domain().1), seg.rotary[1])
-        } else {
-            let [r0, r1] = seg.rotary;
-            (
-                seg.curve.point(self.param.u(seg, local)),
-                [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f),
-            )
-        };
-        let joints = machine
-            .joints(seg.control, &tip, &rotary, previous)
-            .map_err(|source| InterpolateError::Kinematics {
-                line: seg.line,
-                source,
-            })?;
+        let (tip, rotary, joints) = segment_pose(
+            machine,
+            seg,
+            &self.param,
+            s - piece.offsets[self.idx],
+            previous,
+        )?;
         Ok(CursorPose {
             line: seg.line,
             tip,

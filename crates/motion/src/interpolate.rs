@@ -94,6 +94,40 @@ impl Param {
     }
 }
 
+/// The tool at distance `s` along `seg` (mm, or degrees on a rotary-only segment; clamped):
+/// tip, A B C (degrees) and joints nearest `previous`, through
+/// [`PlanMachine::segment_joints`]. The block end is the curve's end point bit for bit. The one
+/// pose lookup of the interpolator and the executor's re-timed cursor.
+pub(crate) fn segment_pose(
+    machine: &PlanMachine,
+    seg: &Segment,
+    param: &Param,
+    s: f64,
+    previous: &Joints,
+) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
+    let len = if seg.rotary_only() {
+        seg.rotary_travel()
+    } else {
+        seg.length
+    };
+    let s = s.clamp(0.0, len);
+    let f = if len > 0.0 { s / len } else { 1.0 };
+    let (_, b) = seg.curve.domain();
+    let (tip, u) = if s >= len {
+        (seg.curve.point(b), b)
+    } else {
+        let u = param.u(seg, s);
+        (seg.curve.point(u), u)
+    };
+    let (q, rotary) = machine
+        .segment_joints(seg, u, f, &tip, previous)
+        .map_err(|source| InterpolateError::Kinematics {
+            line: seg.line,
+            source,
+        })?;
+    Ok((tip, rotary, q))
+}
+
 /// The interpolator: feed it planned items, it calls the sink for every sample.
 pub struct Interpolator {
     /// The machine: joints from the program point under each segment's tool control.
@@ -136,31 +170,9 @@ impl Interpolator {
         param: &Param,
         s: f64,
     ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
-        let len = if seg.rotary_only() {
-            seg.rotary_travel()
-        } else {
-            seg.length
-        };
-        let s = s.clamp(0.0, len);
-        let f = if len > 0.0 { s / len } else { 1.0 };
-        let (_, b) = seg.curve.domain();
-        let (tip, u) = if s >= len {
-            // Block ends exactly: the curve returns its end point bit for bit.
-            (seg.curve.point(b), b)
-        } else {
-            let u = param.u(seg, s);
-            (seg.curve.point(u), u)
-        };
-        let err = |source| InterpolateError::Kinematics {
-            line: seg.line,
-            source,
-        };
-        let (q, rotary) = self
-            .machine
-            .segment_joints(seg, u, f, &tip, &self.joints)
-            .map_err(err)?;
-        self.joints = q;
-        Ok((tip, rotary, q))
+        let pose = segment_pose(&self.machine, seg, param, s, &self.joints)?;
+        self.joints = pose.2;
+        Ok(pose)
     }
 
     /// Hands one sample to the sink with the path it lies on: the segments passed since the

@@ -19,7 +19,7 @@ pub const RETIME_JERK: f64 = 1.03;
 
 pub fn executor() -> Executor {
     let m = Machine::default_machine();
-    Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap()
+    Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap()
 }
 
 /// Every set-point produced, replayed through the verifier.

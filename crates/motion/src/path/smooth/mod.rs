@@ -101,6 +101,34 @@ impl Default for SmoothOptions {
 }
 
 impl SmoothOptions {
+    /// The options a machine runs with: the builder's defaults, then what the machine file's
+    /// `[path]` table sets, the tolerance in force, and the machine itself for the tool axis
+    /// of the program angles (5-axis under TCP). `tezgah run`, `check --machine` and the
+    /// executor all build their paths from these, so they follow the same path.
+    pub fn for_machine(
+        path: &tezgah_kinematics::machine::PathSettings,
+        machine: &crate::plan::PlanMachine,
+        tolerance: f64,
+        start: Pose,
+    ) -> SmoothOptions {
+        let d = SmoothOptions::default();
+        SmoothOptions {
+            tolerance,
+            start,
+            control: machine.initial,
+            orientation: Some(Orientation(Shared::new(machine.clone()))),
+            angular_tolerance: path.axis_tolerance_deg.unwrap_or(d.angular_tolerance),
+            blend_max_angle: path
+                .blend_max_angle_deg
+                .map_or(d.blend_max_angle, f64::to_radians),
+            compress_corner_angle: path
+                .compress_corner_angle_deg
+                .map_or(d.compress_corner_angle, f64::to_radians),
+            short_segment: path.short_segment_mm.unwrap_or(d.short_segment),
+            ..d
+        }
+    }
+
     /// Check every field; the shares must leave at least [`CHORD_SHARE`] to the planner.
     pub fn validate(&self) -> Result<(), PathError> {
         let pos = |name, v: f64| {
