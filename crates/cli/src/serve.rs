@@ -5,7 +5,7 @@
 
 use std::io::ErrorKind;
 use std::net::{TcpListener, TcpStream};
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
@@ -13,7 +13,6 @@ use serde::{Deserialize, Serialize};
 use tezgah_executor::command::{Command, Status};
 use tezgah_executor::drive::IdealDrive;
 use tezgah_executor::executor::{ExecOptions, Executor};
-use tezgah_executor::rt::StopLimits;
 use tezgah_executor::threads::{spawn, Handle};
 use tezgah_geom::Pose;
 use tungstenite::{Message, WebSocket};
@@ -70,9 +69,8 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     }
     let ring = ((args.lead_ms / 1000.0 / period).ceil() as usize).max(2);
     let executor = Executor::new(&machine, options, Pose::ZERO).map_err(|e| miette!("{e}"))?;
-    let limits = StopLimits::of(executor.machine());
-    // Shared by the connections; a request holds it for the period or so its answer takes.
-    let host = Arc::new(Mutex::new(spawn(executor, IdealDrive, limits, ring)));
+    // Shared by the connections: each request waits for its own answer only.
+    let host = Arc::new(spawn(executor, IdealDrive, ring));
 
     let listener = TcpListener::bind(&args.listen)
         .into_diagnostic()
@@ -99,7 +97,7 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
 }
 
 /// One client: commands in, replies and the status stream out, until it closes.
-fn session(stream: TcpStream, host: &Mutex<Handle>, interval: Duration) -> Result<(), String> {
+fn session(stream: TcpStream, host: &Handle, interval: Duration) -> Result<(), String> {
     let mut ws = tungstenite::accept(stream).map_err(|e| e.to_string())?;
     // Reads wait at most a little, so the status stream keeps its pace.
     ws.get_mut()
@@ -124,24 +122,21 @@ fn session(stream: TcpStream, host: &Mutex<Handle>, interval: Duration) -> Resul
         if Instant::now() >= next_status {
             next_status += interval;
             let status = host
+                .status
                 .lock()
-                .ok()
-                .and_then(|h| h.status.lock().ok().map(|s| s.clone()))
-                .ok_or_else(|| "the executor has stopped".to_owned())?;
+                .map(|s| s.clone())
+                .map_err(|_| "the executor has stopped".to_owned())?;
             send(&mut ws, &Outgoing::Status(&status))?;
         }
     }
 }
 
 /// The reply to one text message.
-fn answer(host: &Mutex<Handle>, text: &str) -> Outgoing<'static> {
+fn answer(host: &Handle, text: &str) -> Outgoing<'static> {
     let (id, result) = match serde_json::from_str::<Request>(text) {
         Ok(request) => (
             request.id,
-            match host.lock() {
-                Ok(h) => h.request(request.command).map_err(|e| e.to_string()),
-                Err(_) => Err("the executor has stopped".to_owned()),
-            },
+            host.request(request.command).map_err(|e| e.to_string()),
         ),
         Err(e) => (None, Err(format!("not a command: {e}"))),
     };

@@ -151,13 +151,10 @@ type Request = (Command, mpsc::Sender<Result<(), ExecError>>);
 
 /// What the running pair of threads answers with.
 pub struct Handle {
-    pub commands: mpsc::Sender<Command>,
     /// Commands whose answers come back to the sender ([`Handle::request`]).
     requests: mpsc::Sender<Request>,
     /// The executor's status, refreshed by the planner thread.
     pub status: Arc<Mutex<Status>>,
-    /// Errors of refused commands, in order.
-    pub errors: mpsc::Receiver<ExecError>,
     quit: Arc<AtomicBool>,
     planner: JoinHandle<Lead>,
     rt: JoinHandle<(RtCounters, Jitter)>,
@@ -192,21 +189,16 @@ impl Handle {
 }
 
 /// Starts the planner thread and the real-time thread (period from `exec`) with a ring of
-/// `capacity` set-points; the real-time loop starts at `exec`'s current joints.
-pub fn spawn<D: Drive + Send + 'static>(
-    exec: Executor,
-    drive: D,
-    limits: StopLimits,
-    capacity: usize,
-) -> Handle {
+/// `capacity` set-points; the real-time loop starts at `exec`'s current joints and stops on
+/// an underrun within the machine's joint limits.
+pub fn spawn<D: Drive + Send + 'static>(exec: Executor, drive: D, capacity: usize) -> Handle {
     let period = exec.period();
+    let limits = StopLimits::of(exec.machine());
     let (planner_rings, rt_ends) = rings(capacity, 4 * capacity.max(64));
     // The drive's frame (machine joints plus the homing offsets), where set-points live.
     let start = exec.drive_joints();
     let quit = Arc::new(AtomicBool::new(false));
     let status = Arc::new(Mutex::new(exec.status()));
-    let (tx, rx) = mpsc::channel::<Command>();
-    let (etx, erx) = mpsc::channel::<ExecError>();
     let (rtx, rrx) = mpsc::channel::<Request>();
     let q = quit.clone();
     let rt = std::thread::Builder::new()
@@ -223,11 +215,6 @@ pub fn spawn<D: Drive + Send + 'static>(
         .spawn(move || {
             let mut side = PlannerSide::new(exec, planner_rings, capacity);
             while !q.load(Ordering::Relaxed) {
-                while let Ok(c) = rx.try_recv() {
-                    if let Err(e) = side.command(c) {
-                        let _ = etx.send(e);
-                    }
-                }
                 while let Ok((c, reply)) = rrx.try_recv() {
                     let _ = reply.send(side.command(c));
                 }
@@ -242,10 +229,8 @@ pub fn spawn<D: Drive + Send + 'static>(
         })
         .expect("spawning the planner thread");
     Handle {
-        commands: tx,
         requests: rtx,
         status,
-        errors: erx,
         quit,
         planner,
         rt,

@@ -159,12 +159,9 @@ fn underrun_is_a_jerk_limited_stop() {
 fn spawned_threads_run_a_command() {
     use std::time::{Duration, Instant};
     use tezgah_executor::threads::{spawn, DEFAULT_RING};
-    let exec = executor();
-    let limits = StopLimits::of(exec.machine());
-    let handle = spawn(exec, IdealDrive, limits, DEFAULT_RING);
+    let handle = spawn(executor(), IdealDrive, DEFAULT_RING);
     handle
-        .commands
-        .send(Command::Mdi {
+        .request(Command::Mdi {
             block: "G21 G90 G0 X5 Y-3".into(),
         })
         .unwrap();
@@ -175,10 +172,9 @@ fn spawned_threads_run_a_command() {
         let s = handle.status.lock().unwrap().clone();
         if s.state == RunState::Fault {
             // A stall of the shared machine longer than the ring (an underrun): abort, again.
-            handle.commands.send(Command::Abort).unwrap();
+            handle.request(Command::Abort).unwrap();
             handle
-                .commands
-                .send(Command::Mdi {
+                .request(Command::Mdi {
                     block: "G0 X5 Y-3".into(),
                 })
                 .unwrap();
@@ -193,17 +189,12 @@ fn spawned_threads_run_a_command() {
         }
     }
     // A refused command comes back as an error.
-    handle
-        .commands
-        .send(Command::FeedOverride { percent: -1.0 })
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(50));
-    let refused = handle.errors.try_recv();
+    let refused = handle.request(Command::FeedOverride { percent: -1.0 });
     let figures = handle.stop();
     assert!(done, "the move did not finish");
     assert!(matches!(
         refused,
-        Ok(tezgah_executor::error::ExecError::Override(_))
+        Err(tezgah_executor::error::ExecError::Override(_))
     ));
     assert!(figures.rt.delivered > 0);
     assert!(figures.rt.periods >= figures.rt.delivered);
