@@ -45,14 +45,6 @@ pub struct JobOptions {
     pub single_block: bool,
 }
 
-fn path_length(seg: &tezgah_motion::Segment) -> f64 {
-    if seg.rotary_only() {
-        seg.rotary_travel()
-    } else {
-        seg.length
-    }
-}
-
 impl Job {
     /// A job from `moves`, starting at the machine's current pose and joints.
     pub fn new(
@@ -117,7 +109,7 @@ impl Job {
                     SegmentFeed::InverseTime(t) => SegmentFeed::InverseTime(t / factor),
                     SegmentFeed::Rapid => SegmentFeed::Rapid,
                 };
-                self.pushed += path_length(&seg);
+                self.pushed += seg.path_length();
                 self.log.push_back((self.pushed, factor));
                 PathItem::Segment(seg)
             }

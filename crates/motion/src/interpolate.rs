@@ -105,11 +105,7 @@ pub(crate) fn segment_pose(
     s: f64,
     previous: &Joints,
 ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
-    let len = if seg.rotary_only() {
-        seg.rotary_travel()
-    } else {
-        seg.length
-    };
+    let len = seg.path_length();
     let s = s.clamp(0.0, len);
     let f = if len > 0.0 { s / len } else { 1.0 };
     let (_, b) = seg.curve.domain();

@@ -93,6 +93,16 @@ impl Segment {
         self.length <= f64::EPSILON
     }
 
+    /// The coordinate the planner times the segment along: its length (mm), or for a
+    /// rotary-only segment its rotary travel (degrees).
+    pub fn path_length(&self) -> f64 {
+        if self.rotary_only() {
+            self.rotary_travel()
+        } else {
+            self.length
+        }
+    }
+
     /// The travel (degrees) that times a rotary-only segment: the tool axis's turn where the
     /// planner set it, else the largest rotary axis travel.
     pub fn rotary_travel(&self) -> f64 {

@@ -157,11 +157,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     machine.check_axes(seg)?;
     let n = machine.joint_count().min(MAX_JOINTS);
     let rotary_only = seg.rotary_only();
-    let length = if rotary_only {
-        seg.rotary_travel()
-    } else {
-        seg.length
-    };
+    let length = seg.path_length();
     let mut g = Geometry {
         length,
         rotary_only,
