@@ -10,6 +10,7 @@
 //! `ε ∝ Δt²` law until the error lies in `[ε/2, ε]` (or the span ends or reaches the length
 //! cap).
 
+use tezgah_geom::deviation::point_segment_distance;
 use tezgah_geom::{NurbsSurface, Vec3};
 
 use crate::error::CamError;
@@ -83,22 +84,11 @@ fn at(surface: &NurbsSurface, path: &impl SurfacePath, t: f64) -> Vec3 {
     surface.point(u, v)
 }
 
-fn segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.norm_squared();
-    let s = if len2 > 0.0 {
-        ((p - a).dot(&ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * s)).norm()
-}
-
 /// The true chord error of the move from the point at `ta` to the point at `tb`: the largest
 /// distance from the curve between them to the straight segment (module comment).
 pub fn chord_error(surface: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb: f64) -> f64 {
     let (a, b) = (at(surface, path, ta), at(surface, path, tb));
-    let dist = |t: f64| segment_distance(&at(surface, path, t), &a, &b);
+    let dist = |t: f64| point_segment_distance(&at(surface, path, t), &a, &b);
     let n = CHORD_SAMPLES + 1;
     let step = (tb - ta) / n as f64;
     let (mut worst, mut worst_k) = (0.0, 1);
@@ -230,7 +220,7 @@ mod tests {
     /// The thesis's midpoint test (001 §2.8), for the regression that shows its defect.
     fn midpoint_error(s: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb: f64) -> f64 {
         let (a, b) = (at(s, path, ta), at(s, path, tb));
-        segment_distance(&at(s, path, 0.5 * (ta + tb)), &a, &b)
+        point_segment_distance(&at(s, path, 0.5 * (ta + tb)), &a, &b)
     }
 
     fn dense_error(s: &NurbsSurface, path: &impl SurfacePath, ts: &[f64]) -> f64 {
@@ -240,7 +230,7 @@ mod tests {
                 (1..512)
                     .map(|k| {
                         let t = w[0] + (w[1] - w[0]) * k as f64 / 512.0;
-                        segment_distance(&at(s, path, t), &a, &b)
+                        point_segment_distance(&at(s, path, t), &a, &b)
                     })
                     .fold(0.0, f64::max)
             })

@@ -13,7 +13,7 @@ use std::str::FromStr;
 
 use nalgebra::Unit;
 use rayon::prelude::*;
-use tezgah_geom::{NurbsSurface, Vec3};
+use tezgah_geom::{NurbsSurface, SurfaceDerivs, Vec3};
 
 use crate::cutter::{Cutter, CutterShape};
 use crate::effective_radius::LeadTilt;
@@ -339,7 +339,7 @@ impl Axes {
 
 /// Geometry at one contact point.
 struct Local {
-    d: tezgah_geom::SurfaceDerivs,
+    d: SurfaceDerivs,
     frame: ContactFrame,
     curvature: Curvature2,
 }
@@ -419,8 +419,12 @@ impl<'a> Context<'a> {
 
     /// Frame and curvature at `(u, v)` for a path running along `tangent_uv`.
     fn local(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Option<Local> {
-        let d = self.surface.derivs(u, v);
-        let n = self.surface.normal(u, v)?;
+        self.local_of(self.surface.derivs(u, v), tangent_uv)
+    }
+
+    /// [`Self::local`] from derivatives already evaluated.
+    fn local_of(&self, d: SurfaceDerivs, tangent_uv: (f64, f64)) -> Option<Local> {
+        let n = d.normal()?;
         let n = if self.settings.reverse_normal { -n } else { n };
         let tangent = d.su * tangent_uv.0 + d.sv * tangent_uv.1;
         let frame = ContactFrame::new(n, tangent)?;
@@ -482,14 +486,15 @@ impl<'a> Context<'a> {
         tangent_uv: (f64, f64),
         min_lead: f64,
     ) -> Result<Placed, GougeReport> {
-        let contact = self.surface.point(u, v);
+        let d = self.surface.derivs(u, v);
+        let contact = d.point;
         let refuse = |refusal| GougeReport {
             uv: (u, v),
             contact,
             refusal,
         };
         let local = self
-            .local(u, v, tangent_uv)
+            .local_of(d, tangent_uv)
             .ok_or_else(|| refuse(Refusal::NoNormal))?;
         let mut angles = self
             .nominal_angles(&local)

@@ -149,7 +149,7 @@ pub fn step_over(path: &ToolPath) -> Option<f64> {
             .points
             .iter()
             .step_by(stride)
-            .map(|c| polyline_distance(&c.contact, &next))
+            .map(|c| tezgah_geom::deviation::point_polyline_distance(&c.contact, &next))
             .collect();
         d.sort_by(f64::total_cmp);
         let median = d[d.len() / 2];
@@ -158,24 +158,6 @@ pub fn step_over(path: &ToolPath) -> Option<f64> {
         }
     }
     best
-}
-
-fn polyline_distance(p: &Vec3, line: &[Vec3]) -> f64 {
-    if line.len() == 1 {
-        return (p - line[0]).norm();
-    }
-    line.windows(2)
-        .map(|s| {
-            let d = s[1] - s[0];
-            let l2 = d.norm_squared();
-            let t = if l2 > 0.0 {
-                ((p - s[0]).dot(&d) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (p - (s[0] + d * t)).norm()
-        })
-        .fold(f64::INFINITY, f64::min)
 }
 
 fn positive(what: &'static str, value: f64) -> Result<f64, VerifyError> {
@@ -262,24 +244,23 @@ pub fn simulate(
     // uncut, deeper gouges are reported as that deep.
     let up = r;
     let depth = r;
+    // One dexel on the surface at (u, v), along its outward normal (none where that is
+    // undefined); one surface evaluation each.
+    let dexel = |node: (usize, usize), u: f64, v: f64| {
+        let d = surface.derivs(u, v);
+        let n = d.normal()?.into_inner();
+        Some(Dexel {
+            node,
+            foot: d.point,
+            normal: if flip { -n } else { n },
+            uv: (u, v),
+            height: up,
+        })
+    };
     let mut dexels: Vec<Dexel> = Vec::with_capacity(count);
     for (i, &u) in u_nodes.iter().enumerate() {
         for (j, &v) in v_nodes.iter().enumerate() {
-            let Some(n) = surface.normal(u, v) else {
-                continue;
-            };
-            let n = if flip {
-                -n.into_inner()
-            } else {
-                n.into_inner()
-            };
-            dexels.push(Dexel {
-                node: (i, j),
-                foot: surface.point(u, v),
-                normal: n,
-                uv: (u, v),
-                height: up,
-            });
+            dexels.extend(dexel((i, j), u, v));
         }
     }
     let sweeper = Sweeper {
@@ -343,21 +324,7 @@ pub fn simulate(
                 }
                 let uu = fine_at(&u_nodes, fi, f);
                 let vv = fine_at(&v_nodes, fj, f);
-                let Some(n) = surface.normal(uu, vv) else {
-                    continue;
-                };
-                let n = if flip {
-                    -n.into_inner()
-                } else {
-                    n.into_inner()
-                };
-                fine.push(Dexel {
-                    node: (i, j),
-                    foot: surface.point(uu, vv),
-                    normal: n,
-                    uv: (uu, vv),
-                    height: up,
-                });
+                fine.extend(dexel((i, j), uu, vv));
             }
         }
     }

@@ -82,15 +82,14 @@ impl NurbsSurface {
     /// vanishes (a degenerate point such as a pole of a sphere patch; see
     /// [`DEGENERATE_NORMAL`]).
     pub fn normal(&self, u: f64, v: f64) -> Option<Unit<Vec3>> {
-        let d = self.derivs(u, v);
-        normal_of(&d)
+        self.derivs(u, v).normal()
     }
 
     /// The first and second fundamental forms at `(u, v)`; `None` where the normal is
     /// undefined.
     pub fn fundamental_forms(&self, u: f64, v: f64) -> Option<FundamentalForms> {
         let d = self.derivs(u, v);
-        forms_of(&d, &normal_of(&d)?)
+        forms_of(&d, &d.normal()?)
     }
 
     /// Principal curvatures and directions at `(u, v)`: the symmetric 2×2 second form in the
@@ -99,7 +98,7 @@ impl NurbsSurface {
     /// undefined.
     pub fn principal_curvatures(&self, u: f64, v: f64) -> Option<PrincipalCurvatures> {
         let d = self.derivs(u, v);
-        let n = normal_of(&d)?;
+        let n = d.normal()?;
         let ff = forms_of(&d, &n)?;
         let (k1, k2) = ff.principal_curvatures();
         let [a, b, c] = ff.orthonormal_second_form();
@@ -115,12 +114,16 @@ impl NurbsSurface {
 /// `S_u × S_v` normalised; `None` when it is not finite or at most
 /// [`DEGENERATE_NORMAL`]`·(|S_u| + |S_v|)²`: at a collapsed edge (a pole) `S_u` is rounding
 /// noise, and so would be the direction of the cross product.
-fn normal_of(d: &SurfaceDerivs) -> Option<Unit<Vec3>> {
-    let c = d.su.cross(&d.sv);
-    let len = c.norm();
-    let scale = d.su.norm() + d.sv.norm();
-    (len.is_finite() && len > DEGENERATE_NORMAL * scale * scale)
-        .then(|| Unit::new_unchecked(c / len))
+impl SurfaceDerivs {
+    /// The unit normal `S_u × S_v / |S_u × S_v|` from derivatives already evaluated; `None`
+    /// where it is undefined (a pole or a degenerate edge).
+    pub fn normal(&self) -> Option<Unit<Vec3>> {
+        let c = self.su.cross(&self.sv);
+        let len = c.norm();
+        let scale = self.su.norm() + self.sv.norm();
+        (len.is_finite() && len > DEGENERATE_NORMAL * scale * scale)
+            .then(|| Unit::new_unchecked(c / len))
+    }
 }
 
 /// The fundamental forms from the derivatives and the unit normal (`None` when `EG − F²`
