@@ -80,8 +80,8 @@ pub struct CamArgs {
 pub const DEFAULT_MAX_TILT_DEG: f64 = 75.0;
 
 /// What the strategy is asked for.
-pub struct PlanRequest<'a> {
-    pub strategy: &'a str,
+pub struct PlanRequest {
+    pub strategy: StrategyKind,
     pub scallop_mm: f64,
     pub tolerance_mm: f64,
     pub lead_deg: f64,
@@ -144,15 +144,11 @@ fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -
 fn plan_surface(
     path: &Path,
     cutter: Cutter,
-    request: &PlanRequest<'_>,
+    request: &PlanRequest,
 ) -> Result<(NurbsSurface, ToolPath)> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
     let face = pick_face(path, model, request.face)?;
-    let kind = request
-        .strategy
-        .parse::<StrategyKind>()
-        .map_err(|e| miette!("{e}"))?;
-    let mut settings = Settings::new(kind, request.scallop_mm, request.tolerance_mm);
+    let mut settings = Settings::new(request.strategy, request.scallop_mm, request.tolerance_mm);
     if let ToolAxis::Surface {
         lead_deg, tilt_deg, ..
     } = &mut settings.axis
@@ -229,12 +225,10 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             return Err(miette!("{name} must be an angle in (−90°, 90°), got {v}"));
         }
     }
-    if !["zigzag", "zigzag-oneway", "iso-scallop"].contains(&args.strategy.as_str()) {
-        return Err(miette!(
-            "--strategy {}: expected zigzag, zigzag-oneway or iso-scallop",
-            args.strategy
-        ));
-    }
+    let strategy: StrategyKind = args
+        .strategy
+        .parse()
+        .map_err(|e| miette!("--strategy {}: {e}", args.strategy))?;
     let machine = crate::run::load_machine(Some(args.machine.as_deref().unwrap_or("table-ac")))?;
     if !matches!(
         machine.kinematics,
@@ -268,7 +262,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     // linearisation each get half, so the machine's motion stays within the tolerance of the
     // exact cutter-location path (the two add up where they meet, as on a convex surface).
     let request = PlanRequest {
-        strategy: &args.strategy,
+        strategy,
         scallop_mm: scallop,
         tolerance_mm: 0.5 * tolerance,
         lead_deg: args.lead_deg,
