@@ -9,7 +9,7 @@ use crate::params::Params;
 
 /// Equality tolerance of `EQ`/`NE`: LinuxCNC 2.9's `TOLERANCE_EQUAL` (interp_internal.hh),
 /// 0.0001, so `[EXP[-9.2104] EQ 0]` is true there and here.
-const TOLERANCE_EQUAL: f64 = 1e-4;
+pub(crate) const TOLERANCE_EQUAL: f64 = 1e-4;
 
 /// An error and the index in the normalised text where it was found.
 pub type ReadError = (ErrorKind, usize);

@@ -15,10 +15,8 @@ use crate::error::ErrorKind;
 use super::super::arc::ArcTolerance;
 use super::super::Interpreter;
 use super::queue::{find_turn, Held, HeldArc};
-use super::{plane_axes, CompError, Side, CORNER_TOLERANCE};
-
-/// Two numbers are equal within this (LinuxCNC `TOLERANCE_EQUAL`).
-const TOLERANCE_EQUAL: f64 = 0.0001;
+use super::{angle_to, distance, plane_axes, polar, CompError, Side, CORNER_TOLERANCE};
+use crate::reader::TOLERANCE_EQUAL;
 
 /// A programmed arc, in the compensation plane's coordinates.
 #[derive(Debug, Clone, Copy)]
@@ -46,19 +44,6 @@ impl ProgrammedArc {
     fn end2(&self) -> [f64; 2] {
         [self.end[0], self.end[1]]
     }
-}
-
-fn angle_to(from: [f64; 2], to: [f64; 2]) -> f64 {
-    (to[1] - from[1]).atan2(to[0] - from[0])
-}
-
-fn distance(p: [f64; 2], q: [f64; 2]) -> f64 {
-    (p[0] - q[0]).hypot(p[1] - q[1])
-}
-
-fn polar(center: [f64; 2], radius: f64, angle: f64) -> [f64; 2] {
-    let (s, c) = angle.sin_cos();
-    [center[0] + radius * c, center[1] + radius * s]
 }
 
 impl Interpreter {

@@ -385,3 +385,19 @@ impl Interpreter {
         Ok(())
     }
 }
+
+/// Direction of `to` seen from `from`, radians.
+pub(super) fn angle_to(from: [f64; 2], to: [f64; 2]) -> f64 {
+    (to[1] - from[1]).atan2(to[0] - from[0])
+}
+
+/// Distance between two points of the plane.
+pub(super) fn distance(p: [f64; 2], q: [f64; 2]) -> f64 {
+    (p[0] - q[0]).hypot(p[1] - q[1])
+}
+
+/// The point `radius` from `center` in direction `angle`.
+pub(super) fn polar(center: [f64; 2], radius: f64, angle: f64) -> [f64; 2] {
+    let (s, c) = angle.sin_cos();
+    [center[0] + radius * c, center[1] + radius * s]
+}

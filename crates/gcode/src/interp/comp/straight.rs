@@ -15,13 +15,7 @@ use crate::error::ErrorKind;
 
 use super::super::Interpreter;
 use super::queue::{Held, HeldArc};
-use super::{plane_axes, CompError, Side, CORNER_TOLERANCE};
-
-/// A point in the compensation plane moved `radius` along the angle `angle`.
-fn offset(p: [f64; 2], radius: f64, angle: f64) -> [f64; 2] {
-    let (s, c) = angle.sin_cos();
-    [p[0] + radius * c, p[1] + radius * s]
-}
+use super::{plane_axes, polar, CompError, Side, CORNER_TOLERANCE};
 
 impl Interpreter {
     /// A G0 or G1 to the programmed point `end` with compensation active.
@@ -56,7 +50,7 @@ impl Interpreter {
             return Err(CompError::EntryMoveTooShort.into());
         }
         let alpha = (p[1] - c[1]).atan2(p[0] - c[0]) + side.normal_angle();
-        let tool_end = offset([p[0], p[1]], radius, alpha);
+        let tool_end = polar([p[0], p[1]], radius, alpha);
         // The entry move is longer than the radius, so no later corner can reverse it.
         self.comp.endpoint = Some([c[0], c[1]]);
         self.hold_straight(rapid, alpha.cos(), alpha.sin(), end, tool_end);
@@ -120,8 +114,8 @@ impl Interpreter {
             }
         };
         let gamma = side.normal_angle();
-        let tool_end = offset([p[0], p[1]], radius, alpha + gamma);
-        let mid = offset([op[0], op[1]], radius, alpha + gamma);
+        let tool_end = polar([p[0], p[1]], radius, alpha + gamma);
+        let mid = polar([op[0], op[1]], radius, alpha + gamma);
         let small = CORNER_TOLERANCE;
         // Over the top of an arc into a line (an "h"): stay on this side, not loop round.
         let h_shape = beta > PI - small
@@ -169,7 +163,7 @@ impl Interpreter {
                         return Err(CompError::ZeroDegreeCorner.into());
                     }
                     let retreat = radius / half_corner.tan();
-                    offset([c[0], c[1]], retreat, theta + gamma)
+                    polar([c[0], c[1]], retreat, theta + gamma)
                 }
                 Some(prev) => arc_line_corner(prev, side, radius, op, direction)?,
             };
