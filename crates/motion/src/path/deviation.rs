@@ -118,7 +118,7 @@ fn prog_distance(p: &Prog, q: &Vec3) -> f64 {
         }),
         Prog::Nurbs(c) => {
             let (u0, u1) = c.domain();
-            closest_point(c.as_ref(), q, u0, u1, 16 * c.control_points().len()).distance
+            closest_on_spans(c.as_ref(), q, u0, u1)
         }
     }
 }
