@@ -181,22 +181,11 @@ impl Executor {
                 Ok(Some(self.emit_at(at, true, 0.0)))
             }
             Err(e) => {
-                // A homing that cannot go on (no switch found) stops where it is.
+                // A homing that cannot go on (no switch found) stops where it is; the error
+                // stays in the status (a stop's periods never fail or clear it).
                 self.error = Some(e.to_string());
-                self.manual = None;
-                let last = self
-                    .last_manual
-                    .unwrap_or_else(|| SetPoint::at_rest(0, 0, self.pose.joints));
-                self.manual = Some(ManualMotion::Stop(JointStop::new(
-                    &last,
-                    &self.machine.max_acceleration,
-                    &self.machine.max_jerk,
-                    self.options.period,
-                )));
-                let error = self.error.clone();
-                let out = self.step_manual();
-                self.error = error;
-                out
+                self.stop_manual();
+                self.step_manual()
             }
         }
     }

@@ -107,11 +107,6 @@ impl Inc {
         })
     }
 
-    /// Where the joint ends.
-    pub fn target(&self) -> f64 {
-        self.target
-    }
-
     /// The move's duration, s (the last set-point is at the next period at or after it).
     pub fn duration(&self) -> f64 {
         self.profile.duration()

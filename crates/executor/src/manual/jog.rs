@@ -106,13 +106,6 @@ impl Jog {
         Ok(())
     }
 
-    /// Sets the jog speed (file units per second).
-    pub fn set_speed(&mut self, speed: f64) -> Result<(), ManualError> {
-        self.speed = self.axis.speed(speed)?;
-        self.retarget();
-        Ok(())
-    }
-
     /// Asks for a stop: the joint comes to rest in the jerk-limited minimum distance.
     pub fn stop(&mut self) {
         if !self.stopping {
