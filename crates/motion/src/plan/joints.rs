@@ -132,6 +132,25 @@ impl PlanMachine {
         matches!(self.model, Model::TableAc(_) | Model::TableBc(_))
     }
 
+    /// The tool axis (workpiece frame) and the joints of the program point (`tip`, A B C)
+    /// under tool-centre-point control with a tool `tool_length` long, joints nearest
+    /// `previous`; `None` out of reach.
+    fn axis_of(
+        &self,
+        tool_length: f64,
+        tip: &Vec3,
+        rotary: &[f64; 3],
+        previous: &Joints,
+    ) -> Option<(Vec3, Joints)> {
+        let control = ToolControl::CentrePoint { tool_length };
+        let q = self.joints(control, tip, rotary, previous).ok()?;
+        let pose = self
+            .model
+            .forward(&q, &Tool::with_length(tool_length))
+            .ok()?;
+        Some((pose.axis.into_inner(), q))
+    }
+
     /// The angle (degrees) the tool axis turns through along a rotary-only segment under
     /// tool-centre-point control on a machine whose rotaries orient the tool: the length of
     /// its path on the unit sphere, summed over [`SWEEP_STEPS`] steps of the program angles
@@ -149,15 +168,14 @@ impl PlanMachine {
             let degrees = g.angle().to_degrees();
             return (degrees > 1e-9).then_some(degrees);
         }
-        let tool = Tool::with_length(tool_length);
         let tip = seg.curve.point(seg.curve.domain().0);
         let [r0, r1] = seg.rotary;
         let mut previous = Joints::zeros(self.joint_count());
         let mut axis_at = |f: f64| -> Option<Vec3> {
             let rotary = [0, 1, 2].map(|i| r0[i] + (r1[i] - r0[i]) * f);
-            let q = self.joints(seg.control, &tip, &rotary, &previous).ok()?;
+            let (axis, q) = self.axis_of(tool_length, &tip, &rotary, &previous)?;
             previous = q;
-            Some(self.model.forward(&q, &tool).ok()?.axis.into_inner())
+            Some(axis)
         };
         let mut last = axis_at(0.0)?;
         let mut sweep = 0.0;
@@ -324,14 +342,8 @@ impl ToolAxisMap for PlanMachine {
         }
         // The rotary joints are the angles themselves (no branch to choose), so the axis
         // depends on the angles alone, bit for bit.
-        let q = self
-            .joints(control, tip, rotary, &Joints::zeros(self.joint_count()))
-            .ok()?;
-        let pose = self
-            .model
-            .forward(&q, &Tool::with_length(tool_length))
-            .ok()?;
-        Some(pose.axis.into_inner())
+        let zeros = Joints::zeros(self.joint_count());
+        Some(self.axis_of(tool_length, tip, rotary, &zeros)?.0)
     }
 
     fn follows(
