@@ -22,7 +22,7 @@ use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
 use crate::scale::{PieceView, TimeScale};
-use crate::setpoint::SetPoint;
+use crate::setpoint::{History, SetPoint};
 
 mod manual;
 
@@ -119,8 +119,8 @@ pub struct Executor {
     /// Where the tool is (the last sample, or a piece's exact end).
     pose: CursorPose,
     k: u64,
-    prev_joints: Joints,
-    prev_velocity: Joints,
+    /// The positions produced last (drive frame): each set-point's velocity and acceleration.
+    history: History,
     /// Segments passed since the last set-point (for path checks).
     passed: Vec<Arc<Segment>>,
     /// Path length of the pieces finished, and where in the current one the tool is.
@@ -208,8 +208,7 @@ impl Executor {
                 joints,
             },
             k: 0,
-            prev_joints: joints,
-            prev_velocity: Joints::zeros(n),
+            history: History::at_rest(joints),
             passed: Vec::new(),
             done_length: 0.0,
             s: 0.0,
@@ -541,8 +540,7 @@ impl Executor {
             self.pose.tip = p.tip;
         }
         self.pose.joints = joints;
-        self.prev_joints = drive;
-        self.prev_velocity = Joints::zeros(joints.len());
+        self.history = History::at_rest(drive);
     }
 
     fn target(&self, factor: f64) -> f64 {
@@ -795,9 +793,9 @@ impl Executor {
         Ok(())
     }
 
-    /// The set-point at the current pose; velocity and acceleration by backward differences
-    /// (zero when `rest`: a stop is exact, and the real-time side must see the machine at rest
-    /// to idle without calling it an underrun).
+    /// The set-point at the current pose; velocity and acceleration from the positions
+    /// produced ([`History`]), zero when `rest` (a stop is exact, and the real-time side must
+    /// see the machine at rest to idle without calling it an underrun).
     fn emit(&mut self, rest: bool, feed: f64) -> Produced {
         let q = add(&self.pose.joints, &self.offset);
         self.emit_at(q, rest, feed)
@@ -805,23 +803,18 @@ impl Executor {
 
     /// The set-point at drive-frame joints `q`.
     fn emit_at(&mut self, q: Joints, rest: bool, feed: f64) -> Produced {
-        let ts = self.options.period;
-        let (velocity, acceleration) = if rest {
-            (Joints::zeros(q.len()), Joints::zeros(q.len()))
+        let (k, line) = (self.k, self.pose.line);
+        let setpoint = if rest {
+            self.history.rest(k, line, q)
         } else {
-            let v = sub(&q, &self.prev_joints, 1.0 / ts);
-            let a = sub(&v, &self.prev_velocity, 1.0 / ts);
-            (v, a)
+            self.history.setpoint(k, line, q, self.options.period)
         };
-        self.prev_joints = q;
-        self.prev_velocity = velocity;
-        let setpoint = SetPoint {
-            index: self.k,
-            line: self.pose.line,
-            position: q,
-            velocity,
-            acceleration,
-        };
+        self.produced(setpoint, feed)
+    }
+
+    /// `setpoint` produced at path speed `feed`: the counter moves on; where the tool is goes
+    /// with it.
+    fn produced(&mut self, setpoint: SetPoint, feed: f64) -> Produced {
         self.k += 1;
         Produced {
             setpoint,

@@ -15,25 +15,8 @@ use tezgah_kinematics::Joints;
 use crate::drive::{Drive, DriveFault};
 use crate::ring::{RtEnds, RtReport, RtState, Slot};
 use crate::setpoint::SetPoint;
-use crate::stop::JointStop;
-
-/// The joint limits the underrun stop obeys (internal units, machine-file order).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StopLimits {
-    pub max_acceleration: Joints,
-    pub max_jerk: Joints,
-}
-
-impl StopLimits {
-    /// The machine's joint limits as the planner holds them (internal units).
-    pub fn of(machine: &tezgah_motion::plan::PlanMachine) -> StopLimits {
-        let j = |v: &[f64]| Joints::from_slice(v).unwrap_or_else(|_| Joints::zeros(0));
-        StopLimits {
-            max_acceleration: j(&machine.max_acceleration),
-            max_jerk: j(&machine.max_jerk),
-        }
-    }
-}
+use crate::stop::PlayedStop;
+pub use crate::stop::StopLimits;
 
 /// The real-time loop's counters.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -57,8 +40,8 @@ pub struct RtLoop<D: Drive> {
     limits: StopLimits,
     last: SetPoint,
     state: RtState,
-    stop: Option<(JointStop, u32)>,
-    stop_t: f64,
+    /// The underrun stop being played, and the line it stops on.
+    stop: Option<(PlayedStop, u32)>,
     fault: Option<DriveFault>,
     counters: RtCounters,
 }
@@ -79,7 +62,6 @@ impl<D: Drive> RtLoop<D> {
             last: SetPoint::at_rest(0, 0, start),
             state: RtState::Running,
             stop: None,
-            stop_t: 0.0,
             fault: None,
             counters: RtCounters::default(),
         }
@@ -153,16 +135,10 @@ impl<D: Drive> RtLoop<D> {
                 Ok(Slot::Rearm) => continue,
                 Err(_) if moving(&self.last) => {
                     self.counters.underruns += 1;
-                    let l = &self.limits;
-                    let stop = JointStop::new(
-                        &self.last.position,
-                        &self.last.velocity,
-                        &self.last.acceleration,
-                        &l.max_acceleration,
-                        &l.max_jerk,
-                    );
+                    // From the last set-point's own state (exact for the played positions, see
+                    // `setpoint::History`): within the limits from the first period.
+                    let stop = PlayedStop::new(&self.last, &self.limits, self.period);
                     self.stop = Some((stop, self.last.line));
-                    self.stop_t = 0.0;
                     self.state = RtState::Stopping;
                     return self.stopping();
                 }
@@ -175,13 +151,17 @@ impl<D: Drive> RtLoop<D> {
     fn stopping(&mut self) -> SetPoint {
         // Set-points still arriving belong to the path the stop has left.
         self.discard();
-        let Some((stop, line)) = self.stop else {
+        let Some((stop, line)) = self.stop.as_mut() else {
             self.state = RtState::Halted;
             return self.last;
         };
-        self.stop_t += self.period;
-        let s = stop.at(self.stop_t);
-        if self.stop_t >= stop.duration() {
+        let line = *line;
+        let Some(s) = stop.next() else {
+            self.state = RtState::Halted;
+            self.stop = None;
+            return self.last;
+        };
+        if stop.is_over() {
             self.state = RtState::Halted;
             self.stop = None;
         }

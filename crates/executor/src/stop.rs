@@ -1,93 +1,36 @@
-//! The jerk-limited stop of each joint from its last commanded velocity and acceleration: what
-//! the real-time thread plays when the ring runs dry (an underrun). Closed form, fixed size,
-//! no allocation: it runs inside the period.
+//! The joints' jerk-limited stop: every joint brought from its commanded position, velocity
+//! and acceleration to rest on its own time-optimal velocity ramp ([`VelocityRamp`] to speed
+//! 0, Kröger & Wahl's velocity-control case as Ruckig's velocity interface solves it), all
+//! starting together. One piece for the real-time side's underrun stop and the manual modes'
+//! abort, hold and failed homing. Fixed size and closed form, no allocation: it runs inside
+//! the real-time period.
 //!
-//! Per joint, the time-optimal velocity-to-zero profile (Kröger & Wahl's velocity-control
-//! case, as Ruckig's "velocity interface" solves it): jerk −J until the acceleration reaches a
-//! peak `a_p`, hold `a_p`, jerk +J back to zero acceleration exactly as the velocity reaches
-//! zero. With the joint's state mirrored so that it must slow down (v + a|a|/(2J) > 0), the
-//! velocity change over the two ramps is (a₀² − 2a_p²)/(2J) = −v₀, so
-//! a_p = −√(a₀²/2 + J·v₀), capped at −A with a constant-acceleration phase between. Each joint
-//! stops on its own time, so the tool leaves the path by the difference: an underrun is a
-//! fault, the stop only makes it harmless (no jump, no limit exceeded).
+//! Each joint stops on its own time, so a tool on a path leaves it by the difference: after an
+//! underrun that is a fault, the stop only makes it harmless (no jump, no limit exceeded).
 
 use tezgah_kinematics::Joints;
+use tezgah_motion::plan::PlanMachine;
+use tezgah_motion::profile::State;
+
+use crate::manual::ramp::{stopping_displacement, VelocityRamp};
+use crate::setpoint::SetPoint;
 
 const MAX: usize = tezgah_kinematics::pose::MAX_JOINTS;
 
-/// One joint's stop: three constant-jerk phases from (p₀, v₀, a₀).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct AxisStop {
-    p0: f64,
-    v0: f64,
-    a0: f64,
-    /// Phase durations (s) and jerks.
-    phases: [(f64, f64); 3],
+/// The joint limits a stop obeys (internal units, machine-file order).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopLimits {
+    pub max_acceleration: Joints,
+    pub max_jerk: Joints,
 }
 
-impl AxisStop {
-    fn new(p0: f64, v0: f64, a0: f64, max_acc: f64, max_jerk: f64) -> AxisStop {
-        let (a_lim, j) = (max_acc, max_jerk);
-        let mut phases = [(0.0, 0.0); 3];
-        // Velocity reached if the acceleration were brought to zero at once with full jerk.
-        let coast = v0 + a0 * a0.abs() / (2.0 * j);
-        if coast == 0.0 || !(j > 0.0 && a_lim > 0.0) {
-            // Only the acceleration to remove (or no limits to stop with).
-            if j > 0.0 {
-                phases[0] = (a0.abs() / j, -a0.signum() * j);
-            }
-            return AxisStop { p0, v0, a0, phases };
-        }
-        // Mirror so that the joint must slow a positive velocity.
-        let sigma = coast.signum();
-        let (v, a) = (sigma * v0, sigma * a0);
-        let (t1, t2, t3);
-        if a < -a_lim {
-            // Already beyond the limit (a corrupt set-point): hold it, then release.
-            t1 = 0.0;
-            t2 = ((v - a * a / (2.0 * j)) / -a).max(0.0);
-            t3 = -a / j;
-        } else {
-            let peak = -(a * a / 2.0 + j * v).max(0.0).sqrt();
-            if peak < -a_lim {
-                t1 = (a + a_lim) / j;
-                t2 = ((v + (a * a - 2.0 * a_lim * a_lim) / (2.0 * j)) / a_lim).max(0.0);
-                t3 = a_lim / j;
-            } else {
-                t1 = (a - peak) / j;
-                t2 = 0.0;
-                t3 = -peak / j;
-            }
-        }
-        phases[0] = (t1.max(0.0), -sigma * j);
-        phases[1] = (t2, 0.0);
-        phases[2] = (t3.max(0.0), sigma * j);
-        AxisStop { p0, v0, a0, phases }
-    }
-
-    fn duration(&self) -> f64 {
-        self.phases.iter().map(|p| p.0).sum()
-    }
-
-    /// Position, velocity, acceleration at time t after the start (at rest after the end).
-    fn at(&self, t: f64) -> (f64, f64, f64) {
-        let (mut p, mut v, mut a) = (self.p0, self.v0, self.a0);
-        let mut left = t.max(0.0);
-        for &(d, j) in &self.phases {
-            let dt = left.min(d);
-            p += v * dt + a * dt * dt / 2.0 + j * dt * dt * dt / 6.0;
-            v += a * dt + j * dt * dt / 2.0;
-            a += j * dt;
-            left -= dt;
-            if left <= 0.0 {
-                break;
-            }
-        }
-        if t >= self.duration() {
-            // Exactly at rest: rounding in the sums must not leave a creep.
-            (p, 0.0, 0.0)
-        } else {
-            (p, v, a)
+impl StopLimits {
+    /// The machine's joint limits as the planner holds them (internal units).
+    pub fn of(machine: &PlanMachine) -> StopLimits {
+        let j = |v: &[f64]| Joints::from_slice(v).unwrap_or_else(|_| Joints::zeros(0));
+        StopLimits {
+            max_acceleration: j(&machine.max_acceleration),
+            max_jerk: j(&machine.max_jerk),
         }
     }
 }
@@ -95,15 +38,13 @@ impl AxisStop {
 /// Distance a jerk-limited stop from speed `v` and acceleration `a` travels under
 /// `max_acceleration`, `max_jerk` (the same closed form, along a path or a joint).
 pub fn stopping_distance(v: f64, a: f64, max_acceleration: f64, max_jerk: f64) -> f64 {
-    let s = AxisStop::new(0.0, v, a, max_acceleration, max_jerk);
-    s.at(s.duration()).0
-}
-
-/// Every joint's stop, evaluated together.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JointStop {
-    axes: [AxisStop; MAX],
-    len: usize,
+    let st = State {
+        s: 0.0,
+        v,
+        a,
+        j: 0.0,
+    };
+    stopping_displacement(st, max_acceleration, max_jerk)
 }
 
 /// A joint state on the stop.
@@ -114,49 +55,63 @@ pub struct JointState {
     pub acceleration: Joints,
 }
 
+/// Every joint's stop, evaluated together.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointStop {
+    ramps: [Option<VelocityRamp>; MAX],
+    len: usize,
+}
+
 impl JointStop {
-    /// The stop from `position`, `velocity`, `acceleration` under per-joint limits
-    /// `max_acceleration`, `max_jerk` (same units, same order).
-    pub fn new(
-        position: &Joints,
-        velocity: &Joints,
-        acceleration: &Joints,
-        max_acceleration: &Joints,
-        max_jerk: &Joints,
-    ) -> JointStop {
-        let len = position.len();
-        let mut axes = [AxisStop::default(); MAX];
-        for (i, axis) in axes.iter_mut().enumerate().take(len) {
+    /// The stop from the state a set-point commands (its velocity and acceleration exact:
+    /// see [`crate::setpoint::History`]) under `limits`.
+    pub fn new(from: &SetPoint, limits: &StopLimits) -> JointStop {
+        let len = from.position.len();
+        let mut ramps = [None; MAX];
+        for (i, ramp) in ramps.iter_mut().enumerate().take(len) {
             let g = |q: &Joints| q.as_slice().get(i).copied().unwrap_or(0.0);
-            *axis = AxisStop::new(
-                g(position),
-                g(velocity),
-                g(acceleration),
-                g(max_acceleration),
-                g(max_jerk),
-            );
+            let start = State {
+                s: from.position[i],
+                v: from.velocity[i],
+                a: from.acceleration[i],
+                j: 0.0,
+            };
+            let (a_max, j_max) = (g(&limits.max_acceleration), g(&limits.max_jerk));
+            // A joint with no limits to stop with keeps its position (nothing to ramp).
+            if a_max > 0.0 && j_max > 0.0 {
+                *ramp = Some(VelocityRamp::new(start, 0.0, a_max, j_max));
+            }
         }
-        JointStop { axes, len }
+        JointStop { ramps, len }
     }
 
     /// Time until the last joint is at rest, s.
     pub fn duration(&self) -> f64 {
-        self.axes[..self.len]
+        self.ramps[..self.len]
             .iter()
-            .map(AxisStop::duration)
+            .flatten()
+            .map(VelocityRamp::duration)
             .fold(0.0, f64::max)
     }
 
-    /// The joints t seconds into the stop.
+    /// The joints t seconds into the stop (exactly at rest once a joint's ramp is over:
+    /// rounding in its sums must not leave a creep).
     pub fn at(&self, t: f64) -> JointState {
-        let mut position = Joints::zeros(self.len);
-        let mut velocity = Joints::zeros(self.len);
-        let mut acceleration = Joints::zeros(self.len);
-        for i in 0..self.len {
-            let (p, v, a) = self.axes[i].at(t);
-            position.as_mut_slice()[i] = p;
-            velocity.as_mut_slice()[i] = v;
-            acceleration.as_mut_slice()[i] = a;
+        let z = Joints::zeros(self.len);
+        let (mut position, mut velocity, mut acceleration) = (z, z, z);
+        for (i, ramp) in self.ramps[..self.len].iter().enumerate() {
+            let Some(r) = ramp else {
+                position[i] = f64::NAN;
+                continue;
+            };
+            let st = if t >= r.duration() {
+                r.end()
+            } else {
+                r.state_at(t)
+            };
+            position[i] = st.s;
+            velocity[i] = st.v;
+            acceleration[i] = st.a;
         }
         JointState {
             position,
@@ -166,22 +121,118 @@ impl JointStop {
     }
 }
 
+/// A stop played one period at a time: the states at Ts, 2Ts, … up to and including the first
+/// at or past its end.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlayedStop {
+    stop: JointStop,
+    /// Held position of joints without a ramp.
+    from: Joints,
+    period: f64,
+    played: u64,
+    over: bool,
+}
+
+impl PlayedStop {
+    /// The stop from `from` under `limits`, played at `period`.
+    pub fn new(from: &SetPoint, limits: &StopLimits, period: f64) -> PlayedStop {
+        PlayedStop {
+            stop: JointStop::new(from, limits),
+            from: from.position,
+            period,
+            played: 0,
+            over: false,
+        }
+    }
+
+    /// The next period's state, `None` once the stop is over.
+    pub fn next(&mut self) -> Option<JointState> {
+        if self.over {
+            return None;
+        }
+        self.played += 1;
+        let t = self.played as f64 * self.period;
+        self.over = t >= self.stop.duration();
+        let mut s = self.stop.at(t);
+        for (p, held) in s
+            .position
+            .as_mut_slice()
+            .iter_mut()
+            .zip(self.from.as_slice())
+        {
+            if p.is_nan() {
+                *p = *held;
+            }
+        }
+        Some(s)
+    }
+
+    /// True once the state at rest has been played.
+    pub fn is_over(&self) -> bool {
+        self.over
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    fn one(p: f64, v: f64, a: f64, a_max: f64, j_max: f64) -> JointStop {
+        let j = |x: f64| Joints::from_slice(&[x]).unwrap();
+        let sp = SetPoint {
+            index: 0,
+            line: 0,
+            position: j(p),
+            velocity: j(v),
+            acceleration: j(a),
+        };
+        let limits = StopLimits {
+            max_acceleration: j(a_max),
+            max_jerk: j(j_max),
+        };
+        JointStop::new(&sp, &limits)
+    }
+
+    fn at(s: &JointStop, t: f64) -> (f64, f64, f64) {
+        let st = s.at(t);
+        (st.position[0], st.velocity[0], st.acceleration[0])
+    }
 
     /// The textbook case: from v with a = 0 and A reached, the stop takes v/A + A/J and
     /// travels v²/(2A) + vA/(2J) (the jerk-limited braking distance).
     #[test]
     fn from_cruise_matches_the_closed_form() {
         let (v, a_max, j_max) = (100.0, 1000.0, 20_000.0);
-        let s = AxisStop::new(0.0, v, 0.0, a_max, j_max);
+        let s = one(0.0, v, 0.0, a_max, j_max);
         let t = s.duration();
         assert!((t - (v / a_max + a_max / j_max)).abs() < 1e-12);
-        let (p, ve, ae) = s.at(t);
+        let (p, ve, ae) = at(&s, t);
         assert!((p - (v * v / (2.0 * a_max) + v * a_max / (2.0 * j_max))).abs() < 1e-9);
         assert_eq!((ve, ae), (0.0, 0.0));
+        assert!((stopping_distance(v, 0.0, a_max, j_max) - p).abs() < 1e-12);
+    }
+
+    /// Played at the period: one state per period, the last at rest, then nothing.
+    #[test]
+    fn played_ends_at_rest() {
+        let j = |x: f64| Joints::from_slice(&[x, 3.0]).unwrap();
+        let sp = SetPoint {
+            index: 0,
+            line: 0,
+            position: j(1.0),
+            velocity: Joints::from_slice(&[50.0, 0.0]).unwrap(),
+            acceleration: Joints::zeros(2),
+        };
+        let limits = StopLimits {
+            max_acceleration: j(1000.0),
+            max_jerk: j(20_000.0),
+        };
+        let mut played = PlayedStop::new(&sp, &limits, 1e-3);
+        let d = JointStop::new(&sp, &limits).duration();
+        let n = std::iter::from_fn(|| played.next()).count();
+        assert_eq!(n, (d / 1e-3).ceil() as usize);
+        assert!(played.is_over());
     }
 
     proptest! {
@@ -191,16 +242,16 @@ mod tests {
         fn stops_within_limits(v in -300.0..300.0f64, af in -1.0..=1.0f64,
                                a_max in 10.0..5000.0f64, j_max in 100.0..1e6f64) {
             let a0 = af * a_max;
-            let s = AxisStop::new(1.0, v, a0, a_max, j_max);
+            let s = one(1.0, v, a0, a_max, j_max);
             let t_end = s.duration();
             prop_assert!(t_end.is_finite());
             let coast = v + a0 * a0.abs() / (2.0 * j_max);
             let n = 400;
-            let mut prev = s.at(0.0);
+            let mut prev = at(&s, 0.0);
             let mut crossings = 0;
             for k in 1..=n {
                 let t = t_end * k as f64 / n as f64;
-                let (p, vv, aa) = s.at(t);
+                let (p, vv, aa) = at(&s, t);
                 prop_assert!(aa.abs() <= a_max * (1.0 + 1e-9), "a {aa}");
                 // The velocity crosses zero at most once (only when the start acceleration
                 // already carries it past zero: then the stop settles on coast's side).
@@ -215,13 +266,36 @@ mod tests {
             if crossings == 1 {
                 prop_assert!(v * coast < 0.0, "v {v} coast {coast}");
             }
-            let (_, ve, ae) = s.at(t_end);
+            let (_, ve, ae) = at(&s, t_end);
             prop_assert_eq!((ve, ae), (0.0, 0.0));
             // Just before the end the state is continuous with rest (no jump into it).
             let dt = 1e-9 * t_end;
-            let (_, ve, ae) = s.at(t_end - dt);
+            let (_, ve, ae) = at(&s, t_end - dt);
             prop_assert!(ae.abs() <= j_max * dt * (1.0 + 1e-6) + 1e-9 * a_max, "a {ae}");
             prop_assert!(ve.abs() <= j_max * dt * dt + 1e-9 * (1.0 + v.abs()), "v {ve}");
+        }
+
+        /// A start a little beyond the acceleration limit (a state estimate a hair past it)
+        /// is not clamped — that would be a jump in acceleration — but held or brought back
+        /// at the jerk limit; beyond the start's own magnitude it never goes.
+        #[test]
+        fn a_start_past_the_limit_is_not_clamped(v in -300.0..300.0f64, af in 1.0..1.05f64,
+                                                 sign in prop::bool::ANY) {
+            let (a_max, j_max) = (2000.0, 50_000.0);
+            let a0 = if sign { af * a_max } else { -af * a_max };
+            let s = one(0.0, v, a0, a_max, j_max);
+            let t_end = s.duration();
+            let n = 400;
+            let mut prev = at(&s, 0.0).2;
+            prop_assert_eq!(prev, a0);
+            for k in 1..=n {
+                let t = t_end * k as f64 / n as f64;
+                let aa = at(&s, t).2;
+                prop_assert!(aa.abs() <= a0.abs() * (1.0 + 1e-9), "a {aa}");
+                prop_assert!((aa - prev).abs() <= j_max * t_end / n as f64 * (1.0 + 1e-9) + 1e-9);
+                prev = aa;
+            }
+            prop_assert_eq!(at(&s, t_end).1, 0.0);
         }
     }
 }

@@ -8,11 +8,12 @@ use tezgah_kinematics::Joints;
 use super::{add, sub, Executor, Produced};
 use crate::command::{Direction, Mode, RunState};
 use crate::error::ExecError;
-use crate::manual::active::{JointStop, ManualMotion};
+use crate::manual::active::ManualMotion;
 use crate::manual::{
     default_jog_speed, Home, Inc, IncStep, Jog, ManualError, MAX_OVERRIDE_PERCENT,
 };
 use crate::setpoint::SetPoint;
+use crate::stop::{PlayedStop, StopLimits};
 
 impl Executor {
     pub(super) fn jog(
@@ -131,10 +132,10 @@ impl Executor {
                 let last = self
                     .last_manual
                     .unwrap_or_else(|| SetPoint::at_rest(0, 0, self.pose.joints));
-                self.manual = Some(ManualMotion::Stop(JointStop::new(
+                let limits = StopLimits::of(&self.machine);
+                self.manual = Some(ManualMotion::Stop(PlayedStop::new(
                     &last,
-                    &self.machine.max_acceleration,
-                    &self.machine.max_jerk,
+                    &limits,
                     self.options.period,
                 )));
             }
@@ -163,7 +164,14 @@ impl Executor {
                 } else {
                     add(&position, &self.offset)
                 };
-                Ok(Some(self.emit_at(drive, false, feed)))
+                // The ramps' velocity and acceleration are exact (the same in both frames).
+                let setpoint = self.history.exact(SetPoint {
+                    index: self.k,
+                    line: self.pose.line,
+                    position: drive,
+                    ..sp
+                });
+                Ok(Some(self.produced(setpoint, feed)))
             }
             Ok(None) => {
                 if let Some(ManualMotion::Home(home)) = &self.manual {
@@ -171,13 +179,13 @@ impl Executor {
                         // The drives stay where they are (no jump); the machine frame moves.
                         self.offset = offset;
                         self.homed = true;
-                        self.set_joints(sub(&self.prev_joints, &offset, 1.0));
+                        self.set_joints(sub(&self.history.last(), &offset, 1.0));
                     }
                 }
                 self.manual = None;
                 self.last_manual = None;
                 self.state = RunState::Idle;
-                let at = self.prev_joints;
+                let at = self.history.last();
                 Ok(Some(self.emit_at(at, true, 0.0)))
             }
             Err(e) => {

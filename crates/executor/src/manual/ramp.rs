@@ -23,12 +23,17 @@ pub struct VelocityRamp {
 
 impl VelocityRamp {
     /// From `start` (its jerk is ignored) to speed `target` with zero final acceleration, for
-    /// `max_acceleration` ≥ |start.a| and `max_jerk` > 0.
+    /// `max_jerk` > 0. A start acceleration beyond `max_acceleration` (a state estimate a hair
+    /// past it) is not clamped, which would be a jump: toward the target it is held, then
+    /// released; away from it the first phase brings it back at the jerk limit.
     pub fn new(start: State, target: f64, max_acceleration: f64, max_jerk: f64) -> VelocityRamp {
-        let (a_lim, j) = (max_acceleration, max_jerk);
-        let (v0, a0) = (start.v, start.a.clamp(-a_lim, a_lim));
+        let j = max_jerk;
+        let (v0, a0) = (start.v, start.a);
         let v_rest = v0 + a0 * a0.abs() / (2.0 * j);
         let sigma = if target >= v_rest { 1.0 } else { -1.0 };
+        // Past the limit toward the target: the peak is the start itself (no plateau is
+        // negative: the target lies beyond v_rest, which includes that acceleration's run-out).
+        let a_lim = max_acceleration.max(sigma * a0);
         let dv = sigma * (target - v0);
         let free = ((2.0 * j * dv + a0 * a0) / 2.0).max(0.0).sqrt();
         let (a_p, plateau) = if free > a_lim {
