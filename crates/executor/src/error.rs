@@ -10,8 +10,8 @@ pub enum ExecError {
     },
     #[error("no program loaded")]
     NoProgram,
-    #[error("feed override {0} % is outside 0–200 %")]
-    Override(f64),
+    #[error("{0}")]
+    Override(#[from] crate::speed_override::OverrideError),
     #[error("line {0} is not a line of the program with motion after it")]
     NoSuchLine(u32),
     #[error("program: {0}")]

@@ -23,6 +23,7 @@ use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::{History, SetPoint};
+use crate::speed_override::Override;
 
 mod manual;
 
@@ -131,7 +132,7 @@ pub struct Executor {
     /// The manual generator's last set-point (machine frame, exact velocity and acceleration):
     /// where a stop of it starts.
     last_manual: Option<SetPoint>,
-    jog_override: f64,
+    jog_override: Override,
     /// Drive (power-on) frame minus machine frame per joint: set-points are `joints + offset`.
     /// Zero until homing finds it.
     offset: Joints,
@@ -180,7 +181,7 @@ impl Executor {
             machine_file: machine.clone(),
             manual: None,
             last_manual: None,
-            jog_override: 100.0,
+            jog_override: Override::FULL,
             offset: Joints::zeros(n),
             homed: false,
             switches: Box::new(switches),
@@ -276,7 +277,7 @@ impl Executor {
             optional_stop: self.optional_stop,
             program_loaded: self.program.is_some(),
             homed: self.homed,
-            jog_override_percent: self.jog_override,
+            jog_override_percent: self.jog_override.percent(),
             joints: self.pose.joints.as_slice().to_vec(),
             tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
             time_scale: self.scale.r,
@@ -435,10 +436,7 @@ impl Executor {
                 Ok(())
             }
             Command::FeedOverride { percent } => {
-                if !(0.0..=200.0).contains(&percent) {
-                    return Err(ExecError::Override(percent));
-                }
-                self.override_pct = percent;
+                self.override_pct = Override::new(percent)?.percent();
                 Ok(())
             }
             Command::SingleBlock { on } => {

@@ -17,8 +17,10 @@ pub mod ring;
 pub mod rt;
 pub mod scale;
 pub mod setpoint;
+pub mod speed_override;
 pub mod stop;
 pub mod threads;
 
 pub use drive::{Drive, DriveFault, DriveStatus};
 pub use setpoint::SetPoint;
+pub use speed_override::{Override, OverrideError};

@@ -171,8 +171,21 @@ fn jog_to_the_soft_limit_stops_on_it_and_further_jogs_that_way_are_refused() {
         })
         .unwrap_err();
     assert!(e.to_string().contains("soft limit"), "{e}");
-    exec.command(Command::JogOverride { percent: 250.0 })
+    // Either override out of 0–200 % is refused by the one check and changes nothing.
+    let before = exec.status();
+    let e = exec
+        .command(Command::JogOverride { percent: 250.0 })
         .unwrap_err();
+    assert!(matches!(e, ExecError::Override(_)), "{e}");
+    let e = exec
+        .command(Command::FeedOverride { percent: f64::NAN })
+        .unwrap_err();
+    assert!(e.to_string().contains("outside 0–200 %"), "{e}");
+    let after = exec.status();
+    assert_eq!(
+        (after.jog_override_percent, after.feed_override_percent),
+        (before.jog_override_percent, before.feed_override_percent)
+    );
 }
 
 #[test]

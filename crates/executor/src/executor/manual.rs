@@ -9,10 +9,9 @@ use super::{add, sub, Executor, Produced};
 use crate::command::{Direction, Mode, RunState};
 use crate::error::ExecError;
 use crate::manual::active::ManualMotion;
-use crate::manual::{
-    default_jog_speed, Home, Inc, IncStep, Jog, ManualError, MAX_OVERRIDE_PERCENT,
-};
+use crate::manual::{default_jog_speed, Home, Inc, IncStep, Jog, ManualError};
 use crate::setpoint::SetPoint;
+use crate::speed_override::Override;
 use crate::stop::{PlayedStop, StopLimits};
 
 impl Executor {
@@ -37,7 +36,7 @@ impl Executor {
             speed,
             self.k,
         )?;
-        jog.set_override(self.jog_override)?;
+        jog.set_override(self.jog_override);
         self.start_manual(ManualMotion::Jog(jog), Mode::Jog);
         Ok(())
     }
@@ -55,13 +54,11 @@ impl Executor {
     }
 
     pub(super) fn jog_override(&mut self, percent: f64) -> Result<(), ExecError> {
-        if !(0.0..=MAX_OVERRIDE_PERCENT).contains(&percent) {
-            return Err(ManualError::Override { percent }.into());
-        }
+        let o = Override::new(percent)?;
         if let Some(ManualMotion::Jog(jog)) = &mut self.manual {
-            jog.set_override(percent)?;
+            jog.set_override(o);
         }
-        self.jog_override = percent;
+        self.jog_override = o;
         Ok(())
     }
 

@@ -9,8 +9,9 @@ use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::profile::State;
 
 use super::ramp::{stopping_displacement, VelocityRamp};
-use super::{check_start, override_factor, JointAxis, ManualError};
+use super::{check_start, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
+use crate::speed_override::Override;
 
 /// Which way a manual move goes along its joint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -99,11 +100,10 @@ impl Jog {
         Ok(jog)
     }
 
-    /// Sets the speed override (0–200 %); the speed changes smoothly from the next period.
-    pub fn set_override(&mut self, percent: f64) -> Result<(), ManualError> {
-        self.factor = override_factor(percent)?;
+    /// Sets the speed override; the speed changes smoothly from the next period.
+    pub fn set_override(&mut self, speed_override: Override) {
+        self.factor = speed_override.factor();
         self.retarget();
-        Ok(())
     }
 
     /// Asks for a stop: the joint comes to rest in the jerk-limited minimum distance.
@@ -276,7 +276,7 @@ mod tests {
         let mut jog = Jog::new(&m, 0, &start, Direction::Plus, 80.0, 0).unwrap();
         let mut sps = Vec::new();
         for pct in [25.0, 100.0, 50.0, 200.0, 0.0] {
-            jog.set_override(pct).unwrap();
+            jog.set_override(Override::new(pct).unwrap());
             sps.extend(jog.by_ref().take(300));
             let v = sps.last().unwrap().velocity[0];
             let want = (80.0 * pct / 100.0).min(200.0);
@@ -284,7 +284,6 @@ mod tests {
         }
         // at 0 % the jog is alive but still
         assert!(!jog.is_stopping());
-        assert!(jog.set_override(250.0).is_err() && jog.set_override(f64::NAN).is_err());
         jog.stop();
         sps.extend(jog.by_ref());
         check_limits(&positions(&start, &sps, 0), 1e-3, 200.0, 2000.0, 50000.0).unwrap();
@@ -393,7 +392,7 @@ mod tests {
             let mut jog = Jog::new(&m, 0, &start, dir, speed, 0).unwrap();
             let mut sps = Vec::new();
             for (pct, n) in steps {
-                jog.set_override(pct).unwrap();
+                jog.set_override(Override::new(pct).unwrap());
                 sps.extend(jog.by_ref().take(n));
             }
             let request = jog.stop_position();

@@ -15,7 +15,7 @@
 //! let start = m.home();
 //! let mut drive = ServoDrive::from_machine(&m, &start)?;
 //! let mut jog = Jog::new(&m, 0, &start, Direction::Plus, 50.0, 0)?; // X+ at 50 mm/s
-//! jog.set_override(25.0)?;
+//! jog.set_override(tezgah_executor::Override::new(25.0)?);
 //! let mut errors = JointTracking::new(3);
 //! for sp in jog.by_ref().take(500) {
 //!     errors.record(&drive.apply(&sp));
@@ -55,8 +55,6 @@ pub enum ManualError {
     NotFinite { joint: usize, value: f64 },
     #[error("joint `{name}`: speed {value} must be > 0 and finite")]
     Speed { name: String, value: f64 },
-    #[error("override {percent} % is outside 0–{max} %", max = MAX_OVERRIDE_PERCENT)]
-    Override { percent: f64 },
     #[error("INC step {value} is outside {min}–{max} (file units)", min = inc::MIN_STEP, max = inc::MAX_STEP)]
     Step { value: f64 },
     #[error("joint `{name}`: {target} is beyond its soft limit {limit}")]
@@ -70,9 +68,6 @@ pub enum ManualError {
     #[error("joint `{name}`: {reason}")]
     Motion { name: String, reason: String },
 }
-
-/// Largest speed override accepted, percent.
-pub const MAX_OVERRIDE_PERCENT: f64 = 200.0;
 
 /// Default JOG speed of reference 000 §1.3: 50 mm/s linear, 20 °/s rotary (file units).
 pub fn default_jog_speed(kind: JointKind) -> f64 {
@@ -154,15 +149,6 @@ fn check_start(machine: &Machine, start: &tezgah_kinematics::Joints) -> Result<(
             value: start[joint],
         }),
         None => Ok(()),
-    }
-}
-
-/// An override in percent as a factor, checked.
-fn override_factor(percent: f64) -> Result<f64, ManualError> {
-    if percent.is_finite() && (0.0..=MAX_OVERRIDE_PERCENT).contains(&percent) {
-        Ok(percent / 100.0)
-    } else {
-        Err(ManualError::Override { percent })
     }
 }
 
