@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use tezgah_executor::command::{Command, Status};
 use tezgah_executor::drive::IdealDrive;
 use tezgah_executor::executor::{ExecOptions, Executor};
+use tezgah_executor::realtime::RealtimeSettings;
 use tezgah_executor::threads::{spawn, Handle};
 use tezgah_geom::Pose;
 use tungstenite::{Message, WebSocket};
@@ -33,6 +34,10 @@ pub struct ServeArgs {
     /// Interval of the status stream, ms.
     #[arg(long, default_value_t = 50)]
     pub status_ms: u64,
+    /// Leave the real-time thread time-shared: no SCHED_FIFO, no memory lock (by default
+    /// both are asked for, best effort, with a warning when the system refuses).
+    #[arg(long)]
+    pub no_realtime: bool,
 }
 
 /// A message from a client: a command with an optional id that its reply echoes.
@@ -70,7 +75,15 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     let ring = ((args.lead_ms / 1000.0 / period).ceil() as usize).max(2);
     let executor = Executor::new(&machine, options, Pose::ZERO).map_err(|e| miette!("{e}"))?;
     // Shared by the connections: each request waits for its own answer only.
-    let host = Arc::new(spawn(executor, IdealDrive, ring));
+    let realtime = if args.no_realtime {
+        RealtimeSettings::OFF
+    } else {
+        RealtimeSettings::BEST_EFFORT
+    };
+    let host = Arc::new(spawn(executor, IdealDrive, ring, realtime));
+    for w in host.realtime.warnings() {
+        eprintln!("tezgah serve: warning: {w}");
+    }
 
     let listener = TcpListener::bind(&args.listen)
         .into_diagnostic()

@@ -13,6 +13,7 @@ pub mod executor;
 pub mod job;
 pub mod manual;
 pub mod mdi;
+pub mod realtime;
 pub mod ring;
 pub mod rt;
 pub mod scale;

@@ -14,6 +14,7 @@ use crate::command::{Command, RunState, Status};
 use crate::drive::Drive;
 use crate::error::ExecError;
 use crate::executor::Executor;
+use crate::realtime::{self, Applied, RealtimeSettings};
 use crate::ring::{rings, Rings, RtReport, RtState, Slot};
 use crate::rt::{Jitter, RealClock, RtCounters, RtLoop, StopLimits};
 
@@ -158,6 +159,8 @@ pub struct Handle {
     quit: Arc<AtomicBool>,
     planner: JoinHandle<Lead>,
     rt: JoinHandle<(RtCounters, Jitter)>,
+    /// What the real-time thread's scheduling request got ([`crate::realtime`]).
+    pub realtime: Applied,
 }
 
 /// The threads' figures when they stop.
@@ -190,8 +193,14 @@ impl Handle {
 
 /// Starts the planner thread and the real-time thread (period from `exec`) with a ring of
 /// `capacity` set-points; the real-time loop starts at `exec`'s current joints and stops on
-/// an underrun within the machine's joint limits.
-pub fn spawn<D: Drive + Send + 'static>(exec: Executor, drive: D, capacity: usize) -> Handle {
+/// an underrun within the machine's joint limits. The real-time thread first asks for
+/// `realtime` scheduling (best effort: [`Handle::realtime`] says what it got).
+pub fn spawn<D: Drive + Send + 'static>(
+    exec: Executor,
+    drive: D,
+    capacity: usize,
+    realtime: RealtimeSettings,
+) -> Handle {
     let period = exec.period();
     let limits = StopLimits::of(exec.machine());
     let (planner_rings, rt_ends) = rings(capacity, 4 * capacity.max(64));
@@ -201,9 +210,11 @@ pub fn spawn<D: Drive + Send + 'static>(exec: Executor, drive: D, capacity: usiz
     let status = Arc::new(Mutex::new(exec.status()));
     let (rtx, rrx) = mpsc::channel::<Request>();
     let q = quit.clone();
+    let (applied_tx, applied_rx) = mpsc::channel();
     let rt = std::thread::Builder::new()
         .name("tezgah-rt".into())
         .spawn(move || {
+            let _ = applied_tx.send(realtime::apply(&realtime));
             let mut rt = RtLoop::new(rt_ends, drive, period, limits, start);
             rt.run(&mut RealClock::new(period), &q)
         })
@@ -228,11 +239,17 @@ pub fn spawn<D: Drive + Send + 'static>(exec: Executor, drive: D, capacity: usiz
             side.lead()
         })
         .expect("spawning the planner thread");
+    let realtime = applied_rx.recv().unwrap_or(Applied {
+        fifo: realtime::Outcome::Refused("the real-time thread did not start".into()),
+        memory_locked: realtime::Outcome::NotAsked,
+        cpu: realtime::Outcome::NotAsked,
+    });
     Handle {
         requests: rtx,
         status,
         quit,
         planner,
         rt,
+        realtime,
     }
 }

@@ -159,7 +159,22 @@ fn underrun_is_a_jerk_limited_stop() {
 fn spawned_threads_run_a_command() {
     use std::time::{Duration, Instant};
     use tezgah_executor::threads::{spawn, DEFAULT_RING};
-    let handle = spawn(executor(), IdealDrive, DEFAULT_RING);
+    use tezgah_executor::realtime::{Outcome, RealtimeSettings};
+    let handle = spawn(
+        executor(),
+        IdealDrive,
+        DEFAULT_RING,
+        RealtimeSettings::BEST_EFFORT,
+    );
+    // Granted or refused with the system's reason (no root here, or a container without
+    // CAP_SYS_NICE), never left unanswered.
+    for o in [&handle.realtime.fifo, &handle.realtime.memory_locked] {
+        assert!(
+            *o == Outcome::Done || matches!(o, Outcome::Refused(why) if !why.is_empty()),
+            "{o:?}"
+        );
+    }
+    assert_eq!(handle.realtime.cpu, Outcome::NotAsked);
     handle
         .request(Command::Mdi {
             block: "G21 G90 G0 X5 Y-3".into(),

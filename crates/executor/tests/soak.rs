@@ -1,6 +1,7 @@
 //! The real clock: the planner thread and the real-time thread running programs back to back
 //! (1.5 s here; `TEZGAH_SOAK_SECONDS=60 TEZGAH_SOAK_LOAD=2` for the minute under load the
-//! notes report). Asserts only what timing cannot change: every set-point the planner pushed
+//! notes report). The real-time thread asks for SCHED_FIFO and locked memory, best effort
+//! (`TEZGAH_SOAK_REALTIME=0` leaves it time-shared). Asserts only what timing cannot change: every set-point the planner pushed
 //! is applied once, in order, and the real-time thread never allocates (a counting
 //! allocator, armed on that thread only). Underruns and jitter are printed, not asserted.
 
@@ -16,6 +17,7 @@ use support::*;
 use tezgah_executor::command::{Command, RunState};
 use tezgah_executor::drive::IdealDrive;
 use tezgah_executor::drive::{Drive, DriveStatus};
+use tezgah_executor::realtime::{self, RealtimeSettings};
 use tezgah_executor::ring::rings;
 use tezgah_executor::rt::{RealClock, RtLoop, StopLimits};
 use tezgah_executor::threads::PlannerSide;
@@ -95,8 +97,15 @@ fn real_clock_soak() {
         indices: Vec::with_capacity(room),
         moving: Vec::with_capacity(room),
     };
+    let settings = match std::env::var("TEZGAH_SOAK_REALTIME").as_deref() {
+        Ok("0") => RealtimeSettings::OFF,
+        _ => RealtimeSettings::BEST_EFFORT,
+    };
     let q = quit.clone();
     let rt = std::thread::spawn(move || {
+        // Before the allocation count is armed: the outcome's messages allocate.
+        let applied = realtime::apply(&settings);
+        println!("real-time scheduling: {applied:?}");
         let mut rt = RtLoop::new(rt_ends, drive, period, limits, start);
         ON_RT.with(|c| c.set(true));
         let figures = rt.run(&mut RealClock::new(period), &q);
