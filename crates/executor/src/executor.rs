@@ -17,7 +17,7 @@ use tezgah_motion::{Junction, Segment};
 
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
-use crate::job::{Job, JobOptions, PlannedItem};
+use crate::job::{BuiltPath, Job, JobOptions, PlannedItem};
 use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
@@ -138,8 +138,8 @@ pub struct Executor {
     offset: Joints,
     homed: bool,
     switches: Box<dyn HomeSwitches + Send>,
-    /// The program pose the loaded program was pre-flighted from.
-    checked_from: Option<Pose>,
+    /// The loaded program's path, built and pre-flighted at load, until a job takes it.
+    built: Option<BuiltPath>,
 }
 
 fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
@@ -185,7 +185,7 @@ impl Executor {
             offset: Joints::zeros(n),
             homed: false,
             switches: Box::new(switches),
-            checked_from: None,
+            built: None,
             options,
             mdi: Mdi::new(gcode.clone()),
             mdi_modal: Vec::new(),
@@ -332,21 +332,16 @@ impl Executor {
 
     /// Builds the whole path of `moves` from `start` with the executor's smoothing options
     /// and checks every segment's joints against reach and limits (motion's pre-flight), so
-    /// a program that would leave the machine's work space is refused before anything moves.
-    fn preflight(&self, moves: &[Move], start: Pose) -> Result<(), ExecError> {
-        let options = SmoothOptions {
-            start,
-            control: self.machine.initial,
-            ..self.options.smooth.clone()
-        };
-        let items = tezgah_motion::path::smooth::build(moves.to_vec(), &options)
-            .map_err(ExecError::Path)?;
-        tezgah_motion::preflight::check_path(&items, &self.machine, self.pose.joints).map_err(|e| {
-            ExecError::Preflight {
+    /// a program that would leave the machine's work space is refused before anything moves;
+    /// the job then plans that same path.
+    fn preflight(&self, moves: Vec<Move>, start: Pose) -> Result<BuiltPath, ExecError> {
+        let path = BuiltPath::build(moves, &self.machine, &self.job_options(), start)?;
+        tezgah_motion::preflight::check_path(path.items(), &self.machine, self.pose.joints)
+            .map_err(|e| ExecError::Preflight {
                 line: e.line,
                 message: e.source.to_string(),
-            }
-        })
+            })?;
+        Ok(path)
     }
 
     /// AUTO and MDI wait for homing if the machine file asks.
@@ -359,13 +354,18 @@ impl Executor {
 
     fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
         let start = self.program_pose();
-        // The loaded program was checked at load; again if the machine moved since.
-        let checked = mode == Mode::Auto && self.checked_from.is_some_and(|p| p.0 == start.0);
-        if !checked {
-            self.preflight(&moves, start)?;
-        }
-        let p = &self.pose;
-        let job = Job::new(moves, &self.machine, &self.job_options(), start, p.joints)?;
+        // The loaded program's path was built and checked at load; again if the machine
+        // moved since or single block changed (it builds another path).
+        // (MDI leaves it for the program.)
+        let single_block = self.single_block;
+        let fits = |b: &mut BuiltPath| {
+            mode == Mode::Auto && b.start().0 == start.0 && b.single_block() == single_block
+        };
+        let built = match self.built.take_if(fits) {
+            Some(b) => b,
+            None => self.preflight(moves, start)?,
+        };
+        let job = Job::new(built, &self.machine, self.options.plan, self.pose.joints)?;
         self.job = Some(job);
         self.current = None;
         self.peeked = None;
@@ -393,8 +393,7 @@ impl Executor {
                 let moves = tezgah_gcode::program_moves(&program, self.gcode.clone())
                     .map_err(|e| ExecError::Gcode(e.to_string()))?;
                 let here = self.program_pose();
-                self.preflight(&moves, here)?;
-                self.checked_from = Some(here);
+                self.built = Some(self.preflight(moves.clone(), here)?);
                 self.program = Some(moves);
                 self.mode = Mode::Auto;
                 Ok(())
@@ -484,8 +483,8 @@ impl Executor {
                 self.check_homed("restart")?;
                 let program = self.program.as_ref().ok_or(ExecError::NoProgram)?;
                 let moves = restart_moves(program, line)?;
-                // A restart starts elsewhere than the program: check it whole.
-                self.checked_from = None;
+                // A restart starts elsewhere than the program: built and checked whole.
+                self.built = None;
                 self.start_job(moves, Mode::Auto)
             }
             Command::Jog {

@@ -1,21 +1,21 @@
 //! A job: one stream of moves (a program, the rest of one from a restart line, or an MDI
-//! block) turned into planned items on demand — path building, tool-control take-up, feed
-//! planning — so the planner thread only works as far ahead as the ring needs. Feed override
-//! above 100 % raises the feed of segments as they enter the planner (the plan is then capped
-//! by every limit there); each planned piece remembers the factor it was planned with.
+//! block) made into the smooth path whole, once ([`BuiltPath`]: the pre-flight checks it
+//! before anything moves, then the job takes it over), then into planned items on demand —
+//! tool-control take-up, feed planning — so the planner thread only plans as far ahead as
+//! the ring needs. Feed override above 100 % raises the feed of segments as they enter the
+//! planner (the plan is then capped by every limit there); each planned piece remembers the
+//! factor it was planned with.
 
 use std::collections::{HashMap, VecDeque};
 
 use tezgah_geom::{Move, MoveKind, PathMode, Pose, StopKind, Vec3};
 use tezgah_kinematics::Joints;
-use tezgah_motion::path::smooth::{SmoothOptions, Smoother};
+use tezgah_motion::path::smooth::SmoothOptions;
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned, Planner};
 use tezgah_motion::takeup::TakeUp;
 use tezgah_motion::{PathItem, SegmentFeed};
 
 use crate::error::ExecError;
-
-type Items = Smoother<std::vec::IntoIter<Move>>;
 
 /// A planned item and the feed factor its segments were planned with (≥ 1).
 pub struct PlannedItem {
@@ -23,37 +23,25 @@ pub struct PlannedItem {
     pub factor: f64,
 }
 
-/// Moves → planned items, pulled one at a time.
-pub struct Job {
-    items: Items,
-    takeup: TakeUp,
-    planner: Planner,
-    finished: bool,
-    /// Path length pushed so far with the factor each stretch was planned with.
-    log: VecDeque<(f64, f64)>,
-    pushed: f64,
-    popped: f64,
+/// Moves made into the whole smooth path from a start pose, and the kinds of their stops.
+/// The executor loads whole programs, so the path is held whole: built once, checked by the
+/// pre-flight, then handed to the [`Job`] that plans it (`tezgah run` streams instead).
+pub struct BuiltPath {
+    items: Vec<PathItem>,
     stops: HashMap<u32, StopKind>,
+    start: Pose,
+    single_block: bool,
 }
 
-/// How a job is built.
-#[derive(Debug, Clone)]
-pub struct JobOptions {
-    pub smooth: SmoothOptions,
-    pub plan: PlanOptions,
-    /// Stop at the end of every block (single block): the path is built in exact-stop mode.
-    pub single_block: bool,
-}
-
-impl Job {
-    /// A job from `moves`, starting at the machine's current pose and joints.
-    pub fn new(
+impl BuiltPath {
+    /// The path of `moves` from `start` on `machine` with `options` (under single block every
+    /// block ends at rest: the path is built in exact-stop mode).
+    pub fn build(
         moves: Vec<Move>,
         machine: &PlanMachine,
         options: &JobOptions,
         start: Pose,
-        joints: Joints,
-    ) -> Result<Job, ExecError> {
+    ) -> Result<BuiltPath, ExecError> {
         let mut stops = HashMap::new();
         let mut moves = moves;
         for m in &mut moves {
@@ -80,19 +68,73 @@ impl Job {
             control: machine.initial,
             ..options.smooth.clone()
         };
-        let items = Smoother::new(moves.into_iter(), smooth).map_err(ExecError::Path)?;
+        let items = tezgah_motion::path::smooth::build(moves, &smooth).map_err(ExecError::Path)?;
+        Ok(BuiltPath {
+            items,
+            stops,
+            start,
+            single_block: options.single_block,
+        })
+    }
+
+    pub fn items(&self) -> &[PathItem] {
+        &self.items
+    }
+
+    /// The pose the path starts from.
+    pub fn start(&self) -> Pose {
+        self.start
+    }
+
+    /// Built for single block (exact stop at every block end).
+    pub fn single_block(&self) -> bool {
+        self.single_block
+    }
+}
+
+/// A built path → planned items, pulled one at a time.
+pub struct Job {
+    items: std::vec::IntoIter<PathItem>,
+    takeup: TakeUp,
+    planner: Planner,
+    finished: bool,
+    /// Path length pushed so far with the factor each stretch was planned with.
+    log: VecDeque<(f64, f64)>,
+    pushed: f64,
+    popped: f64,
+    stops: HashMap<u32, StopKind>,
+}
+
+/// How a job is built.
+#[derive(Debug, Clone)]
+pub struct JobOptions {
+    pub smooth: SmoothOptions,
+    pub plan: PlanOptions,
+    /// Stop at the end of every block (single block): the path is built in exact-stop mode.
+    pub single_block: bool,
+}
+
+impl Job {
+    /// The job that plans `path`, the machine standing at its start with `joints`.
+    pub fn new(
+        path: BuiltPath,
+        machine: &PlanMachine,
+        plan: PlanOptions,
+        joints: Joints,
+    ) -> Result<Job, ExecError> {
+        let start = path.start;
         let tip = Vec3::from(start.xyz());
         let takeup = TakeUp::new(machine, (tip, [start.0[3], start.0[4], start.0[5]]), joints);
-        let planner = Planner::new(machine.clone(), options.plan).map_err(ExecError::Plan)?;
+        let planner = Planner::new(machine.clone(), plan).map_err(ExecError::Plan)?;
         Ok(Job {
-            items,
+            items: path.items.into_iter(),
             takeup,
             planner,
             finished: false,
             log: VecDeque::new(),
             pushed: 0.0,
             popped: 0.0,
-            stops,
+            stops: path.stops,
         })
     }
 
@@ -131,7 +173,6 @@ impl Job {
             }
             match self.items.next() {
                 Some(item) => {
-                    let item = item.map_err(ExecError::Path)?;
                     if let Some(t) =
                         self.takeup
                             .before(&item)

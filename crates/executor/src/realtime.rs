@@ -33,6 +33,20 @@ impl RealtimeSettings {
     };
 }
 
+impl RealtimeSettings {
+    /// What the planner thread asks for alongside: SCHED_FIFO ten below the real-time thread
+    /// (so it preempts the machine's ordinary work but never the loop it feeds: under load a
+    /// time-shared planner, not the loop, was what let the ring run dry), nothing else (the
+    /// memory lock is the process', asked once).
+    pub fn for_planner(&self) -> RealtimeSettings {
+        RealtimeSettings {
+            fifo_priority: self.fifo_priority.map(|p| (p - 10).max(1)),
+            lock_memory: false,
+            cpu: None,
+        }
+    }
+}
+
 /// How one request went.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Outcome {
@@ -100,7 +114,8 @@ mod sys {
         };
         // SAFETY: pthread_self() is the calling thread, alive during the call; param is a
         // valid sched_param for the duration of the call.
-        let rc = unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_FIFO, &param) };
+        let rc =
+            unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_FIFO, &param) };
         if rc == 0 {
             Outcome::Done
         } else {
@@ -204,6 +219,9 @@ mod tests {
         assert!(matches!(a.cpu, Outcome::Refused(_)), "{a:?}");
         let w = a.warnings();
         assert_eq!(w.len(), 2);
-        assert!(w[0].contains("SCHED_FIFO") && w[0].contains("1–99"), "{w:?}");
+        assert!(
+            w[0].contains("SCHED_FIFO") && w[0].contains("1–99"),
+            "{w:?}"
+        );
     }
 }

@@ -56,6 +56,8 @@ pub struct PlannerSide {
     capacity: usize,
     last: Option<RtReport>,
     lead: Lead,
+    /// A re-arm waits for room in the ring: no set-point goes before it.
+    rearm_pending: bool,
     /// A re-arm is on its way: reports still saying "halted" are older than it.
     rearming: bool,
     /// The executor has been told of the current halt.
@@ -71,6 +73,7 @@ impl PlannerSide {
             capacity,
             last: None,
             lead: Lead::default(),
+            rearm_pending: false,
             rearming: false,
             halt_seen: false,
         }
@@ -104,23 +107,38 @@ impl PlannerSide {
         let rearm = command == Command::Abort && self.exec.state() == RunState::Fault;
         self.exec.command(command)?;
         if rearm {
-            // The ring has room: the real-time side discards set-points while halted.
-            let _ = self.rings.setpoints.push(Slot::Rearm);
+            self.rearm_pending = true;
+            self.send_rearm();
+        }
+        Ok(())
+    }
+
+    /// Pushes a pending re-arm if the ring has room. The real-time side empties the ring at
+    /// every period while halted, but the ring can be full when the abort comes (it was
+    /// filled after the reports were read and before the real-time thread, preempted, next
+    /// ran): a re-arm dropped then left the real-time side halted for good, discarding every
+    /// set-point after (1.19 million in a loaded soak).
+    fn send_rearm(&mut self) {
+        if self.rearm_pending && self.rings.setpoints.push(Slot::Rearm).is_ok() {
+            self.rearm_pending = false;
             self.rearming = true;
             self.halt_seen = false;
         }
-        Ok(())
     }
 
     /// Reads the reports, then tops the ring up; returns the set-points pushed.
     pub fn pump(&mut self) -> usize {
         while let Ok(r) = self.rings.reports.pop() {
+            // Any report not halted after a re-arm was sent shows it took effect (reports
+            // older than it were read when the halt was seen). Every report counts, not only
+            // the last: the real-time side can run, underrun and halt again between two pumps,
+            // and a last report "halted" then is a new halt, not the old one.
+            if self.rearming && r.state != RtState::Halted {
+                self.rearming = false;
+            }
             self.last = Some(r);
         }
         if let Some(r) = self.last {
-            if self.rearming && r.state == RtState::Running {
-                self.rearming = false;
-            }
             if r.state == RtState::Halted && !self.rearming && !self.halt_seen {
                 self.halt_seen = true;
                 let why = match r.fault {
@@ -132,6 +150,10 @@ impl PlannerSide {
         }
         self.lead
             .record(self.capacity - self.rings.setpoints.slots());
+        self.send_rearm();
+        if self.rearm_pending {
+            return 0;
+        }
         let mut pushed = 0;
         while self.rings.setpoints.slots() > 0 {
             match self.exec.step() {
@@ -211,6 +233,7 @@ pub fn spawn<D: Drive + Send + 'static>(
     let (rtx, rrx) = mpsc::channel::<Request>();
     let q = quit.clone();
     let (applied_tx, applied_rx) = mpsc::channel();
+    let planner_settings = realtime.for_planner();
     let rt = std::thread::Builder::new()
         .name("tezgah-rt".into())
         .spawn(move || {
@@ -224,6 +247,8 @@ pub fn spawn<D: Drive + Send + 'static>(
     let planner = std::thread::Builder::new()
         .name("tezgah-planner".into())
         .spawn(move || {
+            // Best effort too; the real-time thread's outcome is the one reported.
+            let _ = realtime::apply(&planner_settings);
             let mut side = PlannerSide::new(exec, planner_rings, capacity);
             while !q.load(Ordering::Relaxed) {
                 while let Ok((c, reply)) = rrx.try_recv() {

@@ -154,12 +154,59 @@ fn underrun_is_a_jerk_limited_stop() {
     );
 }
 
+/// After a re-arm the real-time side can take it, run, underrun and halt again before the
+/// planner next reads its reports (a preempted planner): that second halt is seen — the
+/// executor goes to fault — instead of being taken for the first and ignored while the
+/// real-time side discards every set-point after (what a loaded soak showed: 121 367 of
+/// 172 208 discarded).
+#[test]
+fn a_second_halt_between_two_pumps_is_seen() {
+    let (mut side, mut rt) = rig(16);
+    let mdi = |side: &mut PlannerSide, block: &str| {
+        side.command(Command::Mdi {
+            block: block.into(),
+        })
+        .unwrap()
+    };
+    mdi(&mut side, "G21 G90 G1 X120 F9000");
+    for _ in 0..300 {
+        side.pump();
+        rt.tick();
+    }
+    for _ in 0..600 {
+        rt.tick();
+    }
+    side.pump();
+    assert_eq!(side.executor().state(), RunState::Fault);
+    side.command(Command::Abort).unwrap();
+    mdi(&mut side, "G1 X0");
+    // One pump: the re-arm and a ring of set-points; then the planner stalls.
+    side.pump();
+    for _ in 0..600 {
+        rt.tick();
+    }
+    assert_eq!(rt.counters().underruns, 2);
+    assert_eq!(rt.state(), RtState::Halted);
+    side.pump();
+    assert_eq!(side.executor().state(), RunState::Fault);
+    // And the machine comes back from it.
+    side.command(Command::Abort).unwrap();
+    mdi(&mut side, "G1 X0");
+    for _ in 0..20_000 {
+        side.pump();
+        rt.tick();
+    }
+    assert_eq!(rt.state(), RtState::Running);
+    assert_eq!(side.executor().state(), RunState::Idle);
+    assert!(rt.last().position[0].abs() < 1e-9, "{:?}", rt.last());
+}
+
 /// The two threads through their handle: an MDI move on the real clock, status back.
 #[test]
 fn spawned_threads_run_a_command() {
     use std::time::{Duration, Instant};
-    use tezgah_executor::threads::{spawn, DEFAULT_RING};
     use tezgah_executor::realtime::{Outcome, RealtimeSettings};
+    use tezgah_executor::threads::{spawn, DEFAULT_RING};
     let handle = spawn(
         executor(),
         IdealDrive,

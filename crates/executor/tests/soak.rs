@@ -124,6 +124,9 @@ fn real_clock_soak() {
             })
         })
         .collect();
+    // This thread is the planner: it asks for its priority as `spawn`'s planner does.
+    let planner = realtime::apply(&settings.for_planner());
+    println!("planner scheduling: {planner:?}");
     let mut side = PlannerSide::new(exec, planner_rings, capacity);
     let mut pushed = 0usize;
     let mut programs = 0u64;
