@@ -145,8 +145,17 @@ impl PlayedStop {
         }
     }
 
+    /// True once the state at rest has been played.
+    pub fn is_over(&self) -> bool {
+        self.over
+    }
+}
+
+impl Iterator for PlayedStop {
+    type Item = JointState;
+
     /// The next period's state, `None` once the stop is over.
-    pub fn next(&mut self) -> Option<JointState> {
+    fn next(&mut self) -> Option<JointState> {
         if self.over {
             return None;
         }
@@ -165,11 +174,6 @@ impl PlayedStop {
             }
         }
         Some(s)
-    }
-
-    /// True once the state at rest has been played.
-    pub fn is_over(&self) -> bool {
-        self.over
     }
 }
 
@@ -230,7 +234,7 @@ mod tests {
         };
         let mut played = PlayedStop::new(&sp, &limits, 1e-3);
         let d = JointStop::new(&sp, &limits).duration();
-        let n = std::iter::from_fn(|| played.next()).count();
+        let n = played.by_ref().count();
         assert_eq!(n, (d / 1e-3).ceil() as usize);
         assert!(played.is_over());
     }

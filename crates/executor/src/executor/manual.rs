@@ -130,11 +130,11 @@ impl Executor {
                     .last_manual
                     .unwrap_or_else(|| SetPoint::at_rest(0, 0, self.pose.joints));
                 let limits = StopLimits::of(&self.machine);
-                self.manual = Some(ManualMotion::Stop(PlayedStop::new(
+                self.manual = Some(ManualMotion::Stop(Box::new(PlayedStop::new(
                     &last,
                     &limits,
                     self.options.period,
-                )));
+                ))));
             }
         }
     }

@@ -14,7 +14,7 @@ pub enum ManualMotion {
     Inc(Inc),
     Home(Box<Home>),
     /// Every joint to rest from its exact state ([`crate::stop`], as the underrun stop).
-    Stop(PlayedStop),
+    Stop(Box<PlayedStop>),
 }
 
 impl ManualMotion {
