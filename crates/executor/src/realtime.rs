@@ -84,6 +84,25 @@ impl Applied {
     }
 }
 
+/// Runs `work` on the calling thread time-shared (SCHED_OTHER), then puts back `fifo` if it
+/// was granted: long non-real-time work (building and checking a whole program's path) must
+/// not hold a core at real-time priority. The machine is idle whenever the planner does such
+/// work (load, cycle start, MDI and restart are accepted only then), so nothing waits on it.
+pub fn time_shared<T>(fifo: &Outcome, priority: Option<i32>, work: impl FnOnce() -> T) -> T {
+    let Some(p) = priority.filter(|_| *fifo == Outcome::Done) else {
+        return work();
+    };
+    sys::other();
+    let out = work();
+    let _ = sys::fifo(p);
+    out
+}
+
+/// The calling thread's scheduling policy is SCHED_FIFO.
+pub fn is_fifo() -> bool {
+    sys::is_fifo()
+}
+
 /// Applies `settings` to the calling thread (and, for the memory lock, the process).
 pub fn apply(settings: &RealtimeSettings) -> Applied {
     Applied {
@@ -121,6 +140,21 @@ mod sys {
         } else {
             Outcome::Refused(errno(rc))
         }
+    }
+
+    pub fn other() {
+        let param = libc::sched_param { sched_priority: 0 };
+        // SAFETY: as in `fifo`; SCHED_OTHER at priority 0 is always permitted.
+        unsafe { libc::pthread_setschedparam(libc::pthread_self(), libc::SCHED_OTHER, &param) };
+    }
+
+    pub fn is_fifo() -> bool {
+        let mut policy = 0;
+        let mut param = libc::sched_param { sched_priority: 0 };
+        // SAFETY: both out-pointers are valid for the call.
+        let rc =
+            unsafe { libc::pthread_getschedparam(libc::pthread_self(), &mut policy, &mut param) };
+        rc == 0 && policy == libc::SCHED_FIFO
     }
 
     pub fn lock_memory() -> Outcome {
@@ -183,6 +217,12 @@ mod sys {
         unsupported()
     }
 
+    pub fn other() {}
+
+    pub fn is_fifo() -> bool {
+        false
+    }
+
     pub fn pin(_: usize) -> Outcome {
         unsupported()
     }
@@ -200,6 +240,34 @@ mod tests {
             (Outcome::NotAsked, Outcome::NotAsked, Outcome::NotAsked)
         );
         assert!(a.warnings().is_empty());
+    }
+
+    /// Work in `time_shared` runs under SCHED_OTHER and the granted FIFO comes back after;
+    /// where FIFO is not granted here (no root, no CAP_SYS_NICE) only the pass-through is
+    /// checked, and said.
+    #[test]
+    fn time_shared_work_drops_and_restores_fifo() {
+        std::thread::spawn(|| {
+            let asked = Some(10);
+            let got = apply(&RealtimeSettings {
+                fifo_priority: asked,
+                lock_memory: false,
+                cpu: None,
+            });
+            let inside = time_shared(&got.fifo, asked, is_fifo);
+            if got.fifo == Outcome::Done {
+                assert!(!inside, "still FIFO inside the work");
+                assert!(is_fifo(), "FIFO not restored");
+            } else {
+                println!(
+                    "SCHED_FIFO not granted here ({:?}): pass-through only",
+                    got.fifo
+                );
+                assert!(!inside && !is_fifo());
+            }
+        })
+        .join()
+        .unwrap();
     }
 
     /// A request the system can never grant comes back refused with a reason, as a warning

@@ -248,11 +248,27 @@ pub fn spawn<D: Drive + Send + 'static>(
         .name("tezgah-planner".into())
         .spawn(move || {
             // Best effort too; the real-time thread's outcome is the one reported.
-            let _ = realtime::apply(&planner_settings);
+            let granted = realtime::apply(&planner_settings).fifo;
             let mut side = PlannerSide::new(exec, planner_rings, capacity);
             while !q.load(Ordering::Relaxed) {
                 while let Ok((c, reply)) = rrx.try_recv() {
-                    let _ = reply.send(side.command(c));
+                    // Commands that build a whole path run time-shared (see
+                    // `realtime::time_shared`); the others are quick.
+                    let builds = matches!(
+                        c,
+                        Command::Load { .. }
+                            | Command::CycleStart
+                            | Command::Resume
+                            | Command::Mdi { .. }
+                            | Command::RestartFrom { .. }
+                    );
+                    let answer = if builds {
+                        let fifo = planner_settings.fifo_priority;
+                        realtime::time_shared(&granted, fifo, || side.command(c))
+                    } else {
+                        side.command(c)
+                    };
+                    let _ = reply.send(answer);
                 }
                 side.pump();
                 if let Ok(mut s) = st.lock() {
