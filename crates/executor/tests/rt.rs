@@ -511,3 +511,37 @@ fn underruns_fall_while_moving() {
         );
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+
+    /// An underrun during a jog (its set-points carry the ramp's exact state) stops within
+    /// the joint limits by differences too, an override change in flight or not.
+    #[test]
+    fn underruns_during_a_jog_stop_within_the_joint_limits(
+        joint in 0usize..3, speed in 5.0..250.0f64, plus in proptest::bool::ANY,
+        change in 0usize..300, percent in 0.0..200.0f64, at in 2usize..400,
+    ) {
+        use tezgah_executor::command::Direction;
+        let (mut side, mut rt) = rig(16);
+        let start = *rt.last();
+        let direction = if plus { Direction::Plus } else { Direction::Minus };
+        side.command(Command::Jog { joint, direction, speed: Some(speed) }).unwrap();
+        for k in 0..at {
+            if k == change {
+                side.command(Command::JogOverride { percent }).unwrap();
+            }
+            side.pump();
+            rt.tick();
+        }
+        for _ in 0..3000 {
+            rt.tick();
+            if rt.state() == RtState::Halted {
+                break;
+            }
+        }
+        let m = side.executor().machine();
+        let r = played_within_limits(&start.position, &rt.drive().seen, m, side.executor().period());
+        proptest::prop_assert!(r.is_ok(), "{}", r.unwrap_err());
+    }
+}
