@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
-use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions, Posted};
+use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::Refusal;
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
@@ -65,7 +65,7 @@ pub struct CamArgs {
     #[arg(long)]
     pub face: Option<u64>,
     /// The most the tool axis may lean from the part's +Z, degrees: contact points facing
-    /// further away are left out (default: 75°, or less if the machine's tilt range is).
+    /// further away are left out (default: as far as the machine's tilt axis reaches).
     #[arg(long = "max-tilt")]
     pub max_tilt_deg: Option<f64>,
     /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
@@ -74,10 +74,11 @@ pub struct CamArgs {
     pub verify_cell_mm: Option<f64>,
 }
 
-/// How far the tool leans from vertical at most unless `--max-tilt` says otherwise: a
-/// table-tilting machine reaches the part from above, and the links retract along the tool
-/// axis to the safe plane, running `tan θ` times the height sideways (3.7× at 75°, 57× at 89°).
-pub const DEFAULT_MAX_TILT_DEG: f64 = 75.0;
+/// The most `--max-tilt` can say: the tool axis straight down. By default the machine's tilt
+/// range decides (table-ac: 120°, past a vertical face into undercuts): the links retract
+/// along the tool axis to a clearance sphere and turn the table only there, which is safe
+/// for any tilt.
+pub const MAX_TILT_DEG: f64 = 180.0;
 
 /// What the strategy is asked for.
 pub struct PlanRequest {
@@ -139,14 +140,40 @@ fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -
     Ok(face)
 }
 
+/// Samples per parameter of each face for the part's box.
+const BOX_SAMPLES: usize = 64;
+
+/// A box holding every face of the model: each surface sampled on a 65 × 65 grid, grown by
+/// 1 mm for what falls between samples (the links add their clearance on top).
+fn part_box(model: &tezgah_cam::step::StepModel) -> Option<PartBox> {
+    let mut points = Vec::new();
+    for face in &model.faces {
+        let s = &face.surface;
+        let (du, dv) = (s.domain_u(), s.domain_v());
+        for i in 0..=BOX_SAMPLES {
+            for j in 0..=BOX_SAMPLES {
+                let u = du.0 + (du.1 - du.0) * i as f64 / BOX_SAMPLES as f64;
+                let v = dv.0 + (dv.1 - dv.0) * j as f64 / BOX_SAMPLES as f64;
+                points.push(s.point(u, v));
+            }
+        }
+    }
+    PartBox::of_points(&points).map(|b| b.grown(1.0))
+}
+
+/// What the strategy planned on a face of a STEP file.
+struct Planned {
+    surface: NurbsSurface,
+    path: ToolPath,
+    /// A box around every face of the file: the part the links keep clear of.
+    part: Option<PartBox>,
+}
+
 /// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
 /// points the strategy could not correct are left out of the path and listed here.
-fn plan_surface(
-    path: &Path,
-    cutter: Cutter,
-    request: &PlanRequest,
-) -> Result<(NurbsSurface, ToolPath)> {
+fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Planned> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
+    let part = part_box(&model);
     let face = pick_face(path, model, request.face)?;
     let mut settings = Settings::new(request.strategy, request.scallop_mm, request.tolerance_mm);
     if let ToolAxis::Surface {
@@ -193,7 +220,11 @@ fn plan_surface(
             plan.refused.len()
         ));
     }
-    Ok((face.surface, plan.path))
+    Ok(Planned {
+        surface: face.surface,
+        path: plan.path,
+        part,
+    })
 }
 
 fn positive(name: &str, v: f64) -> Result<f64> {
@@ -247,11 +278,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .joint_limits()
         .get(3)
         .map(|l| l.min.abs().max(l.max.abs()).to_degrees())
-        .unwrap_or(DEFAULT_MAX_TILT_DEG);
+        .unwrap_or(MAX_TILT_DEG);
     let max_tilt_deg = match args.max_tilt_deg {
-        Some(t) if t.is_finite() && t > 0.0 && t < 90.0 => t,
-        Some(t) => return Err(miette!("--max-tilt must be an angle in (0°, 90°), got {t}")),
-        None => DEFAULT_MAX_TILT_DEG.min(reach_deg),
+        Some(t) if t.is_finite() && t > 0.0 && t <= MAX_TILT_DEG => t,
+        Some(t) => return Err(miette!("--max-tilt must be an angle in (0°, 180°], got {t}")),
+        None => MAX_TILT_DEG.min(reach_deg),
     };
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
@@ -270,7 +301,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         face: args.face,
         max_tilt_deg,
     };
-    let (surface, path) = plan_surface(&args.surface, cutter, &request)?;
+    let Planned {
+        surface,
+        path,
+        part,
+    } = plan_surface(&args.surface, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
             OutputForm::Joints
@@ -284,7 +319,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         },
         tool_number: args.tool_number,
         tool_length_mm: length,
-        part_top_z: Some(part_top(&surface)),
+        part,
         title: format!(
             "{} {} {} scallop {} mm",
             args.surface.display(),
@@ -308,23 +343,6 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
-}
-
-/// The highest point of a surface: its control points' (the convex-hull property holds for
-/// positive weights).
-fn part_top(surface: &NurbsSurface) -> f64 {
-    let (du, dv) = (surface.domain_u(), surface.domain_v());
-    // The grid of control points is not public; a dense sample plus the largest deviation a
-    // 64-step sampling can miss is enough for a safe plane that has a clearance anyway.
-    let mut top = f64::NEG_INFINITY;
-    for i in 0..=64 {
-        for j in 0..=64 {
-            let u = du.0 + (du.1 - du.0) * i as f64 / 64.0;
-            let v = dv.0 + (dv.1 - dv.0) * j as f64 / 64.0;
-            top = top.max(surface.point(u, v).z);
-        }
-    }
-    top
 }
 
 /// A posted program and its verification.
@@ -423,7 +441,11 @@ fn report_json(
         "output_points": s.points,
         "inserted_points": s.inserted,
         "max_linearisation_mm": s.max_linearisation_mm,
-        "safe_z_mm": s.safe_z,
+        "clearance_sphere": s.clearance.map(|c| serde_json::json!({
+            "centre": [c.centre.x, c.centre.y, c.centre.z],
+            "radius_mm": c.radius,
+            "part_radius_mm": c.part_radius,
+        })),
         "max_scallop_mm": v.max_scallop_mm,
         "max_scallop_at": at(&v.max_scallop_at),
         "gouge_depth_mm": v.gouge_depth_mm,
@@ -529,8 +551,7 @@ mod tests {
     fn finish_posts_and_verifies_a_plane_job() {
         let machine = Machine::builtin("table-ac").unwrap();
         let (surface, path) = plane_job(1.0);
-        let mut options = PostOptions::new(1000.0, 0.01);
-        options.part_top_z = Some(part_top(&surface));
+        let options = PostOptions::new(1000.0, 0.01);
         let done = finish(&surface, &path, &machine, &options, None).unwrap();
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.

@@ -113,8 +113,8 @@ pub struct Settings {
     /// cutter's effective radius, so the scallop there grows a little. `None`: no limit.
     pub max_lead_change_deg: Option<f64>,
     /// The most the tool axis may lean from the part's +Z, degrees: what a table-tilting
-    /// machine reaches from above (its C axis is the part's Z; the tilt axis' range and the
-    /// retract to a safe plane bound the lean). Contact points whose axis would lean further
+    /// machine reaches (its C axis is the part's Z; the tilt axis' range bounds the lean).
+    /// Contact points whose axis would lean further
     /// are left out as [`Refusal::OutOfReach`] and their passes split there — on a closed
     /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
     pub max_axis_tilt_deg: Option<f64>,
