@@ -193,21 +193,115 @@ fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
     check_and_run("sphere");
 }
 
+/// The largest and smallest table tilt (the A words) of a program, degrees.
+fn tilt_range(program: &str) -> (f64, f64) {
+    let a: Vec<f64> = program
+        .lines()
+        .filter(|l| !l.starts_with('('))
+        .flat_map(|l| l.split_whitespace())
+        .filter_map(|w| w.strip_prefix('A'))
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let lo = a.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = a.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    (lo, hi)
+}
+
+#[test]
+fn vertical_cylinder_side_is_machined_with_the_table_at_90_degrees() {
+    // The NURBS cylinder's side (R 20, 50 high) stands vertical: every normal is horizontal,
+    // so the tool comes in sideways, A = 90°, and the links leave along it to the clearance
+    // sphere and turn the table there.
+    let (radius, tol) = (20.0_f64, 0.01);
+    let (report, program, _) = cam(
+        "cylinder",
+        "nurbs_cylinder.stp",
+        &[
+            "--face",
+            "17",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.3",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    assert_eq!(report["verification"]["uncut_dexels"], 0, "{report}");
+    assert!(f(&report, "gouge_depth_mm") <= tol, "{report}");
+    // The whole side, each pass its height (50 mm): around the 2π·20 mm no wider gaps than
+    // a plane allows a ball R 3 at h 0.3, 2√(2Rh − h²) (a convex surface allows less).
+    let passes = f(&report, "passes");
+    let flat = 2.0 * (2.0 * 3.0 * 0.3 - 0.09_f64).sqrt();
+    let gaps = (2.0 * std::f64::consts::PI * radius / flat).floor();
+    assert!(passes - 1.0 >= gaps, "{report}");
+    assert!(
+        (f(&report, "path_length_mm") - 50.0 * passes).abs() < 1e-6 * passes,
+        "{report}"
+    );
+    // The ball's tip is its contact point (axis along the normal): every feed point lies on
+    // the cylinder or outside it, and the cutting spans its height.
+    let points = feed_points(&program);
+    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in &points {
+        assert!(p[0].hypot(p[1]) >= radius - tol, "{p:?} inside the cylinder");
+        low = low.min(p[2]);
+        high = high.max(p[2]);
+    }
+    assert!(low < 0.5 && high > 49.5, "{low} … {high}");
+    let (_, a_max) = tilt_range(&program);
+    assert!((a_max - 90.0).abs() < 1e-3, "A reaches {a_max}");
+    let sphere = &report["clearance_sphere"];
+    assert!(f(sphere, "radius_mm") > f(sphere, "part_radius_mm"), "{report}");
+    check_and_run("cylinder");
+}
+
+#[test]
+fn twisted_blade_face_is_machined_past_vertical_within_the_tilt_range() {
+    // A face of the lofted blade leans past vertical in places (normals below the
+    // horizontal): table-ac's A reaches 120°, so by default those are machined too.
+    let tol = 0.01;
+    let (report, program, stderr) = cam(
+        "blade",
+        "twisted_blade.stp",
+        &[
+            "--face",
+            "17",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.3",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    assert_eq!(report["verification"]["uncut_dexels"], 0, "{report}");
+    assert!(!stderr.contains("away from +Z"), "{stderr}");
+    assert!(f(&report, "gouge_depth_mm") <= tol, "{report}");
+    let (a_min, a_max) = tilt_range(&program);
+    assert!(a_max > 90.0 && a_max <= 120.0, "A {a_min} … {a_max}");
+    assert!(a_min >= -30.0, "A {a_min} … {a_max}");
+    check_and_run("blade");
+}
+
 #[test]
 fn a_surface_out_of_reach_from_above_is_refused_with_a_reason() {
-    // The NURBS cylinder's side stands vertical: every normal is horizontal.
-    let ngc = tmp("cylinder.ngc");
+    // The NURBS cylinder's side stands vertical: every normal is horizontal, beyond a
+    // 60° limit.
+    let ngc = tmp("cylinder-60.ngc");
     let out = tezgah()
         .arg("cam")
         .arg(fixture("nurbs_cylinder.stp"))
         .args(["--face", "17", "--tool", "ball:6", "--strategy", "zigzag"])
-        .args(["--scallop", "0.2", "--tolerance", "0.01", "-o"])
+        .args(["--scallop", "0.2", "--tolerance", "0.01", "--max-tilt", "60", "-o"])
         .arg(&ngc)
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
     assert!(stderr.contains("no contact point is left"), "{stderr}");
-    assert!(stderr.contains("more than 75° away from +Z"), "{stderr}");
+    assert!(stderr.contains("more than 60° away from +Z"), "{stderr}");
     assert!(!ngc.exists());
 }
