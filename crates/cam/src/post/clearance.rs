@@ -205,7 +205,11 @@ impl Clearance {
             t0.sin().max(t1.sin())
         };
         let length = dt.abs() + widest * dp.abs();
-        let n = ((length / MAX_STEP).ceil() as usize).max(1);
+        if length < 1e-12 {
+            return vec![*to];
+        }
+        // At least one interior point: the chord between two points of the sphere dips in.
+        let n = ((length / MAX_STEP).ceil() as usize).max(2);
         let step = length / n as f64;
         let lift = self.radius / step.cos();
         let mut out = Vec::with_capacity(n);
