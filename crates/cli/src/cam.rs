@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::step::Face;
-use tezgah_cam::strategy::Refusal;
+use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{Cutter, CutterShape, Settings, StrategyKind, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
@@ -68,6 +68,10 @@ pub struct CamArgs {
     /// further away are left out (default: as far as the machine's tilt axis reaches).
     #[arg(long = "max-tilt")]
     pub max_tilt_deg: Option<f64>,
+    /// The surface parameter the passes run along: v (default) or u; the other is stepped
+    /// over. On a sphere, u gives parallels from pole to pole.
+    #[arg(long = "feed-along", default_value = "v")]
+    pub feed_along: String,
     /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
     /// step-over; coarser is faster and widens the reported grid bound).
     #[arg(long = "verify-cell")]
@@ -91,6 +95,8 @@ pub struct PlanRequest {
     pub face: Option<u64>,
     /// The most the tool axis may lean from +Z, degrees.
     pub max_tilt_deg: f64,
+    /// The parameter the passes run along.
+    pub direction: FeedDirection,
 }
 
 /// How close a face's loops must run to its surface's domain boundary for the face to count
@@ -185,6 +191,7 @@ fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Pl
     // Cut the face's outside: the side its orientation says the material is not.
     settings.reverse_normal = !face.same_sense;
     settings.max_axis_tilt_deg = Some(request.max_tilt_deg);
+    settings.direction = request.direction;
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let out_of_reach = plan
@@ -260,6 +267,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .strategy
         .parse()
         .map_err(|e| miette!("--strategy {}: {e}", args.strategy))?;
+    let direction = match args.feed_along.as_str() {
+        "v" => FeedDirection::AlongV,
+        "u" => FeedDirection::AlongU,
+        other => return Err(miette!("--feed-along must be u or v, got {other}")),
+    };
     let machine = crate::run::load_machine(Some(args.machine.as_deref().unwrap_or("table-ac")))?;
     if !matches!(
         machine.kinematics,
@@ -300,6 +312,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         tilt_deg: args.tilt_deg,
         face: args.face,
         max_tilt_deg,
+        direction,
     };
     let Planned {
         surface,

@@ -150,6 +150,11 @@ impl Clearance {
     /// The whole tool — every point within its widest radius of the ray from `tip` along
     /// `axis` (unit) — lies outside the part's ball.
     pub fn is_clear(&self, tip: &Vec3, axis: &Vec3) -> bool {
+        self.clear_by(tip, axis, 0.0)
+    }
+
+    /// [`Self::is_clear`] with `margin` mm to spare.
+    pub fn clear_by(&self, tip: &Vec3, axis: &Vec3, margin: f64) -> bool {
         let d = tip - self.centre;
         let along = axis.dot(&d);
         // The ray's closest point to the centre: the tip itself when the ray points away.
@@ -158,7 +163,7 @@ impl Clearance {
         } else {
             (d - axis * along).norm()
         };
-        nearest >= self.part_radius + self.tool_radius
+        nearest >= self.part_radius + self.tool_radius + margin
     }
 
     /// The tool axis of a link station at `at` on the sphere: the outward radial direction,

@@ -185,7 +185,7 @@ fn link(
 }
 
 /// The axes turning evenly from `from`'s to `to`'s over `route` (one per point), if the tool
-/// stays clear all the way: at every point and at [`LINK_SAMPLES`] places between points
+/// stays clear, with half the clearance to spare, all the way: at every point and at [`LINK_SAMPLES`] places between points
 /// (tip on the chord, axis between the two), and no axis tilts further than both ends do.
 fn turning(sphere: &Clearance, from: &Pose, to: &Pose, route: &[Vec3]) -> Option<Vec<Vec3>> {
     let (ua, ub) = (Unit::new_normalize(from.axis), Unit::new_normalize(to.axis));
@@ -199,13 +199,16 @@ fn turning(sphere: &Clearance, from: &Pose, to: &Pose, route: &[Vec3]) -> Option
         }
         axes.push(a);
     }
+    // Half the clearance to spare: the machine's motion between stations may stray from
+    // this blend by the linearisation tolerance, and the check after posting allows none.
+    let margin = 0.5 * (sphere.radius - sphere.part_radius - sphere.tool_radius);
     let mut before = (from.tip, from.axis);
     for (q, a) in route.iter().zip(&axes) {
         for k in 1..=LINK_SAMPLES {
             let t = k as f64 / LINK_SAMPLES as f64;
             let tip = before.0 + (q - before.0) * t;
             let axis = (before.1 * (1.0 - t) + a * t).normalize();
-            if !sphere.is_clear(&tip, &axis) {
+            if !sphere.clear_by(&tip, &axis, margin) {
                 return None;
             }
         }

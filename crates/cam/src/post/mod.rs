@@ -309,13 +309,17 @@ pub fn post(
     })
 }
 
+/// Requested axes closer than this (rad) count as one: the limit normals at a pole differ
+/// by ~10⁻⁸ with the side they are taken from.
+const STILL_AXIS: f64 = 1e-6;
+
 /// Samples per link move checked for clearance while the table turns.
 const CLEAR_SAMPLES: usize = 8;
 
 /// Every move that turns the tool, off the cutting (a link), keeps the whole tool outside
 /// the part's ball at every sample as the machine moves it. Moves between two stations of
-/// the same axis (retract, approach, C turned at the pole) do not turn the tool: the table
-/// may move there only within the linearisation tolerance, checked already.
+/// the same axis (retract, approach, C turned at the pole; [`STILL_AXIS`]) do not turn the
+/// tool: the table may move there only within the linearisation tolerance, checked already.
 fn check_clear(
     points: &[PostedPoint],
     motion: &MachineMotion<'_>,
@@ -324,7 +328,7 @@ fn check_clear(
     for w in points.windows(2) {
         let (a, b) = (&w[0], &w[1]);
         let turn = (b.angles.tilt - a.angles.tilt).abs() + (b.angles.c - a.angles.c).abs();
-        if b.motion != Motion::Rapid || turn <= 1e-12 || (b.axis - a.axis).norm() <= 1e-12 {
+        if b.motion != Motion::Rapid || turn <= 1e-12 || a.axis.angle(&b.axis) <= STILL_AXIS {
             continue;
         }
         for k in 0..=CLEAR_SAMPLES {

@@ -344,6 +344,11 @@ struct Local {
     curvature: Curvature2,
 }
 
+/// How far into the domain (fraction of the parameter range) the limit derivatives on a
+/// degenerate edge are taken: the normal there is off by about this angle times the range
+/// (a sphere: 3·10⁻⁸ rad), far below any tolerance, while the derivatives stay well defined.
+const LIMIT_NUDGE: f64 = 1e-8;
+
 /// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
 const MATCH_MARGIN: f64 = 0.05;
 /// Lean added per correction trial, degrees.
@@ -419,7 +424,43 @@ impl<'a> Context<'a> {
 
     /// Frame and curvature at `(u, v)` for a path running along `tangent_uv`.
     fn local(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Option<Local> {
-        self.local_of(self.surface.derivs(u, v), tangent_uv)
+        self.local_of(self.derivs(u, v), tangent_uv)
+    }
+
+    /// The surface's derivatives at `(u, v)`; on a degenerate edge (a pole, where one
+    /// parameter's derivative vanishes and the normal with it) those of the limit from inside:
+    /// the point itself with the derivatives a hair ([`LIMIT_NUDGE`] of the range) into the
+    /// domain across that edge, where the normal is defined. On a sphere's pole that is the
+    /// pole's normal to within the nudge's angle; the gouge checks stand guard where a
+    /// degenerate point has no single limit (an apex).
+    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
+        let d = self.surface.derivs(u, v);
+        if d.normal().is_some() {
+            return d;
+        }
+        let inward = |x: f64, (lo, hi): (f64, f64)| {
+            let e = LIMIT_NUDGE * (hi - lo);
+            if x - lo < hi - x {
+                x + e
+            } else {
+                x - e
+            }
+        };
+        let (du, dv) = (self.surface.domain_u(), self.surface.domain_v());
+        // The parameter whose derivative vanished runs along the edge; step across it.
+        let (nu, nv) = if d.su.norm() <= d.sv.norm() {
+            (u, inward(v, dv))
+        } else {
+            (inward(u, du), v)
+        };
+        let near = self.surface.derivs(nu, nv);
+        if near.normal().is_none() {
+            return d;
+        }
+        SurfaceDerivs {
+            point: d.point,
+            ..near
+        }
     }
 
     /// [`Self::local`] from derivatives already evaluated.
@@ -486,7 +527,7 @@ impl<'a> Context<'a> {
         tangent_uv: (f64, f64),
         min_lead: f64,
     ) -> Result<Placed, GougeReport> {
-        let d = self.surface.derivs(u, v);
+        let d = self.derivs(u, v);
         let contact = d.point;
         let refuse = |refusal| GougeReport {
             uv: (u, v),
