@@ -193,6 +193,60 @@ fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
     check_and_run("sphere");
 }
 
+#[test]
+fn sphere_cap_iso_scallop_along_parallels_is_verified_to_the_pole() {
+    // Iso-scallop with the passes along u (parallels): the fronts march from the south pole
+    // to the north pole, the cap within 45° of +Z is cut to the pole (a point, cut as one),
+    // the scallop close to the target and nothing uncut.
+    let (radius, max_tilt, h, tol) = (40.0_f64, 45.0_f64, 0.2, 0.01);
+    let (report, program, _) = cam(
+        "sphere-iso",
+        "rational_sphere.stp",
+        &[
+            "--strategy",
+            "iso-scallop",
+            "--feed-along",
+            "u",
+            "--scallop",
+            "0.2",
+            "--max-tilt",
+            "45",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    let v = &report["verification"];
+    assert_eq!(v["uncut_dexels"], 0, "{report}");
+    let scallop = f(&report, "max_scallop_mm");
+    assert!(
+        scallop - f(v, "sweep_bound_mm") <= h + tol && scallop > 0.75 * h,
+        "{report}"
+    );
+    assert!(f(&report, "gouge_depth_mm") <= tol, "{report}");
+    // The cap's meridian arc (R·π/4) at no more than a plane's step for a ball R 3 at h.
+    let flat = 2.0 * (2.0 * 3.0 * h - h * h).sqrt();
+    let passes = f(&report, "passes");
+    assert!(passes >= (radius * std::f64::consts::FRAC_PI_4 / flat).floor(), "{report}");
+    let points = feed_points(&program);
+    let rim = radius * max_tilt.to_radians().cos();
+    let mut lowest = f64::INFINITY;
+    for p in &points {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!(r >= radius - tol, "{p:?} inside the sphere");
+        assert!(p[2] >= rim - tol, "{p:?} below the cap");
+        lowest = lowest.min(p[2]);
+    }
+    assert!(lowest < rim + flat, "lowest cut {lowest}, rim {rim}");
+    assert!(
+        points
+            .iter()
+            .any(|p| p[0].hypot(p[1]) < 1e-3 && (p[2] - radius).abs() < 1e-3),
+        "the pole is cut"
+    );
+    check_and_run("sphere-iso");
+}
+
 /// The largest and smallest table tilt (the A words) of a program, degrees.
 fn tilt_range(program: &str) -> (f64, f64) {
     let a: Vec<f64> = program
