@@ -572,7 +572,10 @@ fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
 /// The rational sphere OpenCascade wrote (R 40; u the longitude with its seam at 0 = 2π,
 /// v the latitude with the poles at ±π/2).
 fn step_sphere() -> NurbsSurface {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/rational_sphere.stp");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/rational_sphere.stp"
+    );
     let model = tezgah_cam::step::read_file(path).unwrap();
     model.faces[0].surface.clone()
 }
@@ -612,7 +615,10 @@ fn iso_scallop_along_parallels_covers_a_sphere_from_pole_to_pole() {
             assert!(d >= want * 0.97, "gap {d} vs {want} at z {}", z(&w[0]));
             let r = w[1].points[0].contact.xy().norm();
             for c in &w[1].points {
-                assert!((c.contact.xy().norm() - r).abs() < 1e-6 && (c.contact.z - z(&w[1])).abs() < 1e-6);
+                assert!(
+                    (c.contact.xy().norm() - r).abs() < 1e-6
+                        && (c.contact.z - z(&w[1])).abs() < 1e-6
+                );
             }
         }
     }
@@ -634,8 +640,16 @@ fn zigzag_along_u_reaches_the_sphere_poles() {
     settings.direction = FeedDirection::AlongU;
     let p = plan(&s, &ball(6.0), &settings).unwrap();
     assert!(p.refused.is_empty(), "{:?}", &p.refused[..1]);
-    let zs: Vec<f64> = p.path.passes.iter().map(|q| q.points[0].contact.z).collect();
-    assert!((zs[0] + 40.0).abs() < 1e-9 && (zs[zs.len() - 1] - 40.0).abs() < 1e-9, "{zs:?}");
+    let zs: Vec<f64> = p
+        .path
+        .passes
+        .iter()
+        .map(|q| q.points[0].contact.z)
+        .collect();
+    assert!(
+        (zs[0] + 40.0).abs() < 1e-9 && (zs[zs.len() - 1] - 40.0).abs() < 1e-9,
+        "{zs:?}"
+    );
     for c in p.path.passes.iter().flat_map(|q| &q.points) {
         assert!((c.normal - c.contact / 40.0).norm() < 1e-6, "{c:?}");
     }

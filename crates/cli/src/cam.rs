@@ -293,7 +293,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .unwrap_or(MAX_TILT_DEG);
     let max_tilt_deg = match args.max_tilt_deg {
         Some(t) if t.is_finite() && t > 0.0 && t <= MAX_TILT_DEG => t,
-        Some(t) => return Err(miette!("--max-tilt must be an angle in (0°, 180°], got {t}")),
+        Some(t) => {
+            return Err(miette!(
+                "--max-tilt must be an angle in (0°, 180°], got {t}"
+            ))
+        }
         None => MAX_TILT_DEG.min(reach_deg),
     };
     if let Some(c) = args.verify_cell_mm {

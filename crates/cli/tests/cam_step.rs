@@ -227,7 +227,10 @@ fn sphere_cap_iso_scallop_along_parallels_is_verified_to_the_pole() {
     // The cap's meridian arc (R·π/4) at no more than a plane's step for a ball R 3 at h.
     let flat = 2.0 * (2.0 * 3.0 * h - h * h).sqrt();
     let passes = f(&report, "passes");
-    assert!(passes >= (radius * std::f64::consts::FRAC_PI_4 / flat).floor(), "{report}");
+    assert!(
+        passes >= (radius * std::f64::consts::FRAC_PI_4 / flat).floor(),
+        "{report}"
+    );
     let points = feed_points(&program);
     let rim = radius * max_tilt.to_radians().cos();
     let mut lowest = f64::INFINITY;
@@ -299,7 +302,10 @@ fn vertical_cylinder_side_is_machined_with_the_table_at_90_degrees() {
     let points = feed_points(&program);
     let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
     for p in &points {
-        assert!(p[0].hypot(p[1]) >= radius - tol, "{p:?} inside the cylinder");
+        assert!(
+            p[0].hypot(p[1]) >= radius - tol,
+            "{p:?} inside the cylinder"
+        );
         low = low.min(p[2]);
         high = high.max(p[2]);
     }
@@ -307,7 +313,10 @@ fn vertical_cylinder_side_is_machined_with_the_table_at_90_degrees() {
     let (_, a_max) = tilt_range(&program);
     assert!((a_max - 90.0).abs() < 1e-3, "A reaches {a_max}");
     let sphere = &report["clearance_sphere"];
-    assert!(f(sphere, "radius_mm") > f(sphere, "part_radius_mm"), "{report}");
+    assert!(
+        f(sphere, "radius_mm") > f(sphere, "part_radius_mm"),
+        "{report}"
+    );
     check_and_run("cylinder");
 }
 
@@ -349,7 +358,15 @@ fn a_surface_out_of_reach_from_above_is_refused_with_a_reason() {
         .arg("cam")
         .arg(fixture("nurbs_cylinder.stp"))
         .args(["--face", "17", "--tool", "ball:6", "--strategy", "zigzag"])
-        .args(["--scallop", "0.2", "--tolerance", "0.01", "--max-tilt", "60", "-o"])
+        .args([
+            "--scallop",
+            "0.2",
+            "--tolerance",
+            "0.01",
+            "--max-tilt",
+            "60",
+            "-o",
+        ])
         .arg(&ngc)
         .output()
         .unwrap();

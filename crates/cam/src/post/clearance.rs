@@ -119,11 +119,7 @@ impl Clearance {
             .map(|p| (p - centre).norm())
             .fold(0.0, f64::max);
         let c = &path.cutter;
-        let tool_radius = c
-            .shape
-            .radius()
-            .max(c.shank.radius)
-            .max(c.holder.radius);
+        let tool_radius = c.shape.radius().max(c.shank.radius).max(c.holder.radius);
         Ok(Clearance {
             centre,
             part_radius,
@@ -204,11 +200,12 @@ impl Clearance {
         }
         let dt = t1 - t0;
         // The arc between two points of the route is at most |Δθ| + sin θ_max |Δφ| long.
-        let widest = if (t0 - std::f64::consts::FRAC_PI_2) * (t1 - std::f64::consts::FRAC_PI_2) < 0.0 {
-            1.0
-        } else {
-            t0.sin().max(t1.sin())
-        };
+        let widest =
+            if (t0 - std::f64::consts::FRAC_PI_2) * (t1 - std::f64::consts::FRAC_PI_2) < 0.0 {
+                1.0
+            } else {
+                t0.sin().max(t1.sin())
+            };
         let length = dt.abs() + widest * dp.abs();
         if length < 1e-12 {
             return vec![*to];

@@ -4,8 +4,8 @@
 
 use std::fmt::Write as _;
 
-use super::linearise::MachineMotion;
 use super::clearance::Clearance;
+use super::linearise::MachineMotion;
 use super::links::Motion;
 use super::{FeedOutput, OutputForm, PostError, PostOptions, PostedPoint};
 

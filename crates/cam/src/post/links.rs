@@ -55,11 +55,7 @@ fn tilt(axis: &Vec3) -> f64 {
 /// to the top with the tool vertical. Cutter locations repeated in place are dropped.
 /// `approach` is the distance above the first point where the rapid approach ends and the
 /// plunge at the feed begins, mm.
-pub fn stations(
-    path: &ToolPath,
-    sphere: &Clearance,
-    approach: f64,
-) -> Vec<Station> {
+pub fn stations(path: &ToolPath, sphere: &Clearance, approach: f64) -> Vec<Station> {
     let mut out: Vec<Station> = Vec::new();
     let start = Pose {
         tip: sphere.top(),
@@ -131,7 +127,13 @@ pub fn stations(
 }
 
 /// A rapid station, unless it repeats the last one.
-fn push(out: &mut Vec<Station>, tip: Vec3, axis: Vec3, motion: Motion, place: Option<(usize, usize)>) {
+fn push(
+    out: &mut Vec<Station>,
+    tip: Vec3,
+    axis: Vec3,
+    motion: Motion,
+    place: Option<(usize, usize)>,
+) {
     if let Some(l) = out.last() {
         if (l.tip - tip).norm() <= 1e-9 && (l.axis - axis).norm() <= 1e-12 {
             return;
