@@ -30,6 +30,9 @@ struct FrontPoint {
 const PULL_BACK_SLACK: f64 = 0.002;
 /// Front points on either side used for the front's tangent.
 const TANGENT_STENCIL: usize = 3;
+/// Samples of the way to the far edge searched for a point beyond the side step when the
+/// edge itself lies within it (a closed surface: the far edge is the seam it started from).
+const SEAM_SCAN: usize = 64;
 /// Root-search iterations for one offset (bracketed, so the bound only stops a stall).
 const OFFSET_ITERATIONS: usize = 40;
 
@@ -263,11 +266,27 @@ fn offset(ctx: &Context, p: FrontPoint, dir: (f64, f64), origin: &Vec3, w: f64) 
         return edge_point(0.0);
     }
     let g_edge = dist(to_edge);
-    if g_edge <= 0.0 {
-        return edge_point(to_edge);
-    }
-    // Bracketed Illinois (regula falsi) on g(λ) = |S(p + λ·dir) − origin| − w, g(0) = −w.
     let (mut lo, mut glo, mut hi, mut ghi) = (0.0, -w, to_edge, g_edge);
+    if g_edge <= 0.0 {
+        // Within reach of the far edge — unless the surface closes on itself (a seam: the far
+        // edge is the near one), when it comes back within `w` of the origin after going far
+        // away. The first sample beyond `w` on the way brackets the true offset.
+        let mut found = false;
+        for k in 1..SEAM_SCAN {
+            let lam = to_edge * k as f64 / SEAM_SCAN as f64;
+            let g = dist(lam);
+            if g > 0.0 {
+                (hi, ghi) = (lam, g);
+                found = true;
+                break;
+            }
+            (lo, glo) = (lam, g);
+        }
+        if !found {
+            return edge_point(to_edge);
+        }
+    }
+    // Bracketed Illinois (regula falsi) on g(λ) = |S(p + λ·dir) − origin| − w, g(lo) ≤ 0.
     let mut side = 0;
     let mut lam = hi;
     for _ in 0..OFFSET_ITERATIONS {
