@@ -68,9 +68,9 @@ pub struct CamArgs {
     /// further away are left out (default: as far as the machine's tilt axis reaches).
     #[arg(long = "max-tilt")]
     pub max_tilt_deg: Option<f64>,
-    /// The surface parameter the passes run along: v (default) or u; the other is stepped
-    /// over. On a sphere, u gives parallels from pole to pole.
-    #[arg(long = "feed-along", default_value = "v")]
+    /// The surface parameter the passes run along: u or v (the other is stepped over), or
+    /// auto: v unless a v boundary is a single point (a sphere's pole), then u.
+    #[arg(long = "feed-along", default_value = "auto")]
     pub feed_along: String,
     /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
     /// step-over; coarser is faster and widens the reported grid bound).
@@ -95,8 +95,8 @@ pub struct PlanRequest {
     pub face: Option<u64>,
     /// The most the tool axis may lean from +Z, degrees.
     pub max_tilt_deg: f64,
-    /// The parameter the passes run along.
-    pub direction: FeedDirection,
+    /// The parameter the passes run along (`None`: chosen for the surface).
+    pub direction: Option<FeedDirection>,
 }
 
 /// How close a face's loops must run to its surface's domain boundary for the face to count
@@ -173,6 +173,8 @@ struct Planned {
     path: ToolPath,
     /// A box around every face of the file: the part the links keep clear of.
     part: Option<PartBox>,
+    /// The parameter the passes run along.
+    direction: FeedDirection,
 }
 
 /// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
@@ -191,7 +193,9 @@ fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Pl
     // Cut the face's outside: the side its orientation says the material is not.
     settings.reverse_normal = !face.same_sense;
     settings.max_axis_tilt_deg = Some(request.max_tilt_deg);
-    settings.direction = request.direction;
+    settings.direction = request
+        .direction
+        .unwrap_or_else(|| FeedDirection::for_surface(&face.surface));
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let out_of_reach = plan
@@ -231,6 +235,7 @@ fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Pl
         surface: face.surface,
         path: plan.path,
         part,
+        direction: settings.direction,
     })
 }
 
@@ -268,9 +273,10 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .parse()
         .map_err(|e| miette!("--strategy {}: {e}", args.strategy))?;
     let direction = match args.feed_along.as_str() {
-        "v" => FeedDirection::AlongV,
-        "u" => FeedDirection::AlongU,
-        other => return Err(miette!("--feed-along must be u or v, got {other}")),
+        "v" => Some(FeedDirection::AlongV),
+        "u" => Some(FeedDirection::AlongU),
+        "auto" => None,
+        other => return Err(miette!("--feed-along must be u, v or auto, got {other}")),
     };
     let machine = crate::run::load_machine(Some(args.machine.as_deref().unwrap_or("table-ac")))?;
     if !matches!(
@@ -322,6 +328,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         surface,
         path,
         part,
+        direction,
     } = plan_surface(&args.surface, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
@@ -350,7 +357,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
-    let json = report_json(&args, &machine, &path, &done, scallop);
+    let mut json = report_json(&args, &machine, &path, &done, scallop);
+    json["feed_along"] = serde_json::json!(match direction {
+        FeedDirection::AlongU => "u",
+        FeedDirection::AlongV => "v",
+    });
     if let Some(p) = &args.report {
         crate::library::write_json(p, &json)?;
     }

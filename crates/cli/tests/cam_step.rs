@@ -172,6 +172,8 @@ fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
         ],
     );
     assert_eq!(report["verified"], true, "{report}");
+    // The sphere's v boundaries are its poles: the passes run along u (parallels).
+    assert_eq!(report["feed_along"], "u", "{report}");
     assert!(
         stderr.contains("face more than 45° away from +Z"),
         "{stderr}"

@@ -72,6 +72,45 @@ pub enum FeedDirection {
     AlongU,
 }
 
+/// Samples along a boundary curve when [`FeedDirection::for_surface`] measures it.
+const BOUNDARY_SAMPLES: usize = 32;
+
+/// A boundary shorter than this fraction of the longest one is a point (a pole).
+const DEGENERATE_BOUNDARY: f64 = 1e-6;
+
+impl FeedDirection {
+    /// The direction whose passes end on real boundary curves: passes along v end on the
+    /// boundaries v = const, so if one of those is a single point (a latitude–longitude
+    /// sphere's pole) the passes would all converge on it — crowded there and, for
+    /// iso-scallop, fronts that cannot stay monotone in v — and the passes run along u
+    /// instead (a sphere: parallels, each pole cut as a point). Along v otherwise.
+    pub fn for_surface(surface: &NurbsSurface) -> FeedDirection {
+        let (du, dv) = (surface.domain_u(), surface.domain_v());
+        let length = |at: &dyn Fn(f64) -> Vec3| {
+            (1..=BOUNDARY_SAMPLES)
+                .map(|k| {
+                    let (a, b) = (
+                        (k - 1) as f64 / BOUNDARY_SAMPLES as f64,
+                        k as f64 / BOUNDARY_SAMPLES as f64,
+                    );
+                    (at(b) - at(a)).norm()
+                })
+                .sum::<f64>()
+        };
+        let along_u_at = |v: f64| length(&|t| surface.point(du.0 + (du.1 - du.0) * t, v));
+        let along_v_at = |u: f64| length(&|t| surface.point(u, dv.0 + (dv.1 - dv.0) * t));
+        let v_ends = [along_u_at(dv.0), along_u_at(dv.1)];
+        let u_ends = [along_v_at(du.0), along_v_at(du.1)];
+        let longest = v_ends.iter().chain(&u_ends).fold(0.0_f64, |m, &x| m.max(x));
+        let point = |x: f64| !(x > DEGENERATE_BOUNDARY * longest);
+        if v_ends.iter().any(|&x| point(x)) && !u_ends.iter().any(|&x| point(x)) {
+            FeedDirection::AlongU
+        } else {
+            FeedDirection::AlongV
+        }
+    }
+}
+
 /// How the tool axis stands.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ToolAxis {
@@ -703,6 +742,29 @@ impl<'a> Context<'a> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn passes_run_along_the_poles_not_into_them() {
+        // The patch of the tests has four real boundaries: along v. A surface whose v = 0
+        // boundary is one point (a fan of lines from the origin) runs along u.
+        let patch = crate::testing::sphere(30.0);
+        assert_eq!(FeedDirection::for_surface(&patch), FeedDirection::AlongV);
+        let pts = [
+            Vec3::zeros(),
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::zeros(),
+            Vec3::new(0.0, 10.0, 0.0),
+        ];
+        let fan = NurbsSurface::bspline(
+            1,
+            1,
+            &pts,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 1.0, 1.0],
+        )
+        .unwrap();
+        assert_eq!(FeedDirection::for_surface(&fan), FeedDirection::AlongU);
+    }
+
     use super::*;
 
     #[test]
