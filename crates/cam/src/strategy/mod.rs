@@ -102,7 +102,8 @@ impl FeedDirection {
         let v_ends = [along_u_at(dv.0), along_u_at(dv.1)];
         let u_ends = [along_v_at(du.0), along_v_at(du.1)];
         let longest = v_ends.iter().chain(&u_ends).fold(0.0_f64, |m, &x| m.max(x));
-        let point = |x: f64| !(x > DEGENERATE_BOUNDARY * longest);
+        // A NaN length (a surface that does not evaluate) counts as a point too.
+        let point = |x: f64| x.is_nan() || x <= DEGENERATE_BOUNDARY * longest;
         if v_ends.iter().any(|&x| point(x)) && !u_ends.iter().any(|&x| point(x)) {
             FeedDirection::AlongU
         } else {
