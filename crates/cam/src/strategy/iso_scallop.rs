@@ -28,6 +28,9 @@ struct FrontPoint {
 /// Relative excess of the gap between fronts over the allowed step tolerated before
 /// [`pull_back`] moves a point.
 const PULL_BACK_SLACK: f64 = 0.002;
+/// Relative narrowing of the side step at the new pass, compared with the old, above which
+/// the offset is redone with the narrower step.
+const NARROWING_SLACK: f64 = 0.01;
 /// Front points on either side used for the front's tangent.
 const TANGENT_STENCIL: usize = 3;
 /// Samples of the way to the far edge searched for a point beyond the side step when the
@@ -130,7 +133,20 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
                 .unwrap_or(ctx.settings.scallop)
         });
         let (dir_s, dir_f) = cross_direction(ctx, &local);
-        let moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        let mut moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        // The step is set by the curvature at the old pass; where it changes quickly across
+        // the step (a blade's rounded edge) the surface between the passes allows less, and
+        // the ridge can stand anywhere there. The smallest step over samples of the way is
+        // taken (twice: the narrower way may hold a narrower place still).
+        let mut w = w;
+        for _ in 0..2 {
+            let narrowest = narrowest_step(ctx, p, moved, tangent).unwrap_or(w);
+            if narrowest >= w * (1.0 - NARROWING_SLACK) {
+                break;
+            }
+            w = narrowest;
+            moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        }
         next.push(moved);
         steps.push(w);
         kept.push(p);
@@ -236,6 +252,29 @@ fn cross_direction(ctx: &Context, local: &super::Local) -> (f64, f64) {
         return (1.0 / ss.norm().max(1e-300), 0.0);
     }
     (ds, df)
+}
+
+/// Samples of the way between a front point and its offset where [`narrowest_step`] looks.
+const WAY_SAMPLES: usize = 4;
+
+/// The smallest side step allowed at [`WAY_SAMPLES`] places on the straight parameter line
+/// from `from` to `to` (`to` included), for a pass running along `tangent`; `None` if none
+/// has one.
+fn narrowest_step(
+    ctx: &Context,
+    from: FrontPoint,
+    to: FrontPoint,
+    tangent: (f64, f64),
+) -> Option<f64> {
+    (1..=WAY_SAMPLES)
+        .filter_map(|k| {
+            let x = k as f64 / WAY_SAMPLES as f64;
+            let (u, v) = ctx
+                .axes
+                .uv(from.s + (to.s - from.s) * x, from.f + (to.f - from.f) * x);
+            ctx.local(u, v, tangent).and_then(|l| ctx.side_step(&l))
+        })
+        .reduce(f64::min)
 }
 
 /// `p` moved along the parameter direction `dir` until its surface point lies `w` mm (chord)
