@@ -352,6 +352,37 @@ fn twisted_blade_face_is_machined_past_vertical_within_the_tilt_range() {
 }
 
 #[test]
+fn twisted_blade_face_iso_scallop_holds_the_scallop_over_its_rounded_edge() {
+    // The face's curvature changes quickly across a pass near the blade's edge: the side
+    // step is the narrowest allowed on the way to the next pass, so the ridge stays within the
+    // target (it left 0.435 mm at h 0.3 when only the old pass's curvature counted).
+    let (h, tol) = (0.3, 0.01);
+    let (report, _, _) = cam(
+        "blade-iso",
+        "twisted_blade.stp",
+        &[
+            "--face",
+            "17",
+            "--strategy",
+            "iso-scallop",
+            "--scallop",
+            "0.3",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["verified"], true, "{report}");
+    let v = &report["verification"];
+    assert_eq!(v["uncut_dexels"], 0, "{report}");
+    let scallop = f(&report, "max_scallop_mm");
+    assert!(
+        scallop - f(v, "sweep_bound_mm") <= h + tol && scallop > 0.75 * h,
+        "{report}"
+    );
+    check_and_run("blade-iso");
+}
+
+#[test]
 fn a_surface_out_of_reach_from_above_is_refused_with_a_reason() {
     // The NURBS cylinder's side stands vertical: every normal is horizontal, beyond a
     // 60° limit.
