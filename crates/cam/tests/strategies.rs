@@ -568,3 +568,89 @@ fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
     println!("flat D6: largest residual {worst:.4} mm for h = {h}");
     assert!(worst <= 1.1 * h + 0.001, "{worst}");
 }
+
+/// The rational sphere OpenCascade wrote (R 40; u the longitude with its seam at 0 = 2π,
+/// v the latitude with the poles at ±π/2).
+fn step_sphere() -> NurbsSurface {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/rational_sphere.stp"
+    );
+    let model = tezgah_cam::step::read_file(path).unwrap();
+    model.faces[0].surface.clone()
+}
+
+#[test]
+fn iso_scallop_along_parallels_covers_a_sphere_from_pole_to_pole() {
+    // Fronts start at the south pole (a point: it is cut as one, its normal the limit from
+    // inside), march up the sphere as parallels spaced by the exact circle–circle step, and the
+    // last pass is the north pole: nothing refused, no pass collapses at a pole.
+    let (radius, h) = (40.0, 0.2);
+    let s = step_sphere();
+    let mut settings = Settings::new(StrategyKind::IsoScallop, h, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    assert!(p.refused.is_empty(), "{:?}", &p.refused[..1]);
+    let passes = &p.path.passes;
+    let pole = |pass: &Pass, z: f64| {
+        pass.points
+            .iter()
+            .all(|c| (c.contact - Vec3::new(0.0, 0.0, z)).norm() < 1e-9 && c.normal.z * z > 0.0)
+    };
+    assert!(pole(&passes[0], -radius) && pole(&passes[passes.len() - 1], radius));
+    // Between the poles every pass is a whole parallel, and neighbouring parallels are the
+    // exact step apart (measured between contact polylines; the first and last gaps, to the
+    // poles, at most that).
+    let want = stepover_exact(3.0, -1.0 / radius, h).unwrap();
+    let z = |pass: &Pass| pass.points[0].contact.z;
+    for w in passes.windows(2) {
+        let from = w[0].points[0].contact;
+        let d = if pole(&w[1], radius) {
+            (from - w[1].points[0].contact).norm()
+        } else {
+            distance_to_polyline(&from, &w[1])
+        };
+        assert!(d <= want * 1.01, "gap {d} vs {want} at z {}", z(&w[0]));
+        if !pole(&w[0], -radius) && !pole(&w[1], radius) {
+            assert!(d >= want * 0.97, "gap {d} vs {want} at z {}", z(&w[0]));
+            let r = w[1].points[0].contact.xy().norm();
+            for c in &w[1].points {
+                assert!(
+                    (c.contact.xy().norm() - r).abs() < 1e-6
+                        && (c.contact.z - z(&w[1])).abs() < 1e-6
+                );
+            }
+        }
+    }
+    // Half the meridian (π·R) over the step, give or take the last gap.
+    let expected = (std::f64::consts::PI * radius / want).ceil() as usize + 1;
+    assert!(
+        (expected - 1..=expected + 1).contains(&passes.len()),
+        "{} passes, expected {expected}",
+        passes.len()
+    );
+}
+
+#[test]
+fn zigzag_along_u_reaches_the_sphere_poles() {
+    // Iso-lines along u at the poles have no length: each is cut as the pole point, with the
+    // normal from inside (this was `Degenerate { u: 0, v: −π/2 }`).
+    let s = step_sphere();
+    let mut settings = Settings::new(StrategyKind::ZigZag, 0.3, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    assert!(p.refused.is_empty(), "{:?}", &p.refused[..1]);
+    let zs: Vec<f64> = p
+        .path
+        .passes
+        .iter()
+        .map(|q| q.points[0].contact.z)
+        .collect();
+    assert!(
+        (zs[0] + 40.0).abs() < 1e-9 && (zs[zs.len() - 1] - 40.0).abs() < 1e-9,
+        "{zs:?}"
+    );
+    for c in p.path.passes.iter().flat_map(|q| &q.points) {
+        assert!((c.normal - c.contact / 40.0).norm() < 1e-6, "{c:?}");
+    }
+}

@@ -6,9 +6,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
-use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions, Posted};
+use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::step::Face;
-use tezgah_cam::strategy::Refusal;
+use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{Cutter, CutterShape, Settings, StrategyKind, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
@@ -65,19 +65,24 @@ pub struct CamArgs {
     #[arg(long)]
     pub face: Option<u64>,
     /// The most the tool axis may lean from the part's +Z, degrees: contact points facing
-    /// further away are left out (default: 75°, or less if the machine's tilt range is).
+    /// further away are left out (default: as far as the machine's tilt axis reaches).
     #[arg(long = "max-tilt")]
     pub max_tilt_deg: Option<f64>,
+    /// The surface parameter the passes run along: u or v (the other is stepped over), or
+    /// auto: v unless a v boundary is a single point (a sphere's pole), then u.
+    #[arg(long = "feed-along", default_value = "auto")]
+    pub feed_along: String,
     /// Dexel spacing of the verifying simulation, mm (default: a twentieth of the
     /// step-over; coarser is faster and widens the reported grid bound).
     #[arg(long = "verify-cell")]
     pub verify_cell_mm: Option<f64>,
 }
 
-/// How far the tool leans from vertical at most unless `--max-tilt` says otherwise: a
-/// table-tilting machine reaches the part from above, and the links retract along the tool
-/// axis to the safe plane, running `tan θ` times the height sideways (3.7× at 75°, 57× at 89°).
-pub const DEFAULT_MAX_TILT_DEG: f64 = 75.0;
+/// The most `--max-tilt` can say: the tool axis straight down. By default the machine's tilt
+/// range decides (table-ac: 120°, past a vertical face into undercuts): the links retract
+/// along the tool axis to a clearance sphere and turn the table only there, which is safe
+/// for any tilt.
+pub const MAX_TILT_DEG: f64 = 180.0;
 
 /// What the strategy is asked for.
 pub struct PlanRequest {
@@ -90,6 +95,8 @@ pub struct PlanRequest {
     pub face: Option<u64>,
     /// The most the tool axis may lean from +Z, degrees.
     pub max_tilt_deg: f64,
+    /// The parameter the passes run along (`None`: chosen for the surface).
+    pub direction: Option<FeedDirection>,
 }
 
 /// How close a face's loops must run to its surface's domain boundary for the face to count
@@ -139,14 +146,42 @@ fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -
     Ok(face)
 }
 
+/// Samples per parameter of each face for the part's box.
+const BOX_SAMPLES: usize = 64;
+
+/// A box holding every face of the model: each surface sampled on a 65 × 65 grid, grown by
+/// 1 mm for what falls between samples (the links add their clearance on top).
+fn part_box(model: &tezgah_cam::step::StepModel) -> Option<PartBox> {
+    let mut points = Vec::new();
+    for face in &model.faces {
+        let s = &face.surface;
+        let (du, dv) = (s.domain_u(), s.domain_v());
+        for i in 0..=BOX_SAMPLES {
+            for j in 0..=BOX_SAMPLES {
+                let u = du.0 + (du.1 - du.0) * i as f64 / BOX_SAMPLES as f64;
+                let v = dv.0 + (dv.1 - dv.0) * j as f64 / BOX_SAMPLES as f64;
+                points.push(s.point(u, v));
+            }
+        }
+    }
+    PartBox::of_points(&points).map(|b| b.grown(1.0))
+}
+
+/// What the strategy planned on a face of a STEP file.
+struct Planned {
+    surface: NurbsSurface,
+    path: ToolPath,
+    /// A box around every face of the file: the part the links keep clear of.
+    part: Option<PartBox>,
+    /// The parameter the passes run along.
+    direction: FeedDirection,
+}
+
 /// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
 /// points the strategy could not correct are left out of the path and listed here.
-fn plan_surface(
-    path: &Path,
-    cutter: Cutter,
-    request: &PlanRequest,
-) -> Result<(NurbsSurface, ToolPath)> {
+fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Planned> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
+    let part = part_box(&model);
     let face = pick_face(path, model, request.face)?;
     let mut settings = Settings::new(request.strategy, request.scallop_mm, request.tolerance_mm);
     if let ToolAxis::Surface {
@@ -158,6 +193,9 @@ fn plan_surface(
     // Cut the face's outside: the side its orientation says the material is not.
     settings.reverse_normal = !face.same_sense;
     settings.max_axis_tilt_deg = Some(request.max_tilt_deg);
+    settings.direction = request
+        .direction
+        .unwrap_or_else(|| FeedDirection::for_surface(&face.surface));
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let out_of_reach = plan
@@ -193,7 +231,12 @@ fn plan_surface(
             plan.refused.len()
         ));
     }
-    Ok((face.surface, plan.path))
+    Ok(Planned {
+        surface: face.surface,
+        path: plan.path,
+        part,
+        direction: settings.direction,
+    })
 }
 
 fn positive(name: &str, v: f64) -> Result<f64> {
@@ -229,6 +272,12 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .strategy
         .parse()
         .map_err(|e| miette!("--strategy {}: {e}", args.strategy))?;
+    let direction = match args.feed_along.as_str() {
+        "v" => Some(FeedDirection::AlongV),
+        "u" => Some(FeedDirection::AlongU),
+        "auto" => None,
+        other => return Err(miette!("--feed-along must be u, v or auto, got {other}")),
+    };
     let machine = crate::run::load_machine(Some(args.machine.as_deref().unwrap_or("table-ac")))?;
     if !matches!(
         machine.kinematics,
@@ -247,11 +296,15 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         .joint_limits()
         .get(3)
         .map(|l| l.min.abs().max(l.max.abs()).to_degrees())
-        .unwrap_or(DEFAULT_MAX_TILT_DEG);
+        .unwrap_or(MAX_TILT_DEG);
     let max_tilt_deg = match args.max_tilt_deg {
-        Some(t) if t.is_finite() && t > 0.0 && t < 90.0 => t,
-        Some(t) => return Err(miette!("--max-tilt must be an angle in (0°, 90°), got {t}")),
-        None => DEFAULT_MAX_TILT_DEG.min(reach_deg),
+        Some(t) if t.is_finite() && t > 0.0 && t <= MAX_TILT_DEG => t,
+        Some(t) => {
+            return Err(miette!(
+                "--max-tilt must be an angle in (0°, 180°], got {t}"
+            ))
+        }
+        None => MAX_TILT_DEG.min(reach_deg),
     };
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
@@ -269,8 +322,14 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         tilt_deg: args.tilt_deg,
         face: args.face,
         max_tilt_deg,
+        direction,
     };
-    let (surface, path) = plan_surface(&args.surface, cutter, &request)?;
+    let Planned {
+        surface,
+        path,
+        part,
+        direction,
+    } = plan_surface(&args.surface, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
             OutputForm::Joints
@@ -284,7 +343,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         },
         tool_number: args.tool_number,
         tool_length_mm: length,
-        part_top_z: Some(part_top(&surface)),
+        part,
         title: format!(
             "{} {} {} scallop {} mm",
             args.surface.display(),
@@ -298,7 +357,11 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
-    let json = report_json(&args, &machine, &path, &done, scallop);
+    let mut json = report_json(&args, &machine, &path, &done, scallop);
+    json["feed_along"] = serde_json::json!(match direction {
+        FeedDirection::AlongU => "u",
+        FeedDirection::AlongV => "v",
+    });
     if let Some(p) = &args.report {
         crate::library::write_json(p, &json)?;
     }
@@ -308,23 +371,6 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     } else {
         ExitCode::FAILURE
     })
-}
-
-/// The highest point of a surface: its control points' (the convex-hull property holds for
-/// positive weights).
-fn part_top(surface: &NurbsSurface) -> f64 {
-    let (du, dv) = (surface.domain_u(), surface.domain_v());
-    // The grid of control points is not public; a dense sample plus the largest deviation a
-    // 64-step sampling can miss is enough for a safe plane that has a clearance anyway.
-    let mut top = f64::NEG_INFINITY;
-    for i in 0..=64 {
-        for j in 0..=64 {
-            let u = du.0 + (du.1 - du.0) * i as f64 / 64.0;
-            let v = dv.0 + (dv.1 - dv.0) * j as f64 / 64.0;
-            top = top.max(surface.point(u, v).z);
-        }
-    }
-    top
 }
 
 /// A posted program and its verification.
@@ -423,7 +469,11 @@ fn report_json(
         "output_points": s.points,
         "inserted_points": s.inserted,
         "max_linearisation_mm": s.max_linearisation_mm,
-        "safe_z_mm": s.safe_z,
+        "clearance_sphere": s.clearance.map(|c| serde_json::json!({
+            "centre": [c.centre.x, c.centre.y, c.centre.z],
+            "radius_mm": c.radius,
+            "part_radius_mm": c.part_radius,
+        })),
         "max_scallop_mm": v.max_scallop_mm,
         "max_scallop_at": at(&v.max_scallop_at),
         "gouge_depth_mm": v.gouge_depth_mm,
@@ -529,8 +579,7 @@ mod tests {
     fn finish_posts_and_verifies_a_plane_job() {
         let machine = Machine::builtin("table-ac").unwrap();
         let (surface, path) = plane_job(1.0);
-        let mut options = PostOptions::new(1000.0, 0.01);
-        options.part_top_z = Some(part_top(&surface));
+        let options = PostOptions::new(1000.0, 0.01);
         let done = finish(&surface, &path, &machine, &options, None).unwrap();
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.

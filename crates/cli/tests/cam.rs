@@ -209,7 +209,8 @@ fn cam_refuses_bad_options_without_a_panic() {
     assert!(!out_ngc.exists());
     // Out-of-range reach and verification options are refused before any file is read.
     for (flag, value, word) in [
-        ("--max-tilt", "95", "--max-tilt"),
+        ("--max-tilt", "181", "--max-tilt"),
+        ("--feed-along", "w", "--feed-along"),
         ("--max-tilt", "0", "--max-tilt"),
         ("--verify-cell", "0", "--verify-cell"),
     ] {

@@ -4,6 +4,7 @@
 
 use std::fmt::Write as _;
 
+use super::clearance::Clearance;
 use super::linearise::MachineMotion;
 use super::links::Motion;
 use super::{FeedOutput, OutputForm, PostError, PostOptions, PostedPoint};
@@ -69,7 +70,7 @@ pub fn program(
     motion: &MachineMotion<'_>,
     options: &PostOptions,
     letters: [char; 2],
-    safe: f64,
+    sphere: &Clearance,
 ) -> Result<String, PostError> {
     let mut out = String::new();
     let tool = options.tool_number;
@@ -90,10 +91,13 @@ pub fn program(
     comment(
         &mut out,
         &format!(
-            "feed {} mm/min, linearisation tolerance {} mm, safe plane Z{} on the part",
+            "feed {} mm/min, linearisation tolerance {} mm, links on the sphere R{} about X{} Y{} Z{} of the part",
             number(options.feed_mm_per_min),
             options.tolerance_mm,
-            number(safe)
+            number(sphere.radius),
+            number(sphere.centre.x),
+            number(sphere.centre.y),
+            number(sphere.centre.z)
         ),
     );
     let _ = writeln!(out, "G21 G17 G90 G40 G94 G64");
@@ -107,8 +111,8 @@ pub fn program(
     match motion.form {
         OutputForm::CentrePoint => {
             let _ = writeln!(out, "G43.4 H{tool}");
-            // From wherever the machine is, up to the safe plane at the current orientation,
-            // then across it with the tool vertical.
+            // From wherever the machine is, up to the top of the clearance sphere at the
+            // current orientation, then to its top with the tool vertical.
             let _ = writeln!(out, "G0 Z{}", number(first.tip.z));
         }
         OutputForm::Joints => {

@@ -17,6 +17,7 @@ use tezgah_kinematics::{Joints, Kinematics, Tool};
 
 use nalgebra::Unit;
 
+use super::links::Motion;
 use super::orient::{Orienter, TableAngles};
 use super::{OutputForm, PostError, PostedPoint};
 
@@ -134,7 +135,8 @@ impl MachineMotion<'_> {
     }
 
     /// `points` with points inserted wherever a segment strays more than `tolerance` from the
-    /// path; returns the largest deviation left and the number inserted.
+    /// path (rapid links excepted); returns the largest deviation left and the number
+    /// inserted.
     pub fn refine(
         &self,
         points: Vec<PostedPoint>,
@@ -203,6 +205,15 @@ impl MachineMotion<'_> {
         worst: &mut f64,
         inserted: &mut usize,
     ) -> Result<(), PostError> {
+        // A rapid move (a link: retract, move on the clearance sphere, approach) stands for no
+        // path on the part: the machine's own motion is what it is meant to be. Its clearance
+        // is checked on that motion after posting (`check_clear`); moves at one axis are
+        // straight anyway. Halving it toward great-circle axes would only add points, and
+        // past 90° of tilt the great circle between two reachable axes can leave the limits.
+        if next.motion == Motion::Rapid {
+            out.push(next);
+            return Ok(());
+        }
         {
             // Depth-first halving: a stack of pending ends with their depth.
             let mut stack = vec![(next, 0u32)];

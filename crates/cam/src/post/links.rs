@@ -1,15 +1,19 @@
 //! The stations of a posted program: every cutter location of every pass, and the links
-//! between passes — retract along the tool axis to the safe plane, move there to the next
-//! pass, plunge back along its axis. First step of the post-processor, before the angles.
+//! between passes — retract along the tool axis to the clearance sphere, turn the table
+//! there, move on the sphere to the next pass, turn, come down its axis and plunge. First
+//! step of the post-processor, before the angles.
 //!
-//! The safe plane lies a clearance plus the cutter radius above the highest point of the part
-//! (or of the tool path): a tool whose axis points upward (`k > 0`) has no point lower than
-//! its radius below the tip, so a link at that height cannot touch the part.
+//! The sphere ([`Clearance`]) holds the part and the tool's widest radius with a clearance
+//! to spare; on it, with the link axes [`Clearance::link_axis`] gives, the whole tool stands
+//! outside the part's ball, so the table turns only where it cannot touch the part. The
+//! retract and the approach keep the tool axis fixed (no rotary motion), along the line the
+//! tool itself occupies while it cuts, for any tilt the machine reaches.
 
+use nalgebra::Unit;
 use tezgah_geom::Vec3;
 
-use super::PostError;
-use crate::toolpath::ToolPath;
+use super::clearance::Clearance;
+use crate::toolpath::{CutterLocation, ToolPath};
 
 /// How the tool gets to a station.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -35,60 +39,56 @@ pub struct Station {
     pub place: Option<(usize, usize)>,
 }
 
-/// Smallest upward component of a tool axis that can still be retracted to the safe plane.
-const MIN_AXIS_Z: f64 = 1e-3;
-
-/// The safe plane's height: `clearance` plus the cutter radius above `part_top` or above the
-/// highest tip and contact point of the path, whichever is higher.
-pub fn safe_height(path: &ToolPath, part_top: Option<f64>, clearance: f64) -> f64 {
-    let top = path
-        .passes
-        .iter()
-        .flat_map(|p| &p.points)
-        .map(|c| c.tip.z.max(c.contact.z))
-        .fold(part_top.unwrap_or(f64::NEG_INFINITY), f64::max);
-    top + clearance + path.cutter.shape.radius()
+/// Where the tool is between passes: on the sphere, with its axis.
+#[derive(Clone, Copy)]
+struct Pose {
+    tip: Vec3,
+    axis: Vec3,
 }
 
-/// The point where the line from `tip` along `axis` meets the plane `z = safe`.
-fn lifted(tip: Vec3, axis: Vec3, safe: f64, at: (usize, usize)) -> Result<Vec3, PostError> {
-    if axis.z < MIN_AXIS_Z {
-        return Err(PostError::NoRetract {
-            pass: at.0,
-            point: at.1,
-        });
-    }
-    let lambda = ((safe - tip.z) / axis.z).max(0.0);
-    Ok(tip + axis * lambda)
+fn tilt(axis: &Vec3) -> f64 {
+    axis.z.clamp(-1.0, 1.0).acos()
 }
 
-/// Every station in order: above the first pass with the tool vertical, then for each pass
-/// its approach (rapid), plunge, cuts and retract, and last the tool vertical again above the
-/// final retract. Cutter locations repeated in place (same tip and axis) are dropped.
-pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
+/// Every station in order: the top of the sphere with the tool vertical, then for each pass
+/// the link to it, its approach and plunge, its cuts and the retract, and last the link back
+/// to the top with the tool vertical. Cutter locations repeated in place are dropped.
+/// `approach` is the distance above the first point where the rapid approach ends and the
+/// plunge at the feed begins, mm.
+pub fn stations(path: &ToolPath, sphere: &Clearance, approach: f64) -> Vec<Station> {
     let mut out: Vec<Station> = Vec::new();
+    let start = Pose {
+        tip: sphere.top(),
+        axis: Vec3::z(),
+    };
+    out.push(Station {
+        tip: start.tip,
+        axis: start.axis,
+        motion: Motion::Rapid,
+        source: None,
+        place: None,
+    });
+    let mut here = start;
     for (p, pass) in path.passes.iter().enumerate() {
         let Some(first) = pass.points.first() else {
             continue;
         };
-        let above = lifted(first.tip, first.axis, safe, (p, 0))?;
-        if out.is_empty() {
-            out.push(Station {
-                tip: Vec3::new(above.x, above.y, safe),
-                axis: Vec3::z(),
-                motion: Motion::Rapid,
-                source: None,
-                place: None,
-            });
-        }
-        out.push(Station {
-            tip: above,
+        let last_index = pass.points.len() - 1;
+        let entry = Pose {
+            tip: sphere.exit(&first.tip, &first.axis),
             axis: first.axis,
-            motion: Motion::Rapid,
-            source: None,
-            place: Some((p, 0)),
-        });
-        let mut last = first;
+        };
+        link(&mut out, sphere, here, entry, Some((p, 0)));
+        let depth = (first.tip - entry.tip).norm();
+        if depth > approach {
+            push(
+                &mut out,
+                first.tip + first.axis * approach,
+                first.axis,
+                Motion::Rapid,
+                Some((p, 0)),
+            );
+        }
         out.push(Station {
             tip: first.tip,
             axis: first.axis,
@@ -96,6 +96,7 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
             source: Some((p, 0)),
             place: Some((p, 0)),
         });
+        let mut last: &CutterLocation = first;
         for (i, cl) in pass.points.iter().enumerate().skip(1) {
             if (cl.tip - last.tip).norm() <= 1e-9 && (cl.axis - last.axis).norm() <= 1e-12 {
                 continue;
@@ -109,24 +110,111 @@ pub fn stations(path: &ToolPath, safe: f64) -> Result<Vec<Station>, PostError> {
             });
             last = cl;
         }
-        let at = (p, pass.points.len() - 1);
-        let up = lifted(last.tip, last.axis, safe, at)?;
-        out.push(Station {
-            tip: up,
+        here = Pose {
+            tip: sphere.exit(&last.tip, &last.axis),
             axis: last.axis,
-            motion: Motion::Rapid,
-            source: None,
-            place: Some(at),
-        });
+        };
+        push(
+            &mut out,
+            here.tip,
+            here.axis,
+            Motion::Rapid,
+            Some((p, last_index)),
+        );
     }
-    if let Some(end) = out.last().copied() {
-        out.push(Station {
-            tip: end.tip,
-            axis: Vec3::z(),
-            motion: Motion::Rapid,
-            source: None,
-            place: None,
-        });
+    link(&mut out, sphere, here, start, None);
+    out
+}
+
+/// A rapid station, unless it repeats the last one.
+fn push(
+    out: &mut Vec<Station>,
+    tip: Vec3,
+    axis: Vec3,
+    motion: Motion,
+    place: Option<(usize, usize)>,
+) {
+    if let Some(l) = out.last() {
+        if (l.tip - tip).norm() <= 1e-9 && (l.axis - axis).norm() <= 1e-12 {
+            return;
+        }
     }
-    Ok(out)
+    out.push(Station {
+        tip,
+        axis,
+        motion,
+        source: None,
+        place,
+    });
+}
+
+/// Samples per link move where [`link`] tests the tool's clearance.
+const LINK_SAMPLES: usize = 8;
+
+/// From `from` to `to`, both on the sphere, as [`Clearance::traverse`] runs. The tool axis
+/// turns from one pass's axis to the other's along the way when that keeps the whole tool
+/// clear of the part's ball at every station and between them (the table then turns no more
+/// than the passes need — none between parallel passes); otherwise it turns on the spot to
+/// the link axes, which are always clear, and back at the end. Those lean no further than
+/// the larger of the two axes' tilts, so a link asks no more of the tilt axis than the
+/// cutting on either side of it.
+fn link(
+    out: &mut Vec<Station>,
+    sphere: &Clearance,
+    from: Pose,
+    to: Pose,
+    place: Option<(usize, usize)>,
+) {
+    let route = sphere.traverse(&from.tip, &to.tip);
+    if let Some(axes) = turning(sphere, &from, &to, &route) {
+        for (q, a) in route.iter().zip(axes) {
+            push(out, *q, a, Motion::Rapid, place);
+        }
+        return;
+    }
+    let cap = tilt(&from.axis).max(tilt(&to.axis));
+    push(
+        out,
+        from.tip,
+        sphere.link_axis(&from.tip, cap),
+        Motion::Rapid,
+        place,
+    );
+    for q in &route {
+        push(out, *q, sphere.link_axis(q, cap), Motion::Rapid, place);
+    }
+    push(out, to.tip, to.axis, Motion::Rapid, place);
+}
+
+/// The axes turning evenly from `from`'s to `to`'s over `route` (one per point), if the tool
+/// stays clear, with half the clearance to spare, all the way: at every point and at [`LINK_SAMPLES`] places between points
+/// (tip on the chord, axis between the two), and no axis tilts further than both ends do.
+fn turning(sphere: &Clearance, from: &Pose, to: &Pose, route: &[Vec3]) -> Option<Vec<Vec3>> {
+    let (ua, ub) = (Unit::new_normalize(from.axis), Unit::new_normalize(to.axis));
+    let n = route.len();
+    let cap = tilt(&from.axis).max(tilt(&to.axis)) + 1e-9;
+    let mut axes = Vec::with_capacity(n);
+    for k in 1..=n {
+        let a = ua.try_slerp(&ub, k as f64 / n as f64, 1e-9)?.into_inner();
+        if tilt(&a) > cap {
+            return None;
+        }
+        axes.push(a);
+    }
+    // Half the clearance to spare: the machine's motion between stations may stray from
+    // this blend by the linearisation tolerance, and the check after posting allows none.
+    let margin = 0.5 * (sphere.radius - sphere.part_radius - sphere.tool_radius);
+    let mut before = (from.tip, from.axis);
+    for (q, a) in route.iter().zip(&axes) {
+        for k in 1..=LINK_SAMPLES {
+            let t = k as f64 / LINK_SAMPLES as f64;
+            let tip = before.0 + (q - before.0) * t;
+            let axis = (before.1 * (1.0 - t) + a * t).normalize();
+            if !sphere.clear_by(&tip, &axis, margin) {
+                return None;
+            }
+        }
+        before = (*q, *a);
+    }
+    Some(axes)
 }

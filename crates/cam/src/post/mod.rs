@@ -2,12 +2,13 @@
 //! [`ToolPath`] into G-code that `tezgah check` accepts and `tezgah run` executes. Comes after
 //! the strategies; its output feeds the verifying simulation ([`crate::verify`]) and the CLI.
 //!
-//! Steps, one module each: [`links`] (stations: passes plus retract / link / plunge through
-//! the safe plane), [`orient`] (both inverse solutions, the branch choice along the whole
+//! Steps, one module each: [`clearance`] (the sphere the links run on), [`links`] (stations:
+//! passes plus retract / link / plunge through that sphere), [`orient`] (both inverse solutions, the branch choice along the whole
 //! path, the pole, C unwrapped), the joints through the kinematics crate (limits checked),
 //! [`linearise`] (points inserted where the machine's motion strays from the path), [`emit`]
 //! (the G-code text, feed per minute or inverse time).
 
+pub mod clearance;
 pub mod emit;
 pub mod linearise;
 pub mod links;
@@ -18,6 +19,8 @@ use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, Too
 
 use crate::toolpath::ToolPath;
 use crate::verify::CutterPose;
+use clearance::Clearance;
+pub use clearance::PartBox;
 use linearise::MachineMotion;
 use links::{Motion, Station};
 use orient::{Orienter, TableAngles};
@@ -57,9 +60,11 @@ pub struct PostOptions {
     pub tool_number: u32,
     /// The tool's length (tool table), mm: enters the machine's Z and its limit check.
     pub tool_length_mm: f64,
-    /// Highest point of the part, if known (else the highest point of the path is used).
-    pub part_top_z: Option<f64>,
-    /// Safe plane clearance above the part plus the cutter radius, mm.
+    /// A box holding the whole part, if known (else the box of the path's contact points and
+    /// tips is used): the links keep clear of it.
+    pub part: Option<PartBox>,
+    /// Clearance between the tool's widest radius and the ball holding the part on the
+    /// links, and the length of the plunge at the feed into each pass, mm.
     pub clearance_mm: f64,
     /// Spindle speed for `S… M3`, if any.
     pub spindle_rpm: Option<f64>,
@@ -79,7 +84,7 @@ impl PostOptions {
             tolerance_mm,
             tool_number: 1,
             tool_length_mm: 0.0,
-            part_top_z: None,
+            part: None,
             clearance_mm: 5.0,
             spindle_rpm: None,
             max_halvings: 24,
@@ -97,8 +102,8 @@ pub enum PostError {
     Option { what: &'static str, value: f64 },
     #[error("pass {pass} point {point}: tip or tool axis not finite, or the axis is zero")]
     BadLocation { pass: usize, point: usize },
-    #[error("pass {pass} point {point}: the tool axis does not point up, so the tool cannot retract to the safe plane along it")]
-    NoRetract { pass: usize, point: usize },
+    #[error("{}: the table turns where the tool is not clear of the part's bounding ball", place(*at))]
+    Unclear { at: Option<(usize, usize)> },
     #[error("{}: {error}", place(*at))]
     Kinematics {
         at: Option<(usize, usize)>,
@@ -156,8 +161,8 @@ pub struct PostStats {
     pub inserted: usize,
     /// Largest deviation of the machine's motion from the path left after insertion, mm.
     pub max_linearisation_mm: f64,
-    /// Height of the safe plane (part frame), mm.
-    pub safe_z: f64,
+    /// The sphere the links run on (part frame).
+    pub clearance: Option<Clearance>,
 }
 
 /// A posted program: its points, text and figures.
@@ -250,8 +255,9 @@ pub fn post(
         reach,
     };
 
-    let safe = links::safe_height(&path, options.part_top_z, options.clearance_mm);
-    let stations = links::stations(&path, safe)?;
+    let sphere = Clearance::around(&path, options.part.as_ref(), options.clearance_mm)
+        .map_err(|_| PostError::Empty)?;
+    let stations = links::stations(&path, &sphere, options.clearance_mm);
     let axes: Vec<Vec3> = stations.iter().map(|s| s.axis).collect();
     let home = TableAngles { tilt: 0.0, c: 0.0 };
     let angles = orienter
@@ -273,12 +279,13 @@ pub fn post(
         points.push(point(s, *a, joints));
     }
     let (points, worst, inserted) = motion.refine(points, tolerance, options.max_halvings)?;
+    check_clear(&points, &motion, &sphere)?;
 
     let mut stats = PostStats {
         points: points.len(),
         inserted,
         max_linearisation_mm: worst,
-        safe_z: safe,
+        clearance: Some(sphere),
         ..PostStats::default()
     };
     for w in points.windows(2) {
@@ -290,7 +297,7 @@ pub fn post(
         }
     }
     stats.feed_time_s = 60.0 * (stats.cutting_length_mm + stats.plunge_length_mm) / feed;
-    let program = emit::program(&points, &motion, options, letters, safe)?;
+    let program = emit::program(&points, &motion, options, letters, &sphere)?;
     Ok(Posted {
         points,
         program,
@@ -300,6 +307,38 @@ pub fn post(
         tool,
         reach,
     })
+}
+
+/// Requested axes closer than this (rad) count as one: the limit normals at a pole differ
+/// by ~10⁻⁸ with the side they are taken from.
+const STILL_AXIS: f64 = 1e-6;
+
+/// Samples per link move checked for clearance while the table turns.
+const CLEAR_SAMPLES: usize = 8;
+
+/// Every move that turns the tool, off the cutting (a link), keeps the whole tool outside
+/// the part's ball at every sample as the machine moves it. Moves between two stations of
+/// the same axis (retract, approach, C turned at the pole; [`STILL_AXIS`]) do not turn the
+/// tool: the table may move there only within the linearisation tolerance, checked already.
+fn check_clear(
+    points: &[PostedPoint],
+    motion: &MachineMotion<'_>,
+    sphere: &Clearance,
+) -> Result<(), PostError> {
+    for w in points.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        let turn = (b.angles.tilt - a.angles.tilt).abs() + (b.angles.c - a.angles.c).abs();
+        if b.motion != Motion::Rapid || turn <= 1e-12 || a.axis.angle(&b.axis) <= STILL_AXIS {
+            continue;
+        }
+        for k in 0..=CLEAR_SAMPLES {
+            let (tip, axis) = motion.pose_at(a, b, k as f64 / CLEAR_SAMPLES as f64)?;
+            if !sphere.is_clear(&tip, &axis) {
+                return Err(PostError::Unclear { at: b.source });
+            }
+        }
+    }
+    Ok(())
 }
 
 fn point(s: &Station, angles: TableAngles, joints: Joints) -> PostedPoint {

@@ -28,8 +28,14 @@ struct FrontPoint {
 /// Relative excess of the gap between fronts over the allowed step tolerated before
 /// [`pull_back`] moves a point.
 const PULL_BACK_SLACK: f64 = 0.002;
+/// Relative narrowing of the side step at the new pass, compared with the old, above which
+/// the offset is redone with the narrower step.
+const NARROWING_SLACK: f64 = 0.01;
 /// Front points on either side used for the front's tangent.
 const TANGENT_STENCIL: usize = 3;
+/// Samples of the way to the far edge searched for a point beyond the side step when the
+/// edge itself lies within it (a closed surface: the far edge is the seam it started from).
+const SEAM_SCAN: usize = 64;
 /// Root-search iterations for one offset (bracketed, so the bound only stops a stall).
 const OFFSET_ITERATIONS: usize = 40;
 
@@ -127,7 +133,20 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
                 .unwrap_or(ctx.settings.scallop)
         });
         let (dir_s, dir_f) = cross_direction(ctx, &local);
-        let moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        let mut moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        // The step is set by the curvature at the old pass; where it changes quickly across
+        // the step (a blade's rounded edge) the surface between the passes allows less, and
+        // the ridge can stand anywhere there. The smallest step over samples of the way is
+        // taken (twice: the narrower way may hold a narrower place still).
+        let mut w = w;
+        for _ in 0..2 {
+            let narrowest = narrowest_step(ctx, p, moved, tangent).unwrap_or(w);
+            if narrowest >= w * (1.0 - NARROWING_SLACK) {
+                break;
+            }
+            w = narrowest;
+            moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        }
         next.push(moved);
         steps.push(w);
         kept.push(p);
@@ -235,6 +254,29 @@ fn cross_direction(ctx: &Context, local: &super::Local) -> (f64, f64) {
     (ds, df)
 }
 
+/// Samples of the way between a front point and its offset where [`narrowest_step`] looks.
+const WAY_SAMPLES: usize = 4;
+
+/// The smallest side step allowed at [`WAY_SAMPLES`] places on the straight parameter line
+/// from `from` to `to` (`to` included), for a pass running along `tangent`; `None` if none
+/// has one.
+fn narrowest_step(
+    ctx: &Context,
+    from: FrontPoint,
+    to: FrontPoint,
+    tangent: (f64, f64),
+) -> Option<f64> {
+    (1..=WAY_SAMPLES)
+        .filter_map(|k| {
+            let x = k as f64 / WAY_SAMPLES as f64;
+            let (u, v) = ctx
+                .axes
+                .uv(from.s + (to.s - from.s) * x, from.f + (to.f - from.f) * x);
+            ctx.local(u, v, tangent).and_then(|l| ctx.side_step(&l))
+        })
+        .reduce(f64::min)
+}
+
 /// `p` moved along the parameter direction `dir` until its surface point lies `w` mm (chord)
 /// from `origin`, or onto the far edge if that comes first.
 fn offset(ctx: &Context, p: FrontPoint, dir: (f64, f64), origin: &Vec3, w: f64) -> FrontPoint {
@@ -263,11 +305,27 @@ fn offset(ctx: &Context, p: FrontPoint, dir: (f64, f64), origin: &Vec3, w: f64) 
         return edge_point(0.0);
     }
     let g_edge = dist(to_edge);
-    if g_edge <= 0.0 {
-        return edge_point(to_edge);
-    }
-    // Bracketed Illinois (regula falsi) on g(λ) = |S(p + λ·dir) − origin| − w, g(0) = −w.
     let (mut lo, mut glo, mut hi, mut ghi) = (0.0, -w, to_edge, g_edge);
+    if g_edge <= 0.0 {
+        // Within reach of the far edge — unless the surface closes on itself (a seam: the far
+        // edge is the near one), when it comes back within `w` of the origin after going far
+        // away. The first sample beyond `w` on the way brackets the true offset.
+        let mut found = false;
+        for k in 1..SEAM_SCAN {
+            let lam = to_edge * k as f64 / SEAM_SCAN as f64;
+            let g = dist(lam);
+            if g > 0.0 {
+                (hi, ghi) = (lam, g);
+                found = true;
+                break;
+            }
+            (lo, glo) = (lam, g);
+        }
+        if !found {
+            return edge_point(to_edge);
+        }
+    }
+    // Bracketed Illinois (regula falsi) on g(λ) = |S(p + λ·dir) − origin| − w, g(lo) ≤ 0.
     let mut side = 0;
     let mut lam = hi;
     for _ in 0..OFFSET_ITERATIONS {

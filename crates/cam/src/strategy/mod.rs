@@ -72,6 +72,46 @@ pub enum FeedDirection {
     AlongU,
 }
 
+/// Samples along a boundary curve when [`FeedDirection::for_surface`] measures it.
+const BOUNDARY_SAMPLES: usize = 32;
+
+/// A boundary shorter than this fraction of the longest one is a point (a pole).
+const DEGENERATE_BOUNDARY: f64 = 1e-6;
+
+impl FeedDirection {
+    /// The direction whose passes end on real boundary curves: passes along v end on the
+    /// boundaries v = const, so if one of those is a single point (a latitude–longitude
+    /// sphere's pole) the passes would all converge on it — crowded there and, for
+    /// iso-scallop, fronts that cannot stay monotone in v — and the passes run along u
+    /// instead (a sphere: parallels, each pole cut as a point). Along v otherwise.
+    pub fn for_surface(surface: &NurbsSurface) -> FeedDirection {
+        let (du, dv) = (surface.domain_u(), surface.domain_v());
+        let length = |at: &dyn Fn(f64) -> Vec3| {
+            (1..=BOUNDARY_SAMPLES)
+                .map(|k| {
+                    let (a, b) = (
+                        (k - 1) as f64 / BOUNDARY_SAMPLES as f64,
+                        k as f64 / BOUNDARY_SAMPLES as f64,
+                    );
+                    (at(b) - at(a)).norm()
+                })
+                .sum::<f64>()
+        };
+        let along_u_at = |v: f64| length(&|t| surface.point(du.0 + (du.1 - du.0) * t, v));
+        let along_v_at = |u: f64| length(&|t| surface.point(u, dv.0 + (dv.1 - dv.0) * t));
+        let v_ends = [along_u_at(dv.0), along_u_at(dv.1)];
+        let u_ends = [along_v_at(du.0), along_v_at(du.1)];
+        let longest = v_ends.iter().chain(&u_ends).fold(0.0_f64, |m, &x| m.max(x));
+        // A NaN length (a surface that does not evaluate) counts as a point too.
+        let point = |x: f64| x.is_nan() || x <= DEGENERATE_BOUNDARY * longest;
+        if v_ends.iter().any(|&x| point(x)) && !u_ends.iter().any(|&x| point(x)) {
+            FeedDirection::AlongU
+        } else {
+            FeedDirection::AlongV
+        }
+    }
+}
+
 /// How the tool axis stands.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ToolAxis {
@@ -113,8 +153,8 @@ pub struct Settings {
     /// cutter's effective radius, so the scallop there grows a little. `None`: no limit.
     pub max_lead_change_deg: Option<f64>,
     /// The most the tool axis may lean from the part's +Z, degrees: what a table-tilting
-    /// machine reaches from above (its C axis is the part's Z; the tilt axis' range and the
-    /// retract to a safe plane bound the lean). Contact points whose axis would lean further
+    /// machine reaches (its C axis is the part's Z; the tilt axis' range bounds the lean).
+    /// Contact points whose axis would lean further
     /// are left out as [`Refusal::OutOfReach`] and their passes split there — on a closed
     /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
     pub max_axis_tilt_deg: Option<f64>,
@@ -344,6 +384,11 @@ struct Local {
     curvature: Curvature2,
 }
 
+/// How far into the domain (fraction of the parameter range) the limit derivatives on a
+/// degenerate edge are taken: the normal there is off by about this angle times the range
+/// (a sphere: 3·10⁻⁸ rad), far below any tolerance, while the derivatives stay well defined.
+const LIMIT_NUDGE: f64 = 1e-8;
+
 /// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
 const MATCH_MARGIN: f64 = 0.05;
 /// Lean added per correction trial, degrees.
@@ -419,7 +464,43 @@ impl<'a> Context<'a> {
 
     /// Frame and curvature at `(u, v)` for a path running along `tangent_uv`.
     fn local(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Option<Local> {
-        self.local_of(self.surface.derivs(u, v), tangent_uv)
+        self.local_of(self.derivs(u, v), tangent_uv)
+    }
+
+    /// The surface's derivatives at `(u, v)`; on a degenerate edge (a pole, where one
+    /// parameter's derivative vanishes and the normal with it) those of the limit from inside:
+    /// the point itself with the derivatives a hair ([`LIMIT_NUDGE`] of the range) into the
+    /// domain across that edge, where the normal is defined. On a sphere's pole that is the
+    /// pole's normal to within the nudge's angle; the gouge checks stand guard where a
+    /// degenerate point has no single limit (an apex).
+    fn derivs(&self, u: f64, v: f64) -> SurfaceDerivs {
+        let d = self.surface.derivs(u, v);
+        if d.normal().is_some() {
+            return d;
+        }
+        let inward = |x: f64, (lo, hi): (f64, f64)| {
+            let e = LIMIT_NUDGE * (hi - lo);
+            if x - lo < hi - x {
+                x + e
+            } else {
+                x - e
+            }
+        };
+        let (du, dv) = (self.surface.domain_u(), self.surface.domain_v());
+        // The parameter whose derivative vanished runs along the edge; step across it.
+        let (nu, nv) = if d.su.norm() <= d.sv.norm() {
+            (u, inward(v, dv))
+        } else {
+            (inward(u, du), v)
+        };
+        let near = self.surface.derivs(nu, nv);
+        if near.normal().is_none() {
+            return d;
+        }
+        SurfaceDerivs {
+            point: d.point,
+            ..near
+        }
     }
 
     /// [`Self::local`] from derivatives already evaluated.
@@ -486,7 +567,7 @@ impl<'a> Context<'a> {
         tangent_uv: (f64, f64),
         min_lead: f64,
     ) -> Result<Placed, GougeReport> {
-        let d = self.surface.derivs(u, v);
+        let d = self.derivs(u, v);
         let contact = d.point;
         let refuse = |refusal| GougeReport {
             uv: (u, v),
@@ -662,6 +743,29 @@ impl<'a> Context<'a> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn passes_run_along_the_poles_not_into_them() {
+        // The patch of the tests has four real boundaries: along v. A surface whose v = 0
+        // boundary is one point (a fan of lines from the origin) runs along u.
+        let patch = crate::testing::sphere(30.0);
+        assert_eq!(FeedDirection::for_surface(&patch), FeedDirection::AlongV);
+        let pts = [
+            Vec3::zeros(),
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::zeros(),
+            Vec3::new(0.0, 10.0, 0.0),
+        ];
+        let fan = NurbsSurface::bspline(
+            1,
+            1,
+            &pts,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 1.0, 1.0],
+        )
+        .unwrap();
+        assert_eq!(FeedDirection::for_surface(&fan), FeedDirection::AlongU);
+    }
+
     use super::*;
 
     #[test]
