@@ -497,15 +497,25 @@ impl Interpreter {
         self.emit_or_hold(sink, call);
     }
 
-    /// A pose in the machine's units (tool table, parameters) in the program's units
-    /// (LinuxCNC's `USER_TO_PROGRAM_LEN`).
-    fn to_program_units(&self, p: Pose) -> Pose {
-        p.scale_linear(self.cfg.machine_units.mm() / self.state.units.mm())
+    /// Program units per machine unit: a length in the machine's units (tool table,
+    /// parameters) times this is in the program's units (LinuxCNC's `USER_TO_PROGRAM_LEN`).
+    fn program_per_machine_unit(&self) -> f64 {
+        self.cfg.machine_units.mm() / self.state.units.mm()
     }
 
-    /// A pose in the program's units in the machine's (LinuxCNC's `PROGRAM_TO_USER_LEN`).
+    /// Machine units per program unit (LinuxCNC's `PROGRAM_TO_USER_LEN`).
+    fn machine_per_program_unit(&self) -> f64 {
+        self.state.units.mm() / self.cfg.machine_units.mm()
+    }
+
+    /// A pose in the machine's units in the program's units (angles are not lengths).
+    fn to_program_units(&self, p: Pose) -> Pose {
+        p.scale_linear(self.program_per_machine_unit())
+    }
+
+    /// A pose in the program's units in the machine's.
     fn to_machine_units(&self, p: Pose) -> Pose {
-        p.scale_linear(self.state.units.mm() / self.cfg.machine_units.mm())
+        p.scale_linear(self.machine_per_program_unit())
     }
 
     /// Six offset parameters from `base` on, in program units.
