@@ -329,6 +329,9 @@ pub struct Origin {
     pub line: u32,
     /// The block's N word, if any.
     pub n: Option<i64>,
+    /// The text the line is in: 0 the program, k the k-th subroutine file the interpreter
+    /// loaded ([`crate::Interpreter::subroutine_file`]).
+    pub file: u16,
 }
 
 /// Receiver of canonical calls.

@@ -12,8 +12,8 @@
 use std::sync::Arc;
 
 use tezgah_geom::{
-    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, Pose, StopKind,
-    ToolControl, Vec3,
+    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, Pose, StopKind, ToolControl,
+    Vec3,
 };
 
 use crate::canon::{Canon, CanonSink, ControlMode, NurbsFeed, Origin, Units};

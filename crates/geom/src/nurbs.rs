@@ -512,7 +512,10 @@ mod tests {
             for k in 0..=20 {
                 let u = a + (b - a) * k as f64 / 20.0;
                 let (want, got) = (f(c.point(u)), m.point(u));
-                assert!((want - got).norm() < 1e-9 * (1.0 + want.norm()), "{case} {u}");
+                assert!(
+                    (want - got).norm() < 1e-9 * (1.0 + want.norm()),
+                    "{case} {u}"
+                );
             }
         }
     }

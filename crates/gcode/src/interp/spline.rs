@@ -49,8 +49,9 @@ pub(super) struct SplineMemory {
 /// A G6.2 NURBS while its lines are read.
 #[derive(Debug, Clone)]
 struct G62Block {
-    /// Line of the G6.2 word (for the error when the NURBS is left unfinished).
-    line: u32,
+    /// Where the G6.2 word is: the move belongs to it, and the error when the NURBS is left
+    /// unfinished names its line.
+    origin: Origin,
     order: usize,
     points: Vec<[f64; 3]>,
     weights: Vec<f64>,
@@ -266,7 +267,7 @@ impl Interpreter {
         }
         let at = block.g[ggroup::MOTION].map_or(0, |c| c.at);
         Err((
-            ErrorKind::G62Unfinished(open.line, open.closing, open.order),
+            ErrorKind::G62Unfinished(open.origin.line, open.closing, open.order),
             at,
         ))
     }
@@ -328,7 +329,10 @@ impl Interpreter {
         }
         let start = self.state.pos;
         let mut open = G62Block {
-            line: self.origin.line,
+            origin: Origin {
+                n: None,
+                ..self.origin
+            },
             order,
             points: Vec::new(),
             weights: Vec::new(),
@@ -401,10 +405,7 @@ impl Interpreter {
         let curve = build(order, &open.points, &open.weights, open.knots).map_err(|e| (e, at))?;
         let end = open.cursor;
         // The move belongs to the G6.2 line that began it, where samples and reports point.
-        let origin = Origin {
-            line: open.line,
-            n: None,
-        };
+        let origin = open.origin;
         if let Some(f) = open.inverse_time {
             // As a G1 or G2 under G93: the rate that runs the curve's length in 1/F minutes.
             let rate = inverse_time_rate(f, curve.length());

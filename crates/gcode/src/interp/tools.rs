@@ -148,7 +148,6 @@ impl Interpreter {
             self.params.set(TOOL_PARAMETERS + k, v);
         }
     }
-
 }
 
 /// The `named` axes of `offset` take their value from `value`; the others are kept.
