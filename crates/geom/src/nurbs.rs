@@ -177,7 +177,8 @@ impl Nurbs {
     /// The image of the curve under the affine map `f` (a change of frame, units or offsets):
     /// the NURBS of the mapped control points with the same weights and knots, which is the
     /// exact image because rational B-splines are invariant under affine maps (P&T §4.2). A
-    /// valid curve stays valid, so nothing is checked again; `f` must be affine.
+    /// valid curve stays valid, so nothing is checked again, and the Bézier cache is mapped
+    /// the same way instead of being derived again; `f` must be affine.
     pub fn mapped(&self, f: impl Fn(Vec3) -> Vec3) -> Nurbs {
         let cw = self
             .cw
@@ -193,9 +194,8 @@ impl Nurbs {
             cw,
             first: self.first,
             last: self.last,
-            spans: None,
+            spans: self.spans.as_ref().map(|s| s.mapped(&f)),
         }
-        .with_spans()
     }
 
     /// A non-rational B-spline (all weights 1).
@@ -498,7 +498,7 @@ mod tests {
                 knots.push(k as f64 + r() * 0.5);
             }
             knots.extend(std::iter::repeat_n((n - p) as f64, p + 1));
-            let c = Nurbs::new(p, &pts, &weights, knots).unwrap();
+            let c = Nurbs::new(p, &pts, &weights, knots.clone()).unwrap();
             let (angle, scale) = (r() * 6.0, 25.4 * r() + 0.1);
             let shift = Vec3::new(r() * 100.0, -r() * 50.0, r());
             let f = |q: Vec3| {
@@ -508,6 +508,11 @@ mod tests {
             let m = c.mapped(f);
             assert_eq!(m.knots(), c.knots());
             assert_eq!(m.weights(), c.weights());
+            // The same curve as one built from the mapped points, derivatives (and so the
+            // mapped Bézier cache) included.
+            let mapped: Vec<Vec3> = pts.iter().map(|&q| f(q)).collect();
+            let fresh = Nurbs::new(p, &mapped, &weights, knots).unwrap();
+            assert_eq!(m.spans.is_some(), fresh.spans.is_some());
             let (a, b) = c.domain();
             for k in 0..=20 {
                 let u = a + (b - a) * k as f64 / 20.0;
@@ -516,6 +521,11 @@ mod tests {
                     (want - got).norm() < 1e-9 * (1.0 + want.norm()),
                     "{case} {u}"
                 );
+                let (d, e) = (fresh.derivs(u), m.derivs(u));
+                for i in 0..3 {
+                    let tol = 1e-8 * (1.0 + d[i].norm());
+                    assert!((d[i] - e[i]).norm() < tol, "{case} {u} d{i}");
+                }
             }
         }
     }
