@@ -115,7 +115,7 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
         Ok(()) => Ok(ExitCode::SUCCESS),
         Err(e) => {
             let sources =
-                Sources::new(program, &text).with_subroutines(&interp, |name| extra.locate(name));
+                Sources::new(program, text).with_subroutines(&interp, |name| extra.locate(name));
             eprintln!("{:?}", diagnostics::report(&sources, &e));
             Ok(ExitCode::FAILURE)
         }
@@ -156,7 +156,7 @@ fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitC
         None => Pass::Check,
     };
     let done = source::interpret(
-        Sources::new(program, &text),
+        Sources::new(program, text),
         config,
         pass,
         |name| extra.locate(name),

@@ -184,7 +184,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
     let done = interpret(
-        Sources::new(&path_name, &text),
+        Sources::new(&path_name, text),
         config,
         Pass::Run,
         |name| extra.locate(name),

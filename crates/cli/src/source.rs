@@ -102,8 +102,9 @@ pub struct Sources {
 }
 
 impl Sources {
-    /// A program with no subroutine file loaded yet.
-    pub fn new(path: &Path, text: &str) -> Self {
+    /// A program with no subroutine file loaded yet (an owned `String` is moved, not copied
+    /// twice).
+    pub fn new(path: &Path, text: impl Into<Arc<str>>) -> Self {
         Sources {
             program: Source {
                 name: path.display().to_string(),
