@@ -96,7 +96,9 @@ fn check_with_a_machine_counts_and_passes_a_program_with_subroutines() {
     // One pass of the interpreter feeds the summary and the machine's pre-flight: the counts
     // are the program's (its lines, not the subroutine file's), and the moves reach the path.
     let dir = tmp_dir("sub-ok");
-    let (main, _) = program_with_sub(&dir, "square", "G1 X10\nG1 Y10\nG1 X0\nG1 Y0\n");
+    // The square's moves are on its file's lines 6 to 9, past the program's last line (5).
+    let body = "(one)\n(two)\n(three)\n(four)\nG1 X10\nG1 Y10\nG1 X0\nG1 Y0\n";
+    let (main, _) = program_with_sub(&dir, "square", body);
     let out = tezgah()
         .arg("check")
         .arg(&main)
@@ -109,7 +111,7 @@ fn check_with_a_machine_counts_and_passes_a_program_with_subroutines() {
         stdout.contains("OK on mill3, 5 lines, 0 rapid, 4 feed"),
         "{stdout}"
     );
-    // `run` prints each sample's line in its own file: the square's lines 2 to 5.
+    // `run` prints each sample's line in its own file: the square's lines 6 to 9.
     let csv = dir.join("samples.csv");
     let out = tezgah()
         .arg("run")
@@ -126,8 +128,8 @@ fn check_with_a_machine_counts_and_passes_a_program_with_subroutines() {
         .map(|row| row.split(',').nth(1).unwrap().parse().unwrap())
         .collect();
     lines.dedup();
-    assert_eq!(lines.iter().max(), Some(&5), "{lines:?}");
-    for line in 2..=5 {
+    assert_eq!(lines.iter().max(), Some(&9), "{lines:?}");
+    for line in 6..=9 {
         assert!(lines.contains(&line), "{lines:?}");
     }
 }
