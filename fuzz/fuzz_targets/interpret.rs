@@ -1,5 +1,5 @@
-//! Arbitrary bytes, read as (lossy) UTF-8, through the whole interpreter and through `check`.
-//! Errors are expected; a panic, a hang or an out-of-memory is a bug.
+//! Arbitrary bytes, read as (lossy) UTF-8, through the whole interpreter into moves and
+//! through `check`. Errors are expected; a panic, a hang or an out-of-memory is a bug.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

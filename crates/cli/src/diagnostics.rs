@@ -2,57 +2,54 @@
 //!
 //! The library's errors carry a `Span`; here they become `miette` reports with the source.
 
-use std::path::Path;
-
 use miette::{miette, LabeledSpan, NamedSource, Report};
-use tezgah_gcode::{Canon, CanonSink, GcodeError, Origin};
+use tezgah_gcode::{Canon, CanonSink, GcodeError, Origin, Span};
 
-/// A report naming `file:line:col` and underlining the place in the source.
-pub fn report(path: &Path, text: &str, e: &GcodeError) -> Report {
-    let name = path.display().to_string();
-    let span = e.span;
-    if let Some(file) = &e.file {
-        // In a subroutine file: name it; its text is not at hand here.
-        return miette!(
-            "{file}:{}:{}: {} (in a subroutine called from {name})",
-            span.line,
-            span.column,
-            e.kind
-        );
+use crate::source::{Source, SourceLine, Sources};
+
+/// A report naming `file:line:col` and underlining the place in the file the error is in (the
+/// program, or a subroutine file it called).
+pub fn report(sources: &Sources, e: &GcodeError) -> Report {
+    let Some(file) = &e.file else {
+        return located(&sources.program, e.span, 0, &e.kind.to_string());
+    };
+    let message = format!(
+        "{} (in a subroutine called from {})",
+        e.kind, sources.program.name
+    );
+    match sources.named(file) {
+        Some(source) => located(source, e.span, 0, &message),
+        // Not loaded (cannot happen for an error inside it): name it without its text.
+        None => miette!("{file}:{}: {message}", e.span),
     }
-    let label = LabeledSpan::at_offset(span.offset.min(text.len()), "here");
-    miette!(
-        labels = vec![label],
-        "{name}:{}:{}: {}",
-        span.line,
-        span.column,
-        e.kind
-    )
-    .with_source_code(NamedSource::new(name, text.to_string()))
 }
 
-/// A report for an error known only by its 1-based line (the path and the kinematics keep
-/// lines, not columns): `file:line:col` of the line's first word, underlined.
-pub fn report_line(path: &Path, text: &str, line: u32, message: &str) -> Report {
-    let name = path.display().to_string();
+/// A report for an error known only by its line (the path and the kinematics keep lines, not
+/// columns): `file:line:col` of the line's first word, the line's words underlined.
+pub fn report_line(sources: &Sources, at: SourceLine, message: &str) -> Report {
+    let source = sources.file(at.file);
+    let text = &source.text;
     let start: usize = text
         .split_inclusive('\n')
-        .take((line as usize).saturating_sub(1))
+        .take((at.line as usize).saturating_sub(1))
         .map(str::len)
         .sum();
     let body = text[start.min(text.len())..].lines().next().unwrap_or("");
     let indent = body.len() - body.trim_start().len();
-    let width = body.trim().len().max(1);
-    let label = LabeledSpan::at(
-        (start + indent).min(text.len())..(start + indent + width).min(text.len()),
-        "here",
-    );
-    miette!(
-        labels = vec![label],
-        "{name}:{line}:{}: {message}",
-        indent + 1
-    )
-    .with_source_code(NamedSource::new(name, text.to_string()))
+    let span = Span::in_line(at.line, body, start, indent);
+    located(source, span, body.trim().len().max(1), message)
+}
+
+/// `file:line:col: message`, with `width` bytes from the span underlined (a point for 0).
+fn located(source: &Source, span: Span, width: usize, message: &str) -> Report {
+    let len = source.text.len();
+    let from = span.offset.min(len);
+    let label = match width {
+        0 => LabeledSpan::at_offset(from, "here"),
+        _ => LabeledSpan::at(from..(from + width).min(len), "here"),
+    };
+    miette!(labels = vec![label], "{}:{span}: {message}", source.name)
+        .with_source_code(NamedSource::new(&source.name, source.text.to_string()))
 }
 
 /// Counts of what a program does, for `check`'s summary line.
@@ -68,7 +65,9 @@ pub struct Counts {
 
 impl CanonSink for Counts {
     fn call(&mut self, origin: Origin, call: Canon) {
-        self.lines = self.lines.max(origin.line);
+        if origin.file == 0 {
+            self.lines = self.lines.max(origin.line);
+        }
         match call {
             Canon::StraightTraverse(_) => self.rapids += 1,
             Canon::StraightFeed(_) => self.feeds += 1,

@@ -14,18 +14,28 @@ use tezgah_gcode::IniFile;
 #[derive(Debug)]
 pub struct Folders(Vec<PathBuf>);
 
-impl SubroutineLibrary for Folders {
-    fn source(&self, name: &str) -> Option<String> {
+impl Folders {
+    /// The file that defines subroutine `name`: `<name>.ngc` in the first folder that has it.
+    pub fn locate(&self, name: &str) -> Option<PathBuf> {
         self.0
             .iter()
-            .find_map(|dir| std::fs::read(dir.join(format!("{name}.ngc"))).ok())
-            .map(|bytes| String::from_utf8_lossy(&bytes).into_owned())
+            .map(|dir| dir.join(format!("{name}.ngc")))
+            .find(|path| path.is_file())
+    }
+}
+
+impl SubroutineLibrary for Folders {
+    fn source(&self, name: &str) -> Option<String> {
+        let bytes = std::fs::read(self.locate(name)?).ok()?;
+        Some(String::from_utf8_lossy(&bytes).into_owned())
     }
 }
 
 /// The subroutine library, INI file and parameter file of a program.
 pub struct ProgramInputs {
     pub subroutines: Option<Arc<dyn SubroutineLibrary>>,
+    /// The same folders, to name the file a subroutine was read from.
+    pub folders: Option<Arc<Folders>>,
     pub ini: Option<Arc<IniFile>>,
     pub parameters: Option<Arc<ParameterFile>>,
 }
@@ -94,9 +104,10 @@ pub fn program_inputs(
         .chain(from_ini)
         .chain(extra.iter().cloned())
         .collect();
+    let folders = (!dirs.is_empty()).then(|| Arc::new(Folders(dirs)));
     Ok(ProgramInputs {
-        subroutines: (!dirs.is_empty())
-            .then(|| Arc::new(Folders(dirs)) as Arc<dyn SubroutineLibrary>),
+        subroutines: folders.clone().map(|f| f as Arc<dyn SubroutineLibrary>),
+        folders,
         ini: ini.map(|(_, file)| file),
         parameters: load_parameters(parameters)?,
     })
@@ -126,6 +137,13 @@ pub struct Inputs {
     /// parameters the program starts with.
     #[arg(long)]
     pub params: Option<PathBuf>,
+}
+
+impl ProgramInputs {
+    /// Where subroutine `name` was read from, for reports.
+    pub fn locate(&self, name: &str) -> Option<PathBuf> {
+        self.folders.as_ref()?.locate(name)
+    }
 }
 
 impl Inputs {

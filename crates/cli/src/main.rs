@@ -8,6 +8,7 @@ mod library;
 mod plot;
 mod run;
 mod serve;
+mod source;
 mod tracking;
 
 use std::path::{Path, PathBuf};
@@ -16,6 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use library::Inputs;
 use miette::{IntoDiagnostic, Result};
+use source::{Pass, Sources};
 use tezgah_gcode::{Canon, CanonSink, Config, Interpreter, Origin};
 
 #[derive(Parser)]
@@ -95,9 +97,9 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     // As `rs274`: tool table and stored offsets in inches.
     let extra = inputs.program_inputs(Some(program))?;
     let config = Config {
-        subroutines: extra.subroutines,
-        ini: extra.ini,
-        parameters: extra.parameters,
+        subroutines: extra.subroutines.clone(),
+        ini: extra.ini.clone(),
+        parameters: extra.parameters.clone(),
         ..Config::linuxcnc(library::load_tool_table(inputs.tool_table.as_deref())?)
     };
     let mut interp = Interpreter::new(config);
@@ -112,7 +114,9 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     match result {
         Ok(()) => Ok(ExitCode::SUCCESS),
         Err(e) => {
-            eprintln!("{:?}", diagnostics::report(program, &text, &e));
+            let sources =
+                Sources::new(program, text).with_subroutines(&interp, |name| extra.locate(name));
+            eprintln!("{:?}", diagnostics::report(&sources, &e));
             Ok(ExitCode::FAILURE)
         }
     }
@@ -129,48 +133,53 @@ impl<W: std::io::Write> tezgah_gcode::CanonSink for Printer<'_, W> {
     }
 }
 
-/// `tezgah check`: every error with its place, or a summary of the program.
+/// `tezgah check`: every error with its place, or a summary of the program. The program is
+/// interpreted once; with a machine, its moves go on to the path and the machine's pre-flight.
 fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitCode> {
     let text = library::read_text(program)?;
     let mut counts = diagnostics::Counts::default();
     // As `run`: the machine's units (mm) for the tool table and the stored offsets.
     let extra = inputs.program_inputs(Some(program))?;
-    let config = Config {
-        tool_table: library::load_tool_table(inputs.tool_table.as_deref())?,
-        subroutines: extra.subroutines,
-        ini: extra.ini,
-        parameters: extra.parameters,
-        ..Config::default()
-    };
     let machine = machine.map(|m| run::load_machine(Some(m))).transpose()?;
     let config = Config {
+        tool_table: library::load_tool_table(inputs.tool_table.as_deref())?,
+        subroutines: extra.subroutines.clone(),
+        ini: extra.ini.clone(),
+        parameters: extra.parameters.clone(),
         tool_centre_point_always: machine
             .as_ref()
             .is_some_and(|m| m.tcp == tezgah_kinematics::TcpSwitch::Always),
-        ..config
+        ..Config::default()
     };
-    let errors = tezgah_gcode::check_into(&text, config.clone(), &mut counts);
-    if errors.is_empty() {
+    let pass = match machine {
+        Some(_) => Pass::CheckMoves,
+        None => Pass::Check,
+    };
+    let done = source::interpret(
+        Sources::new(program, text),
+        config,
+        pass,
+        |name| extra.locate(name),
+        &mut counts,
+    );
+    if done.errors.is_empty() {
         if let Some(machine) = &machine {
-            // The interpreter found nothing: its moves exist; the machine checks them.
-            let moves = tezgah_gcode::program_moves(&text, config)
-                .map_err(|e| diagnostics::report(program, &text, &e))?;
             let tolerance = machine.motion.tolerance_mm;
-            run::build_path(program, &text, moves, machine, tolerance)?;
+            run::build_path(&done.sources, &done.keys, done.moves, machine, tolerance)?;
             println!("{}: OK on {}, {counts}", program.display(), machine.name);
             return Ok(ExitCode::SUCCESS);
         }
         println!("{}: OK, {counts}", program.display());
         return Ok(ExitCode::SUCCESS);
     }
-    for e in &errors {
-        eprintln!("{:?}", diagnostics::report(program, &text, e));
+    for e in &done.errors {
+        eprintln!("{:?}", diagnostics::report(&done.sources, e));
     }
+    let n = done.errors.len();
     eprintln!(
-        "{}: {} error{}",
+        "{}: {n} error{}",
         program.display(),
-        errors.len(),
-        if errors.len() == 1 { "" } else { "s" }
+        if n == 1 { "" } else { "s" }
     );
     Ok(ExitCode::FAILURE)
 }

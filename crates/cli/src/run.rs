@@ -13,7 +13,9 @@ use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::verify::{Report, Verifier};
 
+use crate::diagnostics::report_line;
 use crate::plot::Trace;
+use crate::source::{interpret, LineKeys, Pass, Sources};
 use crate::tracking::{DriveKind, Tracker, Tracking};
 
 /// The path a machine will follow, checked whole before anything moves.
@@ -28,10 +30,12 @@ pub struct BuiltPath {
 
 /// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
 /// the tolerance, G61 keeps corners, G61.1 stops at every block end), then the pre-flight:
-/// every segment within the machine's reach and joint limits, else a report naming the line.
+/// every segment within the machine's reach and joint limits, else a report naming the file,
+/// line and column. `moves` carry `keys` numbers ([`crate::source`]); the path returned carries
+/// plain line numbers.
 pub fn build_path(
-    program: &std::path::Path,
-    text: &str,
+    sources: &Sources,
+    keys: &LineKeys,
     moves: Vec<tezgah_geom::Move>,
     machine: &Machine,
     tolerance: f64,
@@ -41,10 +45,10 @@ pub fn build_path(
     let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
     let mut smoother =
         smooth::Smoother::new(moves.into_iter(), opts.clone()).map_err(|e| miette!("{e}"))?;
-    let items = smoother
+    let mut items = smoother
         .by_ref()
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| miette!("{e}"))?;
+        .map_err(|e| path_error(sources, keys, &e))?;
     let axis = AxisFigures {
         deviation_deg: smoother.stats().max_axis_deviation,
         tolerance_deg: opts.angular_tolerance,
@@ -57,15 +61,33 @@ pub fn build_path(
             &tezgah_kinematics::Joints::zeros(pm.joint_count()),
         )
         .map_err(|e| miette!("the start pose: {e}"))?;
-    tezgah_motion::preflight::check_path(&items, &pm, start_joints).map_err(|e| {
-        crate::diagnostics::report_line(program, text, e.line, &e.source.to_string())
-    })?;
+    tezgah_motion::preflight::check_path(&items, &pm, start_joints)
+        .map_err(|e| report_line(sources, keys.source(e.line), &e.source.to_string()))?;
+    keys.unkey(&mut items);
     Ok(BuiltPath {
         items,
         pm,
         start,
         axis,
     })
+}
+
+/// A path builder's error at the file, line and column of its move (the message without its
+/// own `line N:`, which would give the key).
+fn path_error(sources: &Sources, keys: &LineKeys, e: &smooth::PathError) -> miette::Report {
+    use smooth::PathError as P;
+    let line = match e {
+        P::Curve { line, .. }
+        | P::Feed { line, .. }
+        | P::FeedPerRevolution { line }
+        | P::Tolerance { line, .. } => *line,
+        P::Option { .. } => return miette!("{e}"),
+    };
+    let text = e.to_string();
+    let message = text
+        .strip_prefix(&format!("line {line}: "))
+        .unwrap_or(&text);
+    report_line(sources, keys.source(line), message)
 }
 
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
@@ -154,20 +176,24 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let extra = args.inputs.program_inputs(args.program.as_deref())?;
     let config = Config {
         tool_table: table,
-        subroutines: extra.subroutines,
-        ini: extra.ini,
-        parameters: extra.parameters,
+        subroutines: extra.subroutines.clone(),
+        ini: extra.ini.clone(),
+        parameters: extra.parameters.clone(),
         tool_centre_point_always: machine.tcp == TcpSwitch::Always,
         ..Config::default()
     };
-    let moves = match tezgah_gcode::program_moves(&text, config) {
-        Ok(m) => m,
-        Err(e) => {
-            let path = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
-            eprintln!("{:?}", crate::diagnostics::report(&path, &text, &e));
-            return Ok(std::process::ExitCode::FAILURE);
-        }
-    };
+    let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
+    let done = interpret(
+        Sources::new(&path_name, text),
+        config,
+        Pass::Run,
+        |name| extra.locate(name),
+        &mut tezgah_gcode::canon::Discard,
+    );
+    if let Some(e) = done.errors.first() {
+        eprintln!("{:?}", crate::diagnostics::report(&done.sources, e));
+        return Ok(std::process::ExitCode::FAILURE);
+    }
     let period = args.period.unwrap_or(machine.motion.period_s);
     if !(period > 0.0 && period.is_finite()) {
         return Err(miette!("--period must be > 0, got {period}"));
@@ -176,13 +202,12 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
-    let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
     let BuiltPath {
         items,
         pm,
         start,
         axis,
-    } = build_path(&path_name, &text, moves, &machine, tolerance)?;
+    } = build_path(&done.sources, &done.keys, done.moves, &machine, tolerance)?;
     let segments = items
         .iter()
         .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))

@@ -1,7 +1,9 @@
 //! `tezgah canon` end to end through the binary: a program that reads an INI file's values and
 //! calls a subroutine from the INI file's `SUBROUTINE_PATH`.
 
-use std::process::Command;
+mod common;
+
+use common::tezgah;
 
 #[test]
 fn canon_reads_ini_values_and_subroutine_path() {
@@ -24,7 +26,7 @@ fn canon_reads_ini_values_and_subroutine_path() {
         "G21\no<lift> call\nG0 X[#<_ini[vars]safe_z> * 2]\nM2\n",
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+    let out = tezgah()
         .arg("canon")
         .arg(&program)
         .arg("--ini")
@@ -50,7 +52,7 @@ fn canon_reads_ini_values_and_subroutine_path() {
     );
 
     // Without the INI file the value is not defined: an error naming it, exit status 1.
-    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+    let out = tezgah()
         .arg("canon")
         .arg(&program)
         .arg("--subroutine-path")
@@ -73,7 +75,7 @@ fn canon_starts_from_a_parameter_file() {
     std::fs::write(dir.join("offsets.var"), "5220\t2.000000\n5241\t1.000000\n").unwrap();
     let program = dir.join("p.ngc");
     std::fs::write(&program, "G21 G0 X0\nM2\n").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+    let out = tezgah()
         .arg("canon")
         .arg(&program)
         .arg("--params")

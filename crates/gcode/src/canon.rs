@@ -6,8 +6,9 @@
 //! the `canon` command can be diffed against it; [`crate::moves`] turns the calls into moves.
 
 use std::fmt;
+use std::sync::Arc;
 
-use tezgah_geom::{Plane, Pose};
+use tezgah_geom::{Nurbs, Plane, Pose};
 
 /// Length units of the program.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -51,18 +52,13 @@ pub enum NurbsDialect {
     Fanuc,
 }
 
-/// The data of a NURBS feed, in program coordinates and units (A B C in degrees).
+/// A NURBS feed, in program coordinates and units (A B C in degrees).
 #[derive(Debug, Clone, PartialEq)]
 pub struct NurbsFeed {
     pub dialect: NurbsDialect,
-    /// Order (degree + 1): 4 for a cubic.
-    pub order: usize,
-    /// Control points X Y Z; the first is the current point.
-    pub points: Vec<[f64; 3]>,
-    /// One weight per control point, all positive.
-    pub weights: Vec<f64>,
-    /// `points + order` knots, non-decreasing.
-    pub knots: Vec<f64>,
+    /// The curve, built (and so validated) once by the interpreter; its first control point
+    /// is the current point. [`crate::moves`] maps it to the machine frame.
+    pub curve: Arc<Nurbs>,
     /// Where the move ends, all six axes (X Y Z = the last control point).
     pub end: Pose,
 }
@@ -239,7 +235,9 @@ impl fmt::Display for Canon {
             ),
             NurbsFeed(n) => match n.dialect {
                 // rs274 2.9's saicanon prints only the number of control points.
-                NurbsDialect::LinuxCnc => write!(f, "NURBS_FEED({}, ...)", n.points.len()),
+                NurbsDialect::LinuxCnc => {
+                    write!(f, "NURBS_FEED({}, ...)", n.curve.weights().len())
+                }
                 NurbsDialect::Fanuc => write_nurbs_g6(f, n),
             },
             Dwell(s) => write!(f, "DWELL({s:.4})"),
@@ -293,13 +291,15 @@ impl fmt::Display for Canon {
 /// `NURBS_G6_FEED(order, n, X Y Z W; …, K k0 k1 …, A, B, C)`: tezgah's own call for G06.2,
 /// every number in `%.4f` as rs274 prints positions.
 fn write_nurbs_g6(f: &mut fmt::Formatter<'_>, n: &NurbsFeed) -> fmt::Result {
-    write!(f, "NURBS_G6_FEED({}, {}, ", n.order, n.points.len())?;
-    for (k, (p, w)) in n.points.iter().zip(&n.weights).enumerate() {
+    let c = &n.curve;
+    let points = c.control_points();
+    write!(f, "NURBS_G6_FEED({}, {}, ", c.degree() + 1, points.len())?;
+    for (k, (p, w)) in points.iter().zip(c.weights()).enumerate() {
         let sep = if k == 0 { "" } else { "; " };
-        write!(f, "{sep}{:.4} {:.4} {:.4} {:.4}", p[0], p[1], p[2], w)?;
+        write!(f, "{sep}{:.4} {:.4} {:.4} {:.4}", p.x, p.y, p.z, w)?;
     }
     f.write_str(", K")?;
-    for k in &n.knots {
+    for k in c.knots() {
         write!(f, " {k:.4}")?;
     }
     let e = &n.end.0;
@@ -329,6 +329,9 @@ pub struct Origin {
     pub line: u32,
     /// The block's N word, if any.
     pub n: Option<i64>,
+    /// The text the line is in: 0 the program, k the k-th subroutine file the interpreter
+    /// loaded ([`crate::Interpreter::subroutine_file`]).
+    pub file: u16,
 }
 
 /// Receiver of canonical calls.

@@ -1,13 +1,14 @@
 //! What the `interpret` fuzz target does with one input, shared with the test that replays the
 //! saved corpus, so the two can never drift apart.
 
-use crate::canon::Discard;
 use crate::interp::{check, ControlLimits};
-use crate::{Config, Interpreter};
+use crate::moves::program_moves;
+use crate::Config;
 
-/// Run arbitrary bytes (read as lossy UTF-8) through the interpreter and the pre-flight, with
-/// small loop and call limits so that a runaway program ends in an error quickly. Errors are
-/// expected; only a panic or a hang is a bug.
+/// Run arbitrary bytes (read as lossy UTF-8) through the interpreter into moves (NURBS mapped to
+/// the machine frame included) and through the pre-flight, with small loop and call limits so
+/// that a runaway program ends in an error quickly. Errors are expected; only a panic or a
+/// hang is a bug.
 pub fn interpret(data: &[u8]) {
     let text = String::from_utf8_lossy(data);
     let cfg = Config {
@@ -17,7 +18,6 @@ pub fn interpret(data: &[u8]) {
         },
         ..Config::default()
     };
-    let mut interp = Interpreter::new(cfg.clone());
-    let _ = interp.run(&text, &mut Discard);
+    let _ = program_moves(&text, cfg.clone());
     let _ = check(&text, cfg);
 }

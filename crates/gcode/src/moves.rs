@@ -12,8 +12,8 @@
 use std::sync::Arc;
 
 use tezgah_geom::{
-    ArcMove, FeedMode, Move, MoveKind, Nurbs, NurbsMove, PathMode, Plane, Pose, StopKind,
-    ToolControl, Vec3,
+    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, Pose, StopKind, ToolControl,
+    Vec3,
 };
 
 use crate::canon::{Canon, CanonSink, ControlMode, NurbsFeed, Origin, Units};
@@ -97,29 +97,18 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
         self.push(line, MoveKind::ToolControl { control, at });
     }
 
-    /// A NURBS call as a move: every control point through the same affine map as an end
-    /// point, which maps the curve exactly; weights and knots are unchanged by it.
+    /// A NURBS call as a move: the interpreter's curve through the same affine map as an end
+    /// point, which maps the curve exactly (weights and knots are unchanged by it).
     fn nurbs(&mut self, n: &NurbsFeed) -> MoveKind {
         let end = self.machine(n.end);
-        let points: Vec<Vec3> = n
-            .points
-            .iter()
-            .map(|&[x, y, z]| {
-                let p = self.with_tool(self.tipless_of(Pose([x, y, z, 0.0, 0.0, 0.0])));
-                Vec3::from(p.xyz())
-            })
-            .collect();
-        let degree = n.order.saturating_sub(1);
-        match Nurbs::new(degree, &points, &n.weights, n.knots.clone()) {
-            Ok(curve) => MoveKind::Nurbs(NurbsMove {
-                curve: Arc::new(curve),
-                end,
-            }),
-            // The interpreter validated the same curve in program coordinates, and an affine
-            // map keeps it valid; should a caller hand over one that is not, the tool still
-            // ends where the call says.
-            Err(_) => MoveKind::Feed { end },
-        }
+        let curve = n.curve.mapped(|p| {
+            let q = self.with_tool(self.tipless_of(Pose([p.x, p.y, p.z, 0.0, 0.0, 0.0])));
+            Vec3::from(q.xyz())
+        });
+        MoveKind::Nurbs(NurbsMove {
+            curve: Arc::new(curve),
+            end,
+        })
     }
 
     fn push(&mut self, line: u32, kind: MoveKind) {

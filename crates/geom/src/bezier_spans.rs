@@ -52,6 +52,15 @@ impl BezierSpans {
         out
     }
 
+    /// The spans of the curve's image under the affine map `f`: a Bézier's image under an
+    /// affine map is the Bézier of the mapped control points.
+    pub(crate) fn mapped(&self, f: impl Fn(Vec3) -> Vec3) -> Self {
+        BezierSpans {
+            spans: self.spans.iter().map(|s| s.map(&f)).collect(),
+            ..self.clone()
+        }
+    }
+
     /// The last span whose start is at or before `u` (the first span for `u` before it):
     /// `starts.partition_point(|x| x <= u).clamp(1, n) − 1`. Knots of fits and programs are
     /// spread roughly evenly, so the span in proportion to `u` is a guess a few steps from the

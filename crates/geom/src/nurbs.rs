@@ -174,6 +174,30 @@ impl Nurbs {
         Some(spans.locate(clamp_param(u, a, b)))
     }
 
+    /// The image of the curve under the affine map `f` (a change of frame, units or offsets):
+    /// the NURBS of the mapped control points with the same weights and knots, which is the
+    /// exact image because rational B-splines are invariant under affine maps (P&T §4.2). A
+    /// valid curve stays valid, so nothing is checked again, and the Bézier cache is mapped
+    /// the same way instead of being derived again; `f` must be affine.
+    pub fn mapped(&self, f: impl Fn(Vec3) -> Vec3) -> Nurbs {
+        let cw = self
+            .cw
+            .iter()
+            .map(|c| {
+                let p = f(Vec3::new(c.x / c.w, c.y / c.w, c.z / c.w));
+                Vector4::new(p.x * c.w, p.y * c.w, p.z * c.w, c.w)
+            })
+            .collect();
+        Nurbs {
+            degree: self.degree,
+            knots: self.knots.clone(),
+            cw,
+            first: self.first,
+            last: self.last,
+            spans: self.spans.as_ref().map(|s| s.mapped(&f)),
+        }
+    }
+
     /// A non-rational B-spline (all weights 1).
     pub fn bspline(degree: usize, points: &[Vec3], knots: Vec<f64>) -> Result<Self, CurveError> {
         Nurbs::new(degree, points, &vec![1.0; points.len()], knots)
@@ -452,6 +476,57 @@ mod tests {
             x ^= x << 25;
             x ^= x >> 27;
             (x.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn mapped_curve_is_the_image_of_the_curve() {
+        // Affine invariance (P&T §4.2): for rational and non-rational curves of degrees 1–5,
+        // the mapped curve's points are the mapped points of the curve, to rounding.
+        let mut r = rng(0x5eed_0002);
+        for case in 0..200 {
+            let p = 1 + case % 5;
+            let n = p + 1 + (r() * 6.0) as usize;
+            let pts: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(20.0 * r() - 10.0, 20.0 * r() - 10.0, r()))
+                .collect();
+            let weights: Vec<f64> = (0..n)
+                .map(|_| if case % 2 == 0 { 1.0 } else { 0.2 + 3.0 * r() })
+                .collect();
+            let mut knots = vec![0.0; p + 1];
+            for k in 1..n - p {
+                knots.push(k as f64 + r() * 0.5);
+            }
+            knots.extend(std::iter::repeat_n((n - p) as f64, p + 1));
+            let c = Nurbs::new(p, &pts, &weights, knots.clone()).unwrap();
+            let (angle, scale) = (r() * 6.0, 25.4 * r() + 0.1);
+            let shift = Vec3::new(r() * 100.0, -r() * 50.0, r());
+            let f = |q: Vec3| {
+                let (s, co) = angle.sin_cos();
+                scale * Vec3::new(co * q.x - s * q.y, s * q.x + co * q.y, q.z) + shift
+            };
+            let m = c.mapped(f);
+            assert_eq!(m.knots(), c.knots());
+            assert_eq!(m.weights(), c.weights());
+            // The same curve as one built from the mapped points, derivatives (and so the
+            // mapped Bézier cache) included.
+            let mapped: Vec<Vec3> = pts.iter().map(|&q| f(q)).collect();
+            let fresh = Nurbs::new(p, &mapped, &weights, knots).unwrap();
+            assert_eq!(m.spans.is_some(), fresh.spans.is_some());
+            let (a, b) = c.domain();
+            for k in 0..=20 {
+                let u = a + (b - a) * k as f64 / 20.0;
+                let (want, got) = (f(c.point(u)), m.point(u));
+                assert!(
+                    (want - got).norm() < 1e-9 * (1.0 + want.norm()),
+                    "{case} {u}"
+                );
+                let (d, e) = (fresh.derivs(u), m.derivs(u));
+                for i in 0..3 {
+                    let tol = 1e-8 * (1.0 + d[i].norm());
+                    assert!((d[i] - e[i]).norm() < tol, "{case} {u} d{i}");
+                }
+            }
         }
     }
 

@@ -8,9 +8,23 @@ use std::process::{Command, Output};
 /// The example tool table (tool 1: a 6 mm ball, 28.5 mm long).
 pub const TOOLS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/tools.tbl");
 
-/// The `tezgah` binary under test.
+/// The `tezgah` binary under test, its output plain text whatever the environment asks: no
+/// colour codes (`NO_COLOR`, and no `FORCE_COLOR`/`CLICOLOR_FORCE` of a CI), and, into a pipe,
+/// error messages never wrapped (the binary's `miette` hook), so tests can search them.
 pub fn tezgah() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_tezgah"))
+    let mut c = Command::new(env!("CARGO_BIN_EXE_tezgah"));
+    c.env("NO_COLOR", "1")
+        .env_remove("FORCE_COLOR")
+        .env_remove("CLICOLOR_FORCE");
+    c
+}
+
+/// A fresh folder in this test process's scratch folder.
+pub fn tmp_dir(name: &str) -> PathBuf {
+    let d = tmp(name);
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
 }
 
 /// A path in this test process's scratch folder.

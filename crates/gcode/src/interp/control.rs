@@ -684,3 +684,10 @@ pub struct SubroutineFile {
     pub name: String,
     pub text: Arc<str>,
 }
+
+impl SubroutineFile {
+    /// The file's name, `<name>.ngc`, as errors in it name it.
+    pub fn file_name(&self) -> String {
+        format!("{}.ngc", self.name)
+    }
+}

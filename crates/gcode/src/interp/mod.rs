@@ -21,8 +21,7 @@ mod tools;
 
 pub use arc::{center_from_offset, center_from_radius, sweep, ArcTolerance, Sense};
 pub use comp::CompError;
-use control::SubroutineFile;
-pub use control::{ControlLimits, LinePos, SubroutineLibrary};
+pub use control::{ControlLimits, LinePos, SubroutineFile, SubroutineLibrary};
 pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
@@ -233,6 +232,14 @@ impl Interpreter {
         &self.params
     }
 
+    /// Subroutine file `file` of an [`Origin`] or a [`LinePos`] (1 the first loaded), once the
+    /// interpreter has loaded it; `None` for 0, the program itself.
+    pub fn subroutine_file(&self, file: u16) -> Option<&SubroutineFile> {
+        usize::from(file)
+            .checked_sub(1)
+            .and_then(|k| self.files.get(k))
+    }
+
     /// Whether M2/M30 or the closing `%` has been reached.
     pub fn ended(&self) -> bool {
         self.ended
@@ -320,17 +327,13 @@ impl Interpreter {
 
     /// The text of subroutine file `file` (`None` for the program itself).
     fn file_text(&self, file: u16) -> Option<std::sync::Arc<str>> {
-        let k = usize::from(file).checked_sub(1)?;
-        self.files.get(k).map(|f| f.text.clone())
+        self.subroutine_file(file).map(|f| f.text.clone())
     }
 
     /// Name the subroutine file an error comes from.
     fn in_file(&self, mut e: GcodeError, file: u16) -> GcodeError {
-        if let Some(f) = usize::from(file)
-            .checked_sub(1)
-            .and_then(|k| self.files.get(k))
-        {
-            e.file = Some(format!("{}.ngc", f.name));
+        if let Some(f) = self.subroutine_file(file) {
+            e.file = Some(f.file_name());
         }
         e
     }
@@ -433,6 +436,7 @@ impl Interpreter {
         self.origin = Origin {
             line: line.number,
             n: block.n,
+            file: line.file,
         };
         self.control.next_line = Some(line.next());
         if let Some(o) = block.o.take() {
@@ -497,15 +501,25 @@ impl Interpreter {
         self.emit_or_hold(sink, call);
     }
 
-    /// A pose in the machine's units (tool table, parameters) in the program's units
-    /// (LinuxCNC's `USER_TO_PROGRAM_LEN`).
-    fn to_program_units(&self, p: Pose) -> Pose {
-        p.scale_linear(self.cfg.machine_units.mm() / self.state.units.mm())
+    /// Program units per machine unit: a length in the machine's units (tool table,
+    /// parameters) times this is in the program's units (LinuxCNC's `USER_TO_PROGRAM_LEN`).
+    fn program_per_machine_unit(&self) -> f64 {
+        self.cfg.machine_units.mm() / self.state.units.mm()
     }
 
-    /// A pose in the program's units in the machine's (LinuxCNC's `PROGRAM_TO_USER_LEN`).
+    /// Machine units per program unit (LinuxCNC's `PROGRAM_TO_USER_LEN`).
+    fn machine_per_program_unit(&self) -> f64 {
+        self.state.units.mm() / self.cfg.machine_units.mm()
+    }
+
+    /// A pose in the machine's units in the program's units (angles are not lengths).
+    fn to_program_units(&self, p: Pose) -> Pose {
+        p.scale_linear(self.program_per_machine_unit())
+    }
+
+    /// A pose in the program's units in the machine's.
     fn to_machine_units(&self, p: Pose) -> Pose {
-        p.scale_linear(self.state.units.mm() / self.cfg.machine_units.mm())
+        p.scale_linear(self.machine_per_program_unit())
     }
 
     /// Six offset parameters from `base` on, in program units.
@@ -558,18 +572,26 @@ pub fn check(program: &str, cfg: Config) -> Vec<GcodeError> {
 
 /// [`check`], sending the calls of the blocks that pass to `sink` (for summaries).
 pub fn check_into(program: &str, cfg: Config, sink: &mut impl CanonSink) -> Vec<GcodeError> {
-    let mut interp = Interpreter::new(cfg);
-    interp.start(sink);
-    let mut errors = Vec::new();
-    interp.drive(program, sink, |e| {
-        // After a runaway loop or recursion, or enough errors, going on tells nothing more
-        // (and a loop whose counting line fails would go on for ever).
-        let hopeless = matches!(
-            e.kind,
-            ErrorKind::RunawayLoop(..) | ErrorKind::CallsTooDeep(_)
-        );
-        errors.push(e);
-        !hopeless && errors.len() < MAX_CHECK_ERRORS
-    });
-    errors
+    Interpreter::new(cfg).check(program, sink)
+}
+
+impl Interpreter {
+    /// [`check_into`] on this interpreter, which keeps what the program loaded (its subroutine
+    /// files, for error reports) and its final state. With no error, `sink` has received
+    /// exactly the calls [`Interpreter::run`] sends, so one pass serves the check and the moves.
+    pub fn check(&mut self, program: &str, sink: &mut impl CanonSink) -> Vec<GcodeError> {
+        self.start(sink);
+        let mut errors = Vec::new();
+        self.drive(program, sink, |e| {
+            // After a runaway loop or recursion, or enough errors, going on tells nothing more
+            // (and a loop whose counting line fails would go on for ever).
+            let hopeless = matches!(
+                e.kind,
+                ErrorKind::RunawayLoop(..) | ErrorKind::CallsTooDeep(_)
+            );
+            errors.push(e);
+            !hopeless && errors.len() < MAX_CHECK_ERRORS
+        });
+        errors
+    }
 }

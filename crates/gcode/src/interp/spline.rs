@@ -8,6 +8,8 @@
 //! uniform clamped knots. G06.2 is Fanuc's format: `G06.2 P<order> K<knot> X Y Z R<weight>`,
 //! one control point with one knot per line, then `order` lines of K alone.
 
+use std::sync::Arc;
+
 use tezgah_geom::basis::MAX_DEGREE;
 use tezgah_geom::{Curve, FeedMode, Nurbs, Plane, Pose, Vec3};
 
@@ -47,8 +49,9 @@ pub(super) struct SplineMemory {
 /// A G6.2 NURBS while its lines are read.
 #[derive(Debug, Clone)]
 struct G62Block {
-    /// Line of the G6.2 word (for the error when the NURBS is left unfinished).
-    line: u32,
+    /// Where the G6.2 word is: the move belongs to it, and the error when the NURBS is left
+    /// unfinished names its line.
+    origin: Origin,
     order: usize,
     points: Vec<[f64; 3]>,
     weights: Vec<f64>,
@@ -233,7 +236,7 @@ impl Interpreter {
         let xyz: Vec<[f64; 3]> = points.iter().map(|p| [p[0], p[1], z]).collect();
         let weights: Vec<f64> = points.iter().map(|p| p[2]).collect();
         let knots = linuxcnc_knots(points.len(), order);
-        validate(order, &xyz, &weights, &knots).map_err(|e| (e, at))?;
+        let curve = build(order, &xyz, &weights, knots).map_err(|e| (e, at))?;
         let last = xyz[xyz.len() - 1];
         end.0[0] = last[0];
         end.0[1] = last[1];
@@ -241,10 +244,7 @@ impl Interpreter {
             sink,
             Canon::NurbsFeed(Box::new(NurbsFeed {
                 dialect: NurbsDialect::LinuxCnc,
-                order,
-                points: xyz,
-                weights,
-                knots,
+                curve: Arc::new(curve),
                 end,
             })),
         );
@@ -267,7 +267,7 @@ impl Interpreter {
         }
         let at = block.g[ggroup::MOTION].map_or(0, |c| c.at);
         Err((
-            ErrorKind::G62Unfinished(open.line, open.closing, open.order),
+            ErrorKind::G62Unfinished(open.origin.line, open.closing, open.order),
             at,
         ))
     }
@@ -329,7 +329,10 @@ impl Interpreter {
         }
         let start = self.state.pos;
         let mut open = G62Block {
-            line: self.origin.line,
+            origin: Origin {
+                n: None,
+                ..self.origin
+            },
             order,
             points: Vec::new(),
             weights: Vec::new(),
@@ -386,7 +389,7 @@ impl Interpreter {
 
     /// The last closing knot: check the whole NURBS and send it.
     fn g62_close(&mut self, open: G62Block, at: u32, sink: &mut impl CanonSink) -> Exec {
-        let (order, knots) = (open.order, &open.knots);
+        let (order, knots) = (open.order, open.knots.as_slice());
         let n = open.points.len();
         if n < order {
             return Err((ErrorKind::G62TooFewPoints(order, n), at));
@@ -399,13 +402,10 @@ impl Interpreter {
         if last.iter().any(|&k| k != last[0]) {
             return Err((ErrorKind::G62NotClamped("last", order, order), at));
         }
-        let curve = validate(order, &open.points, &open.weights, knots).map_err(|e| (e, at))?;
+        let curve = build(order, &open.points, &open.weights, open.knots).map_err(|e| (e, at))?;
         let end = open.cursor;
         // The move belongs to the G6.2 line that began it, where samples and reports point.
-        let origin = Origin {
-            line: open.line,
-            n: None,
-        };
+        let origin = open.origin;
         if let Some(f) = open.inverse_time {
             // As a G1 or G2 under G93: the rate that runs the curve's length in 1/F minutes.
             let rate = inverse_time_rate(f, curve.length());
@@ -416,10 +416,7 @@ impl Interpreter {
             origin,
             Canon::NurbsFeed(Box::new(NurbsFeed {
                 dialect: NurbsDialect::Fanuc,
-                order,
-                points: open.points,
-                weights: open.weights,
-                knots: open.knots,
+                curve: Arc::new(curve),
                 end,
             })),
         );
@@ -439,17 +436,16 @@ fn push_knot(open: &mut G62Block, k: f64, at: u32) -> Exec {
     Ok(())
 }
 
-/// The checks of the curve layer (finite values, knot multiplicities, a non-empty domain), so
-/// that the move built from the call is always a valid curve; the curve, in program units.
-fn validate(
+/// The curve in program coordinates and units, built once: the curve layer's checks (finite
+/// values, knot multiplicities, a non-empty domain) are the block's, and the call carries it.
+fn build(
     order: usize,
     points: &[[f64; 3]],
     weights: &[f64],
-    knots: &[f64],
+    knots: Vec<f64>,
 ) -> Result<Nurbs, ErrorKind> {
     let pts: Vec<Vec3> = points.iter().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    Nurbs::new(order - 1, &pts, weights, knots.to_vec())
-        .map_err(|e| ErrorKind::NurbsInvalid(e.to_string()))
+    Nurbs::new(order - 1, &pts, weights, knots).map_err(|e| ErrorKind::NurbsInvalid(e.to_string()))
 }
 
 /// Byte offset of a block's first axis word.

@@ -43,18 +43,16 @@ impl Interpreter {
         if !TOOL_WORDS.iter().any(|&w| block.has(w)) {
             return Err((ErrorKind::G10L1NoOffsets, at));
         }
-        let user = |v: f64| self.length_to_machine_units(v);
         if l == 1 {
-            for (i, word) in block.axis_words().into_iter().enumerate() {
-                if let Some(v) = word {
-                    tool.offset.0[i] = if i < 3 { user(v) } else { v };
-                }
-            }
+            let words = block.axis_words();
+            let given = Pose(words.map(|w| w.unwrap_or(0.0)));
+            let named = words.map(|w| w.is_some());
+            set_named(&mut tool.offset, self.to_machine_units(given), named);
         } else {
             self.touch_off(block, l == 11, &mut tool);
         }
         if let Some(r) = block.get(b'r') {
-            tool.diameter = user(r) * 2.0;
+            tool.diameter = r * 2.0 * self.machine_per_program_unit();
         }
         if let Some(i) = block.get(b'i') {
             tool.front_angle = i;
@@ -107,21 +105,19 @@ impl Interpreter {
             (None, Some(y)) => (old.0[0], t.0[1] - y),
             (None, None) => (old.0[0], old.0[1]),
         };
-        if words[0].is_some() || words[1].is_some() {
-            let xy = rotate_xy(Pose([x, y, 0.0, 0.0, 0.0, 0.0]), rotation);
-            tool.offset.0[0] = self.length_to_machine_units(xy.0[0]);
-            tool.offset.0[1] = self.length_to_machine_units(xy.0[1]);
-        }
+        let xy = rotate_xy(Pose([x, y, 0.0, 0.0, 0.0, 0.0]), rotation);
+        let mut fresh = Pose([xy.0[0], xy.0[1], 0.0, 0.0, 0.0, 0.0]);
         for (i, word) in words.iter().enumerate().skip(2) {
             if let Some(v) = *word {
-                let d = t.0[i] - v;
-                tool.offset.0[i] = if i < 3 {
-                    self.length_to_machine_units(d)
-                } else {
-                    d
-                };
+                fresh.0[i] = t.0[i] - v;
             }
         }
+        // X and Y change together (the rotation mixes them) when either is touched off.
+        let mut named = words.map(|w| w.is_some());
+        let xy_named = named[0] || named[1];
+        named[0] = xy_named;
+        named[1] = xy_named;
+        set_named(&mut tool.offset, self.to_machine_units(fresh), named);
     }
 
     /// `#5400…#5413` from the spindle's entry, zero when no tool is in it.
@@ -152,10 +148,14 @@ impl Interpreter {
             self.params.set(TOOL_PARAMETERS + k, v);
         }
     }
+}
 
-    /// A length in program units in the machine's units (LinuxCNC's `PROGRAM_TO_USER_LEN`).
-    fn length_to_machine_units(&self, v: f64) -> f64 {
-        v * self.state.units.mm() / self.cfg.machine_units.mm()
+/// The `named` axes of `offset` take their value from `value`; the others are kept.
+fn set_named(offset: &mut Pose, value: Pose, named: [bool; 6]) {
+    for (i, &n) in named.iter().enumerate() {
+        if n {
+            offset.0[i] = value.0[i];
+        }
     }
 }
 

@@ -291,7 +291,7 @@ impl Interpreter {
                     }
                 }
             };
-            diameter * self.cfg.machine_units.mm() / self.state.units.mm() / 2.0
+            diameter * self.program_per_machine_unit() / 2.0
         };
         if radius < 0.0 {
             side = side.other();
