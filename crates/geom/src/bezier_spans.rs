@@ -95,6 +95,29 @@ impl BezierSpans {
         (&self.spans[k], t, self.inv[k])
     }
 
+    /// `∫_a^b |C'(u)| du` by 8-point Gauss–Legendre when `[a, b]` (inside the domain) lies in
+    /// one span, with that span looked up once; `None` when it crosses a knot. Each node's
+    /// `t` and `C'` are computed as [`Self::locate`] and [`d1`] compute them, so the result is
+    /// the per-node quadrature's bit for bit.
+    pub(crate) fn speed_integral(&self, a: f64, b: f64) -> Option<f64> {
+        let k = self.index(a);
+        let (start, end) = (self.starts[k], self.starts[k + 1]);
+        // Every node is strictly inside (a, b); with b at most the span end they all belong
+        // to span k (a node at `end` would belong to the next span).
+        if !(a >= start && b <= end) {
+            return None;
+        }
+        let (span, iw) = (&self.spans[k], self.inv[k]);
+        Some(crate::arclen::gauss_legendre_8(
+            |u| {
+                let t = if u >= end { 1.0 } else { (u - start) * iw };
+                d1(span, t, iw).norm()
+            },
+            a,
+            b,
+        ))
+    }
+
     /// An upper bound of `f` over the curve piece `u` in `[u0, u1]` when `f` is convex (a
     /// distance to a convex set): the piece is cut at the knots, each part's Bézier control
     /// points are found by blossoming, and the part lies in their convex hull (Piegl & Tiller
