@@ -72,6 +72,7 @@ pub fn gauss_legendre<C: Curve + ?Sized>(curve: &C, a: f64, b: f64) -> f64 {
 }
 
 /// `∫_a^b f(u) du` by 8-point Gauss–Legendre (exact for polynomials of degree 15).
+#[inline]
 pub fn gauss_legendre_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
     let mut sum = 0.0;
