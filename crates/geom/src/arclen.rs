@@ -358,13 +358,14 @@ impl ArcLengthMap {
             let mut d = -f / v;
             for _ in 0..3 {
                 let slope = v + d * (v1 + 0.5 * d * v2);
-                if !(slope > 0.0) {
+                // Past a turning point of the model (or NaN): keep the last root estimate.
+                if slope.is_nan() || slope <= 0.0 {
                     break;
                 }
                 d -= model(d) / slope;
             }
             let next = u + d;
-            if !(next > lo && next < hi) || !d.is_finite() {
+            if !(next > lo && next < hi && d.is_finite()) {
                 u = 0.5 * (lo + hi);
                 continue;
             }
