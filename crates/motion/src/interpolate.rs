@@ -222,7 +222,8 @@ impl Interpolator {
                         param = Param::new(&piece.segments[idx]);
                     }
                     let seg = &piece.segments[idx];
-                    let (tip, rotary, joints) = self.pose(seg, &mut param, s - piece.offsets[idx])?;
+                    let (tip, rotary, joints) =
+                        self.pose(seg, &mut param, s - piece.offsets[idx])?;
                     let sample = Sample {
                         index: 0,
                         t: 0.0,
