@@ -288,10 +288,21 @@ impl ArcLengthMap {
             };
         }
         let s = clamp_param(s, 0.0, self.length());
-        // Stay on the cursor's panel when `s` is ahead of it and inside the panel; else
-        // re-anchor at the start of the panel holding `s` (forward walk when ahead).
+        // The end is the table's last entry, as `u_at` finds it; searched for, its root would
+        // sit on the bracket's end (so would a panel's end: that is the next panel's start).
+        if s >= self.length() {
+            *cursor = self.anchor(n - 1);
+            let u = self.u[n];
+            return ArcPosition {
+                u,
+                point: curve.point(u),
+            };
+        }
+        // Stay on the cursor's panel when `s` is ahead of it and before the panel's end; else
+        // re-anchor at the start of the panel holding `s` (forward walk when ahead), where
+        // `s` equal to the start is the table's `u` exactly.
         let k = cursor.panel.min(n - 1);
-        if !(s >= cursor.s && s <= self.s[k + 1] && cursor.panel < n) {
+        if !(s >= cursor.s && s < self.s[k + 1] && cursor.panel < n) {
             let k = if s >= cursor.s && cursor.panel < n {
                 let mut k = k;
                 while k + 1 < n && self.s[k + 1] <= s {

@@ -129,9 +129,13 @@ proptest! {
         let len = m.length();
         let mut cur = m.cursor();
         let scale = 1.0 + c.point(c.domain().0).norm();
+        // Forward steps, then jumps, then the knots' arc lengths: table entries (every span
+        // starts a panel), where a Newton root would sit on the bracket's end.
+        let ends: Vec<f64> = c.breakpoints().iter().map(|&u| m.s_at(&c, u)).collect();
         let ss = (0..=steps)
             .map(|i| len * i as f64 / steps as f64)
-            .chain(jumps.iter().map(|f| f * len));
+            .chain(jumps.iter().map(|f| f * len))
+            .chain(ends);
         for s in ss {
             let at = m.advance(&c, &mut cur, s);
             let u = m.u_at(&c, s);
@@ -142,6 +146,12 @@ proptest! {
             prop_assert!((fine.s_at(&c, at.u) - s).abs() <= 2.0 * tol, "s={} back={}", s, fine.s_at(&c, at.u));
             prop_assert!((fine.s_at(&c, at.u) - fine.s_at(&c, u)).abs() <= 3.0 * tol);
             prop_assert!((at.point - c.point(at.u)).norm() <= 1e-12 * scale, "{} vs {}", at.point, c.point(at.u));
+        }
+        // At a knot's own table length the cursor returns the knot itself, as `u_at` does.
+        for u in c.breakpoints() {
+            let s = m.s_at(&c, u);
+            prop_assert_eq!(m.advance(&c, &mut cur, s).u, u);
+            prop_assert_eq!(m.u_at(&c, s), u);
         }
     }
 }
