@@ -20,7 +20,7 @@ const TAYLOR_STEP: f64 = 1e-4;
 /// Where the last [`ArcLengthMap::advance`] ended: the panel, the parameter and its arc
 /// length, and the speed and its rate there for the next guess. Start with
 /// [`ArcLengthMap::cursor`]; any `s` may follow any other (going back re-anchors). A cursor
-/// belongs to the map that made it: on another map it cannot fail, but answers are meaningless.
+/// belongs to the map that made it: on another map nothing panics, but the answers mean nothing.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArcLengthCursor {
     panel: usize,
