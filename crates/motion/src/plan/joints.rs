@@ -270,7 +270,9 @@ impl PlanMachine {
             return None;
         };
         let limits = self.model.joint_limits();
-        if limits.len() != map.len() || previous.len() != map.len() || !previous.is_finite() {
+        // The model's own input checks (`check_input`), inlined: a call per sample showed.
+        let previous_ok = previous.as_slice().iter().all(|v| v.is_finite());
+        if limits.len() != map.len() || previous.len() != map.len() || !previous_ok {
             return None;
         }
         let length = match control {
@@ -360,7 +362,16 @@ impl PlanMachine {
                 }
                 Ok((q, rotary))
             }
-            _ => Ok((self.joints(seg.control, tip, &rotary, previous)?, rotary)),
+            _ => {
+                // The shortcut straight away: one `Result` layer less per sample.
+                if let Some(q) = self.cartesian_joints(seg.control, tip, &rotary, previous) {
+                    return Ok((q, rotary));
+                }
+                Ok((
+                    self.model_joints(seg.control, tip, &rotary, previous)?,
+                    rotary,
+                ))
+            }
         }
     }
 
