@@ -22,9 +22,14 @@
 //! (safeguarded Newton from a cubic Hermite guess; the last quadrature is skipped when the
 //! Newton step's second-order residual is already below the tolerance), so `s(u(s)) = s` to the
 //! Newton tolerance (`tol / 100`), and `u(s)` inherits the bound above as an arc-length error.
+//! For samples that move forward, [`ArcLengthMap::advance`] (`arclen/cursor.rs`) is the same
+//! inverse from the last answer.
 
 use crate::curve::{clamp_param, Curve, Vec3};
 use crate::error::CurveError;
+
+mod cursor;
+pub use cursor::{ArcLengthCursor, ArcPosition};
 
 /// 8-point Gauss–Legendre nodes (positive half) and weights on [-1, 1].
 const GL_X: [f64; 4] = [
@@ -55,10 +60,11 @@ const ROUNDING_FLOOR: f64 = 64.0 * f64::EPSILON;
 
 /// `∫_a^b |C'(u)| du` by 8-point Gauss–Legendre.
 pub fn gauss_legendre<C: Curve + ?Sized>(curve: &C, a: f64, b: f64) -> f64 {
-    gauss_legendre_8(|u| curve.speed(u), a, b)
+    curve.speed_integral(a, b)
 }
 
 /// `∫_a^b f(u) du` by 8-point Gauss–Legendre (exact for polynomials of degree 15).
+#[inline]
 pub fn gauss_legendre_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
     let mut sum = 0.0;

@@ -104,6 +104,30 @@ impl BezierSpans {
         (&self.spans[k], t, self.inv[k])
     }
 
+    /// `∫_a^b |C'(u)| du` by 8-point Gauss–Legendre when `[a, b]` (inside the domain) lies in
+    /// one span, with that span looked up once; `None` when it crosses a knot. Each node's
+    /// `t` and `C'` are computed as [`Self::locate`] and [`d1`] compute them, so the result is
+    /// the per-node quadrature's bit for bit.
+    pub(crate) fn speed_integral(&self, a: f64, b: f64) -> Option<f64> {
+        let k = self.index(a);
+        let (start, end) = (self.starts[k], self.starts[k + 1]);
+        // Every node is strictly inside (a, b); with b at most the span end they all belong
+        // to span k (a node at `end` would belong to the next span).
+        if !(a >= start && b <= end) {
+            return None;
+        }
+        let (b0, iw) = (&self.spans[k], self.inv[k]);
+        // `d1`'s differences, once for the eight nodes; per node the same arithmetic as `d1`.
+        let (d0, d1, d2) = (b0[1] - b0[0], b0[2] - b0[1], b0[3] - b0[2]);
+        let scale = 3.0 * iw;
+        let speed = |u: f64| {
+            let t = if u >= end { 1.0 } else { (u - start) * iw };
+            let s = 1.0 - t;
+            ((d0 * (s * s) + d1 * (2.0 * s * t) + d2 * (t * t)) * scale).norm()
+        };
+        Some(crate::arclen::gauss_legendre_8(speed, a, b))
+    }
+
     /// An upper bound of `f` over the curve piece `u` in `[u0, u1]` when `f` is convex (a
     /// distance to a convex set): the piece is cut at the knots, each part's Bézier control
     /// points are found by blossoming, and the part lies in their convex hull (Piegl & Tiller

@@ -2,7 +2,7 @@
 //! offers to the planner — parameter domain, point, derivatives up to the third, curvature,
 //! length and arc-length evaluation — so path building and feed planning never match on kinds.
 
-use crate::arclen::ArcLengthMap;
+use crate::arclen::{gauss_legendre_8, ArcLengthMap};
 
 /// A point or vector in the workpiece frame, mm.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -34,6 +34,13 @@ pub trait Curve {
     /// Parametric speed `|C'(u)|`, the arc-length integrand.
     fn speed(&self, u: f64) -> f64 {
         self.d1(u).norm()
+    }
+
+    /// `∫_a^b |C'(u)| du` by 8-point Gauss–Legendre ([`crate::arclen::gauss_legendre_8`]), the
+    /// arc-length quadrature's one rule. Curves that can evaluate the eight nodes of one knot
+    /// span together (one span lookup) override it with the same values.
+    fn speed_integral(&self, a: f64, b: f64) -> f64 {
+        gauss_legendre_8(|u| self.speed(u), a, b)
     }
 
     /// Curvature `|C' × C''| / |C'|³` (1/mm): infinite at a cusp, never NaN.
@@ -102,6 +109,9 @@ macro_rules! forward_curve {
             }
             fn speed(&self, u: f64) -> f64 {
                 (**self).speed(u)
+            }
+            fn speed_integral(&self, a: f64, b: f64) -> f64 {
+                (**self).speed_integral(a, b)
             }
             fn curvature(&self, u: f64) -> f64 {
                 (**self).curvature(u)

@@ -49,6 +49,14 @@ impl<C: Curve> Curve for Trimmed<C> {
     fn d1(&self, u: f64) -> Vec3 {
         self.curve.d1(clamp_param(u, self.u0, self.u1))
     }
+    fn speed_integral(&self, a: f64, b: f64) -> f64 {
+        // Inside the trimmed domain no node is clamped: the inner curve's own rule applies.
+        if a >= self.u0 && b <= self.u1 && a <= b {
+            self.curve.speed_integral(a, b)
+        } else {
+            crate::arclen::gauss_legendre_8(|u| self.speed(u), a, b)
+        }
+    }
     fn breakpoints(&self) -> Vec<f64> {
         let mut out = vec![self.u0];
         out.extend(

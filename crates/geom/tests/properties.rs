@@ -100,6 +100,67 @@ proptest! {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(256))]
 
+    /// A NURBS's panel quadrature (one span lookup for the eight nodes) gives the per-node
+    /// rule's value bit for bit inside a knot span, and across knots falls back to it.
+    #[test]
+    fn speed_integral_is_the_per_node_rule(
+        c in nurbs(), pick in 0.0f64..1.0, f0 in 0.0f64..1.0, f1 in 0.0f64..1.0
+    ) {
+        let (lo, hi) = (f0.min(f1), f0.max(f1));
+        let (u, width) = inside_span(&c, pick, 0.5);
+        let (a, b) = (u - 0.5 * width + lo * width, u - 0.5 * width + hi * width);
+        let per_node = tezgah_geom::arclen::gauss_legendre_8(|x| c.speed(x), a, b);
+        prop_assert_eq!(c.speed_integral(a, b).to_bits(), per_node.to_bits());
+        let (da, db) = c.domain();
+        let whole = tezgah_geom::arclen::gauss_legendre_8(|x| c.speed(x), da, db);
+        prop_assert_eq!(c.speed_integral(da, db).to_bits(), whole.to_bits());
+    }
+
+    /// The forward cursor finds the same u as `u_at` (to the map's bound in arc length) on
+    /// sampling runs like the interpolator's — many small forward steps, crossing panels — and
+    /// after arbitrary jumps back and forth; its point is C(u).
+    #[test]
+    fn arc_length_cursor_agrees_with_u_at(
+        c in nurbs(), steps in 50usize..400, jumps in prop::collection::vec(0.0f64..=1.0, 6)
+    ) {
+        let tol = 1e-9;
+        let m = ArcLengthMap::new(&c, tol).unwrap();
+        let fine = ArcLengthMap::new(&c, 1e-12).unwrap();
+        let len = m.length();
+        let mut cur = m.cursor();
+        let scale = 1.0 + c.point(c.domain().0).norm();
+        // Forward steps, then jumps, then the knots' arc lengths: table entries (every span
+        // starts a panel), where a Newton root would sit on the bracket's end.
+        let ends: Vec<f64> = c.breakpoints().iter().map(|&u| m.s_at(&c, u)).collect();
+        let ss = (0..=steps)
+            .map(|i| len * i as f64 / steps as f64)
+            .chain(jumps.iter().map(|f| f * len))
+            .chain(ends);
+        for s in ss {
+            let at = m.advance(&c, &mut cur, s);
+            let u = m.u_at(&c, s);
+            let (a, b) = c.domain();
+            prop_assert!(at.u >= a && at.u <= b);
+            // Both within the bound of the true arc length s (fine map), so within 2·tol of
+            // each other along the curve.
+            let back = fine.s_at(&c, at.u);
+            prop_assert!((back - s).abs() <= 2.0 * tol, "s={} back={}", s, back);
+            prop_assert!((fine.s_at(&c, at.u) - fine.s_at(&c, u)).abs() <= 3.0 * tol);
+            let exact = c.point(at.u);
+            prop_assert!((at.point - exact).norm() <= 1e-12 * scale, "{} vs {}", at.point, exact);
+        }
+        // At a knot's own table length the cursor returns the knot itself, as `u_at` does.
+        for u in c.breakpoints() {
+            let s = m.s_at(&c, u);
+            prop_assert_eq!(m.advance(&c, &mut cur, s).u, u);
+            prop_assert_eq!(m.u_at(&c, s), u);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
     /// Knot insertion (A5.1) and splitting never change the curve, whatever the degree, the
     /// weights and the multiplicity already present; impossible insertions are typed errors.
     #[test]

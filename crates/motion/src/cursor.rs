@@ -86,7 +86,7 @@ impl PieceCursor {
         let (tip, rotary, joints) = segment_pose(
             machine,
             seg,
-            &self.param,
+            &mut self.param,
             s - piece.offsets[self.idx],
             previous,
         )?;

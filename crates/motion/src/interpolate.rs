@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 
-use tezgah_geom::{ArcLengthMap, Curve, Vec3};
+use tezgah_geom::{ArcLengthCursor, ArcLengthMap, Curve, Vec3};
 use tezgah_kinematics::{Joints, KinematicsError};
 
 use crate::path::Segment;
@@ -41,9 +41,10 @@ pub struct Sample {
 }
 
 /// s → u on one segment: identity for arc-length parametrised curves (lines), otherwise an
-/// arc-length map built once per segment.
+/// arc-length map built once per segment with a forward cursor on it (samples move forward, so
+/// each one starts from the last: [`ArcLengthMap::advance`]).
 pub(crate) struct Param {
-    map: Option<ArcLengthMap>,
+    map: Option<(ArcLengthMap, ArcLengthCursor)>,
     scale: f64,
 }
 
@@ -72,8 +73,9 @@ impl Param {
         match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
             Ok(m) => {
                 let scale = m.length() / seg.length;
+                let cursor = m.cursor();
                 Param {
-                    map: Some(m),
+                    map: Some((m, cursor)),
                     scale,
                 }
             }
@@ -85,11 +87,17 @@ impl Param {
         }
     }
 
-    pub(crate) fn u(&self, seg: &Segment, s: f64) -> f64 {
-        let (a, _) = seg.curve.domain();
-        match &self.map {
-            Some(m) => m.u_at(&*seg.curve, s * self.scale),
-            None => a + s * self.scale,
+    /// The parameter and point at distance `s` along `seg`.
+    pub(crate) fn at(&mut self, seg: &Segment, s: f64) -> (f64, Vec3) {
+        match &mut self.map {
+            Some((m, cursor)) => {
+                let at = m.advance(&*seg.curve, cursor, s * self.scale);
+                (at.u, at.point)
+            }
+            None => {
+                let u = seg.curve.domain().0 + s * self.scale;
+                (u, seg.curve.point(u))
+            }
         }
     }
 }
@@ -101,7 +109,7 @@ impl Param {
 pub(crate) fn segment_pose(
     machine: &PlanMachine,
     seg: &Segment,
-    param: &Param,
+    param: &mut Param,
     s: f64,
     previous: &Joints,
 ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
@@ -112,8 +120,8 @@ pub(crate) fn segment_pose(
     let (tip, u) = if s >= len {
         (seg.curve.point(b), b)
     } else {
-        let u = param.u(seg, s);
-        (seg.curve.point(u), u)
+        let (u, tip) = param.at(seg, s);
+        (tip, u)
     };
     let (q, rotary) = machine
         .segment_joints(seg, u, f, &tip, previous)
@@ -163,7 +171,7 @@ impl Interpolator {
     fn pose(
         &mut self,
         seg: &Segment,
-        param: &Param,
+        param: &mut Param,
         s: f64,
     ) -> Result<(Vec3, [f64; 3], Joints), InterpolateError> {
         let pose = segment_pose(&self.machine, seg, param, s, &self.joints)?;
@@ -214,7 +222,8 @@ impl Interpolator {
                         param = Param::new(&piece.segments[idx]);
                     }
                     let seg = &piece.segments[idx];
-                    let (tip, rotary, joints) = self.pose(seg, &param, s - piece.offsets[idx])?;
+                    let (tip, rotary, joints) =
+                        self.pose(seg, &mut param, s - piece.offsets[idx])?;
                     let sample = Sample {
                         index: 0,
                         t: 0.0,
@@ -232,7 +241,7 @@ impl Interpolator {
                 // The piece's end, exactly (held for the final row and for dwells).
                 let seg = piece.segments.last().expect("a piece has segments");
                 let len = *piece.lengths.last().unwrap_or(&0.0);
-                let (tip, rotary, joints) = self.pose(seg, &param, len)?;
+                let (tip, rotary, joints) = self.pose(seg, &mut param, len)?;
                 self.last = Some(Sample {
                     index: self.k,
                     t: end,

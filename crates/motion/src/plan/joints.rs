@@ -247,6 +247,61 @@ impl PlanMachine {
         rotary: &[f64; 3],
         previous: &Joints,
     ) -> Result<Joints, KinematicsError> {
+        if let Some(q) = self.cartesian_joints(control, tip, rotary, previous) {
+            return Ok(q);
+        }
+        self.model_joints(control, tip, rotary, previous)
+    }
+
+    /// A Cartesian machine's inverse as `Cartesian::tcp_inverse` computes it — X Y Z the tip
+    /// (Z plus the tool length under TCP), further joints the programmed rotaries in radians —
+    /// without building a program pose and going through the model's input checks: the
+    /// interpolator's per-sample call (half of a sample's cost on long lines and arcs). `None`
+    /// (the caller then takes the model's path, and its error) unless the machine is
+    /// Cartesian and every input and joint is finite and inside its limits.
+    fn cartesian_joints(
+        &self,
+        control: ToolControl,
+        tip: &Vec3,
+        rotary: &[f64; 3],
+        previous: &Joints,
+    ) -> Option<Joints> {
+        let (Model::Cartesian(_), Some(map)) = (&self.model, self.map.as_deref()) else {
+            return None;
+        };
+        let limits = self.model.joint_limits();
+        // The model's own input checks (`check_input`), inlined: a call per sample showed.
+        let previous_ok = previous.as_slice().iter().all(|v| v.is_finite());
+        if limits.len() != map.len() || previous.len() != map.len() || !previous_ok {
+            return None;
+        }
+        let length = match control {
+            ToolControl::CentrePoint { tool_length } => tool_length,
+            ToolControl::Joints => Tool::default().length,
+        };
+        let mut q = Joints::zeros(map.len());
+        for ((v, m), l) in q.as_mut_slice().iter_mut().zip(map).zip(limits) {
+            *v = match *m {
+                JointMap::Tip(2) => tip.z + length,
+                JointMap::Tip(i) => tip[i],
+                JointMap::Rotary(k) => rotary[k].to_radians(),
+            };
+            if !(v.is_finite() && l.contains(*v)) {
+                return None;
+            }
+        }
+        // The model also refuses a non-finite tip (a NaN in a coordinate no joint carries).
+        tip.iter().all(|x| x.is_finite()).then_some(q)
+    }
+
+    /// [`Self::joints`] through the model: the program pose and the model's TCP inverse.
+    fn model_joints(
+        &self,
+        control: ToolControl,
+        tip: &Vec3,
+        rotary: &[f64; 3],
+        previous: &Joints,
+    ) -> Result<Joints, KinematicsError> {
         let tool = match control {
             ToolControl::CentrePoint { tool_length } => Tool::with_length(tool_length),
             ToolControl::Joints if self.orients() => {
@@ -307,7 +362,16 @@ impl PlanMachine {
                 }
                 Ok((q, rotary))
             }
-            _ => Ok((self.joints(seg.control, tip, &rotary, previous)?, rotary)),
+            _ => {
+                // The shortcut straight away: one `Result` layer less per sample.
+                if let Some(q) = self.cartesian_joints(seg.control, tip, &rotary, previous) {
+                    return Ok((q, rotary));
+                }
+                Ok((
+                    self.model_joints(seg.control, tip, &rotary, previous)?,
+                    rotary,
+                ))
+            }
         }
     }
 
@@ -404,3 +468,72 @@ impl ToolAxisMap for PlanMachine {
 const FOLLOW_STEP: f64 = 0.01;
 /// How close (mm, rad) the walk's joints must end to the programmed ones.
 const FOLLOW_MATCH: f64 = 1e-9;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// mill3, and mill3 with rotary A and C joints (a Cartesian machine with extra axes).
+    fn machines() -> [PlanMachine; 2] {
+        let text = Machine::builtin_text("mill3").expect("mill3 is built in");
+        let rotary = |name: &str| {
+            format!(
+                "\n[[joint]]\nname = \"{name}\"\nkind = \"rotary\"\nmin = -120.0\nmax = 120.0\n\
+                 max_velocity = 3600.0\nmax_acceleration = 36000.0\nmax_jerk = 360000.0\n"
+            )
+        };
+        let five = format!("{text}{}{}", rotary("a"), rotary("c"));
+        [text.to_string(), five].map(|t| {
+            let m = Machine::from_toml_str(&t).expect("valid machine");
+            PlanMachine::from_machine(&m).expect("Cartesian machines plan")
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The Cartesian shortcut gives the model's joints bit for bit, and where the model
+        /// refuses (outside a limit, non-finite) it steps aside so the model's error is given.
+        #[test]
+        fn cartesian_shortcut_is_the_model_inverse(
+            x in -260.0f64..260.0, y in -200.0f64..200.0, z in -130.0f64..130.0,
+            a in -150.0f64..150.0, c in -150.0f64..150.0, length in 0.0f64..40.0,
+            tcp: bool, nan in 0usize..12,
+        ) {
+            let mut tip = Vec3::new(x, y, z);
+            let mut rotary = [a, 0.0, c];
+            if nan < 3 {
+                tip[nan] = f64::NAN;
+            } else if nan == 3 {
+                rotary[0] = f64::INFINITY;
+            }
+            let control = if tcp {
+                ToolControl::CentrePoint { tool_length: length }
+            } else {
+                ToolControl::Joints
+            };
+            for pm in machines() {
+                let previous = Joints::zeros(pm.joint_count());
+                let fast = pm.joints(control, &tip, &rotary, &previous);
+                let model = pm.model_joints(control, &tip, &rotary, &previous);
+                match (&fast, &model) {
+                    (Ok(f), Ok(m)) => {
+                        let bits = |q: &Joints| {
+                            q.as_slice().iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+                        };
+                        prop_assert_eq!(bits(f), bits(m));
+                    }
+                    _ => prop_assert_eq!(&fast, &model),
+                }
+                let z_joint = z + if tcp { length } else { 0.0 };
+                let rotaries_in = pm.joint_count() == 3 || (a.abs() < 120.0 && c.abs() < 120.0);
+                let inside = x.abs() < 200.0 && y.abs() < 150.0 && z_joint.abs() < 100.0;
+                // In limits and finite, the shortcut is the path taken (the test is not vacuous).
+                if nan >= 4 && inside && rotaries_in {
+                    prop_assert!(pm.cartesian_joints(control, &tip, &rotary, &previous).is_some());
+                }
+            }
+        }
+    }
+}
