@@ -1,0 +1,307 @@
+//! The exact check of one period of the time scale: with r̈ = c held over the period, the
+//! re-timed path acceleration s̈ = ṙv + r²a and jerk s⃛ = r̈v + 3rṙa + r³j are bounded at
+//! every instant of it, not only at samples. The scale ([`super::TimeScale`]) accepts a
+//! period only if this check passes.
+//!
+//! Over t ∈ [0, Ts]: r(t) = r₀ + ṙ₀t + ct²/2 (a parabola: its range is its ends and vertex),
+//! ṙ(t) = ṙ₀ + ct (its ends), τ(t) = τ₀ + ∫r ∈ [τ₀, τ₀ + Δτ] (r ≥ 0). Over that τ span the
+//! plan's jerk is piecewise constant, its acceleration piecewise linear and its speed
+//! piecewise quadratic, so their ranges are exact from the phase ends and the speed's
+//! vertices. Interval arithmetic over these ranges (Moore, "Interval Analysis", 1966) then
+//! contains every value s̈ and s⃛ take in the period; the bound is loose only by the
+//! correlation it ignores, which is O(Ts) relative.
+
+use tezgah_motion::{Profile, State};
+
+use super::Plan;
+
+/// A closed interval [lo, hi].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Span {
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl Span {
+    pub fn point(x: f64) -> Span {
+        Span { lo: x, hi: x }
+    }
+
+    fn include(&mut self, x: f64) {
+        self.lo = self.lo.min(x);
+        self.hi = self.hi.max(x);
+    }
+
+    fn add(self, o: Span) -> Span {
+        Span {
+            lo: self.lo + o.lo,
+            hi: self.hi + o.hi,
+        }
+    }
+
+    fn mul(self, o: Span) -> Span {
+        let p = [
+            self.lo * o.lo,
+            self.lo * o.hi,
+            self.hi * o.lo,
+            self.hi * o.hi,
+        ];
+        Span {
+            lo: p.iter().copied().fold(f64::INFINITY, f64::min),
+            hi: p.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        }
+    }
+
+    fn scale(self, k: f64) -> Span {
+        self.mul(Span::point(k))
+    }
+
+    /// x³ is monotone.
+    fn cube(self) -> Span {
+        Span {
+            lo: self.lo.powi(3),
+            hi: self.hi.powi(3),
+        }
+    }
+
+    fn within(self, bound: f64) -> bool {
+        self.lo >= -bound && self.hi <= bound
+    }
+}
+
+/// The plan's speed, acceleration and jerk over a span of path time, and the tightest path
+/// limits in force there.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PlanRange {
+    pub v: Span,
+    pub a: Span,
+    pub j: Span,
+    pub max_velocity: f64,
+    pub max_acceleration: f64,
+    pub max_jerk: f64,
+}
+
+impl PlanRange {
+    fn empty() -> PlanRange {
+        let e = Span {
+            lo: f64::INFINITY,
+            hi: f64::NEG_INFINITY,
+        };
+        PlanRange {
+            v: e,
+            a: e,
+            j: e,
+            max_velocity: f64::INFINITY,
+            max_acceleration: f64::INFINITY,
+            max_jerk: f64::INFINITY,
+        }
+    }
+
+    fn limit(&mut self, l: &tezgah_motion::Limits) {
+        self.max_velocity = self.max_velocity.min(l.max_velocity());
+        self.max_acceleration = self.max_acceleration.min(l.max_acceleration());
+        self.max_jerk = self.max_jerk.min(l.max_jerk());
+    }
+
+    fn state(&mut self, x: &State) {
+        self.v.include(x.v);
+        self.a.include(x.a);
+    }
+
+    /// The profile over its own time [t0, t1] (within its duration): phase by phase, with
+    /// the speed's vertex (a = 0) where it falls inside a phase.
+    fn profile(&mut self, p: &Profile, t0: f64, t1: f64) {
+        let knots = p.knots();
+        for k in 0..7 {
+            let (ts, x) = knots[k];
+            let te = knots[k + 1].0;
+            let (lo, hi) = (t0.max(ts), t1.min(te));
+            if hi < lo || (te <= ts && !(t0 <= ts && ts <= t1)) {
+                continue;
+            }
+            let at = |dt: f64| State {
+                s: 0.0,
+                v: x.v + dt * (x.a + 0.5 * dt * x.j),
+                a: x.a + dt * x.j,
+                j: x.j,
+            };
+            self.j.include(x.j);
+            self.state(&at(lo - ts));
+            self.state(&at(hi - ts));
+            if x.j != 0.0 {
+                let vertex = -x.a / x.j;
+                if vertex > lo - ts && vertex < hi - ts {
+                    self.state(&at(vertex));
+                }
+            }
+        }
+        if t1 >= p.duration() {
+            // Past the end the motion continues at the end speed.
+            self.state(&p.end());
+            self.j.include(0.0);
+        }
+    }
+
+    /// Past the pieces known: the end speed, acceleration 0 there, any jerk within the last
+    /// limits (the next piece's limits may be lower; see `TimeScale::can_settle`).
+    fn unknown(&mut self, end: &State, max_jerk: f64) {
+        self.v.include(end.v);
+        self.a.include(0.0);
+        self.j.include(-max_jerk);
+        self.j.include(max_jerk);
+    }
+}
+
+impl Plan<'_> {
+    /// The plan over path time [τ0, τ1], one range per piece it touches (the piece in hand,
+    /// the next, past them), each with its own limits: a piece's jerk is checked against its
+    /// own J, not the lower J of the piece after it.
+    pub(super) fn ranges(&self, tau0: f64, tau1: f64) -> [Option<PlanRange>; 3] {
+        let mut out = [None; 3];
+        let d = self.current.profile.duration();
+        if tau0 <= d {
+            let mut r = PlanRange::empty();
+            r.limit(self.current.limits);
+            r.profile(self.current.profile, tau0, tau1.min(d));
+            out[0] = Some(r);
+        }
+        if tau1 <= d {
+            return out;
+        }
+        let last = match self.next {
+            Some(n) => {
+                let dn = n.profile.duration();
+                let (t0, t1) = ((tau0 - d).max(0.0), tau1 - d);
+                if t0 <= dn {
+                    let mut r = PlanRange::empty();
+                    r.limit(n.limits);
+                    r.profile(n.profile, t0, t1.min(dn));
+                    out[1] = Some(r);
+                }
+                if t1 <= dn {
+                    return out;
+                }
+                n
+            }
+            None => self.current,
+        };
+        let mut r = PlanRange::empty();
+        r.limit(last.limits);
+        r.unknown(&last.profile.end(), last.limits.max_jerk());
+        out[2] = Some(r);
+        out
+    }
+}
+
+/// One period checked: where it leaves the scale, or why it was refused.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Period {
+    pub r: f64,
+    pub rate: f64,
+    pub dtau: f64,
+}
+
+/// The period from (r, ṙ) at τ with r̈ = `c` over `ts`, if r stays within [0, `r_max`], the
+/// path speed within the plan's limit, and |s̈| ≤ A, |s⃛| ≤ J at every instant of it.
+pub(super) fn check(
+    plan: &Plan,
+    r: f64,
+    rd: f64,
+    c: f64,
+    tau: f64,
+    ts: f64,
+    r_max: f64,
+) -> Option<Period> {
+    let r1 = r + rd * ts + c * ts * ts / 2.0;
+    let rd1 = rd + c * ts;
+    let dtau = r * ts + rd * ts * ts / 2.0 + c * ts * ts * ts / 6.0;
+    let mut rr = Span::point(r);
+    rr.include(r1);
+    if c != 0.0 {
+        let vertex = -rd / c;
+        if vertex > 0.0 && vertex < ts {
+            rr.include(r - rd * rd / (2.0 * c));
+        }
+    }
+    if rr.lo < -super::SLACK || rr.hi > r_max + super::SLACK {
+        return None;
+    }
+    let rr = Span {
+        lo: rr.lo.max(0.0),
+        hi: rr.hi,
+    };
+    let mut rdr = Span::point(rd);
+    rdr.include(rd1);
+    let slack = 1.0 + super::SLACK;
+    let rr2 = rr.mul(rr);
+    let rr3 = rr.cube();
+    let cross = rr.mul(rdr).scale(3.0);
+    let ok = plan
+        .ranges(tau, tau + dtau.max(0.0))
+        .iter()
+        .flatten()
+        .all(|p| {
+            let speed = rr.mul(p.v);
+            let acc = rdr.mul(p.v).add(rr2.mul(p.a));
+            let jerk = p.v.scale(c).add(cross.mul(p.a)).add(rr3.mul(p.j));
+            speed.hi <= p.max_velocity * slack
+                && acc.within(p.max_acceleration * slack)
+                && jerk.within(p.max_jerk * slack)
+        });
+    ok.then_some(Period {
+        r: r1.clamp(0.0, r_max),
+        rate: rd1,
+        dtau: dtau.max(0.0),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scale::PieceView;
+    use proptest::prelude::*;
+    use tezgah_motion::{solve, Limits};
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// The plan's ranges contain its state at many instants of the span, and the check's
+        /// verdict holds at a fine sampling of the period (the bound is never optimistic).
+        #[test]
+        fn ranges_contain_the_plan(length in 0.5..50.0f64, v0 in 0.0..1.0f64, v1 in 0.0..1.0f64,
+                                   tau0 in 0.0..1.0f64, span in 0.0..0.01f64,
+                                   r in 0.0..1.0f64, rd in -5.0..5.0f64, c in -3e3..3e3f64) {
+            let limits = Limits::new(100.0, 1000.0, 5e4).unwrap();
+            let profile = solve(length, 100.0 * v0, 100.0 * v1, &limits);
+            // Ends a length cannot join are not a plan.
+            prop_assume!(profile.is_ok());
+            let profile = profile.unwrap();
+            let piece = PieceView { profile: &profile, limits: &limits };
+            let plan = Plan { current: piece, next: None };
+            let d = profile.duration();
+            let t0 = tau0 * d;
+            let t1 = (t0 + span).min(d);
+            let range = plan.ranges(t0, t1)[0].unwrap();
+            for k in 0..=50 {
+                let x = profile.state_at(t0 + (t1 - t0) * k as f64 / 50.0);
+                prop_assert!(range.v.lo - 1e-9 <= x.v && x.v <= range.v.hi + 1e-9);
+                prop_assert!(range.a.lo - 1e-9 <= x.a && x.a <= range.a.hi + 1e-9);
+            }
+            let ts = 0.001;
+            if let Some(p) = check(&plan, r, rd, c, t0, ts, 1.0) {
+                for k in 0..=200 {
+                    let t = ts * k as f64 / 200.0;
+                    let rt = r + rd * t + c * t * t / 2.0;
+                    let rdt = rd + c * t;
+                    let tau = t0 + r * t + rd * t * t / 2.0 + c * t * t * t / 6.0;
+                    let x = profile.state_at(tau);
+                    let acc = rdt * x.v + rt * rt * x.a;
+                    let jerk = c * x.v + 3.0 * rt * rdt * x.a + rt * rt * rt * x.j;
+                    prop_assert!(acc.abs() <= 1000.0 * (1.0 + 1e-6), "a {acc}");
+                    prop_assert!(jerk.abs() <= 5e4 * (1.0 + 1e-6), "j {jerk}");
+                }
+                prop_assert!((0.0..=1.0).contains(&p.r));
+            }
+        }
+    }
+}
