@@ -24,6 +24,7 @@ use crate::mdi::Mdi;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::SetPoint;
 
+mod hold;
 mod manual;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
@@ -104,6 +105,8 @@ pub struct Executor {
     /// The planned item after the current one, taken early for the time scale's look-ahead.
     peeked: Option<PlannedItem>,
     scale: TimeScale,
+    /// A feed hold's (or abort's) stop along the path in progress.
+    hold: Option<hold::Hold>,
     mode: Mode,
     state: RunState,
     override_pct: f64,
@@ -195,6 +198,7 @@ impl Executor {
             current: None,
             peeked: None,
             scale: TimeScale::default(),
+            hold: None,
             mode: Mode::Auto,
             state: RunState::Idle,
             override_pct: 100.0,
@@ -369,6 +373,7 @@ impl Executor {
         self.job = Some(job);
         self.current = None;
         self.peeked = None;
+        self.hold = None;
         self.mode = mode;
         self.state = RunState::Running;
         self.scale = TimeScale::held();
@@ -516,6 +521,7 @@ impl Executor {
         self.peeked = None;
         self.manual = None;
         self.last_manual = None;
+        self.hold = None;
         self.state = RunState::Idle;
         self.scale = TimeScale::held();
     }
@@ -588,6 +594,12 @@ impl Executor {
             if let Some(ev) = self.fetch()? {
                 return Ok(self.finish_event(ev));
             }
+        }
+        // A hold stops along the path where it can (a stop begun runs to its end).
+        if self.hold.is_some()
+            || (matches!(self.state, RunState::Holding | RunState::Aborting) && self.begin_hold())
+        {
+            return self.step_hold();
         }
         // The time scale moves with the plan's state where the tool is.
         let factor = match &self.current {
@@ -744,18 +756,7 @@ impl Executor {
                     }
                     left -= d - *tau;
                     *tau = d;
-                    // The piece's exact end, and every segment passed on the way.
-                    let end = cursor.piece().length();
-                    self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
-                    self.done_length += end;
-                    self.s = 0.0;
-                    self.passed.extend(cursor.passed().iter().cloned());
-                    let stop = cursor
-                        .piece()
-                        .segments
-                        .last()
-                        .is_some_and(|s| s.end == Junction::Stop);
-                    self.current = None;
+                    let stop = self.finish_piece()?;
                     if stop
                         && self.single_block
                         && self.mode == Mode::Auto
@@ -778,10 +779,38 @@ impl Executor {
         }
     }
 
+    /// Leaves the piece in hand at its exact end (every segment passed on the way counted);
+    /// whether the path stops there.
+    fn finish_piece(&mut self) -> Result<bool, ExecError> {
+        let Some(Current::Piece { cursor, .. }) = self.current.as_mut() else {
+            return Ok(false);
+        };
+        let end = cursor.piece().length();
+        self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
+        self.done_length += end;
+        self.s = 0.0;
+        self.passed.extend(cursor.passed().iter().cloned());
+        let stop = cursor
+            .piece()
+            .segments
+            .last()
+            .is_some_and(|s| s.end == Junction::Stop);
+        self.current = None;
+        Ok(stop)
+    }
+
     /// The pose at the current path time.
     fn sample(&mut self) -> Result<(), ExecError> {
-        if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
+        if let Some(Current::Piece { cursor, tau, .. }) = &self.current {
             let s = cursor.piece().profile.state_at(*tau).s;
+            self.sample_at(s)?;
+        }
+        Ok(())
+    }
+
+    /// The pose at path coordinate `s` of the piece in hand.
+    fn sample_at(&mut self, s: f64) -> Result<(), ExecError> {
+        if let Some(Current::Piece { cursor, .. }) = self.current.as_mut() {
             self.s = s.clamp(0.0, cursor.piece().length());
             self.pose = cursor.pose(&self.machine, s, &self.pose.joints)?;
             // Segments passed inside this piece (its cursor keeps the current one).

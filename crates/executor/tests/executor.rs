@@ -109,8 +109,18 @@ fn five_axis_tcp_plays_the_interpolator_samples() {
     plays_the_interpolator_samples(&machine, program);
 }
 
-/// Holds at period `at`, checks the stop, resumes; returns the whole trace.
-fn hold_and_resume(program: &str, at: usize) -> Vec<Produced> {
+/// The distance a hold at period `at` travelled, the time-optimal jerk-limited stop from the
+/// hold state (speed, and acceleration by backward difference, under the path limits where it
+/// began and ended), and the allowance the bound adds: one period's travel.
+struct HoldDistance {
+    travelled: f64,
+    optimal: f64,
+    allowance: f64,
+}
+
+/// Holds at period `at`, checks the stop, resumes; returns the whole trace and, if it held
+/// before the program ended, the hold's distance.
+fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDistance>) {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
     exec.command(Command::Load {
@@ -118,35 +128,41 @@ fn hold_and_resume(program: &str, at: usize) -> Vec<Produced> {
     })
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
+    let mut start = None;
     drive(&mut exec, &mut trace, 2_000_000, |k, e| {
         if k == at {
+            start = e.path_limits();
             e.command(Command::FeedHold).unwrap();
         }
     });
+    let mut distance = None;
     // Held, or the program ended before the hold.
     if exec.state() == RunState::Held {
         let out = &trace.out;
         let before = &out[at.saturating_sub(1)];
         let prev = &out[at.saturating_sub(2)];
         let a = (before.feed - prev.feed) / exec.period();
-        let l = exec.path_limits().expect("held inside a piece");
-        let bound = tezgah_executor::stop::stopping_distance(
-            before.feed,
-            a.max(0.0),
-            l.max_acceleration(),
-            l.max_jerk(),
-        );
-        // The time-optimal stop from the hold state is the floor; re-timing reaches it (median
-        // 1.00 of it, p90 1.23) except where the plan's own terms leave the ramp less room —
-        // the 3rṙa term while the plan accelerates or brakes at low speed: seen up to 3.7× (at
-        // 5 mm/s, 0.16 mm) — plus a crawl allowance for holds at near-zero speed, where r
-        // swings at most 10 % per period.
-        let travelled = out.last().unwrap().path - before.path;
-        assert!(
-            travelled <= 4.0 * bound + 0.01,
-            "hold travelled {travelled}, jerk-limited stop {bound} from v {} a {a}",
-            before.feed
-        );
+        let end = exec.path_limits().expect("held inside a piece");
+        // Under the limits of the piece where the hold began; if it stopped in another piece,
+        // the larger of the stops under either's limits (braking as each piece allows lies
+        // between them).
+        let optimal = [start.unwrap_or(end), end]
+            .iter()
+            .map(|l| {
+                tezgah_executor::stop::stopping_distance(
+                    before.feed,
+                    a.clamp(-l.max_acceleration(), l.max_acceleration()),
+                    l.max_acceleration(),
+                    l.max_jerk(),
+                )
+            })
+            .fold(0.0, f64::max);
+        let d = HoldDistance {
+            travelled: out.last().unwrap().path - before.path,
+            optimal,
+            allowance: before.feed * exec.period() + 1e-9,
+        };
+        distance = Some(d);
         // Standing: nothing produced while held.
         assert_eq!(exec.step().unwrap(), None);
         exec.command(Command::Resume).unwrap();
@@ -156,7 +172,24 @@ fn hold_and_resume(program: &str, at: usize) -> Vec<Produced> {
     let (out, report) = trace.report();
     assert_within(&report, RETIME_JERK);
     assert_continuous(&out);
-    out
+    (out, distance)
+}
+
+/// Bound on a hold's distance over the optimum (plus a period's travel).
+const HOLD_RATIO: f64 = 1.2;
+
+/// The stop along the path is the optimum (up to the backward difference's view of the
+/// acceleration); where it would leave the piece the time scale brakes along the plan, which
+/// slows for what lies past the piece anyway.
+fn assert_hold_distance(d: &Option<HoldDistance>) {
+    if let Some(d) = d {
+        assert!(
+            d.travelled <= HOLD_RATIO * d.optimal + d.allowance,
+            "hold travelled {}, jerk-limited stop {}",
+            d.travelled,
+            d.optimal
+        );
+    }
 }
 
 proptest! {
@@ -170,7 +203,8 @@ proptest! {
         let program = random_program(seed, 12);
         let full = reference(&program);
         let at = ((full.len() as f64) * frac) as usize;
-        let out = hold_and_resume(&program, at);
+        let (out, d) = hold_and_resume(&program, at);
+        assert_hold_distance(&d);
         let (a, b) = (full.last().unwrap(), out.last().unwrap());
         prop_assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0), "{} vs {}", a.path, b.path);
         prop_assert!((a.tip - b.tip).norm() <= 1e-9);
@@ -235,6 +269,82 @@ proptest! {
         assert_within(&report, RETIME_JERK);
         assert_continuous(&out);
         prop_assert!(out.last().unwrap().tip.norm() <= 1e-9);
+    }
+}
+
+/// What happens at a random instant of a run.
+#[derive(Debug, Clone, Copy)]
+enum Event {
+    /// Feed hold, resumed this many periods later.
+    Hold(usize),
+    Override(f64),
+}
+
+fn event() -> impl Strategy<Value = Event> {
+    prop_oneof![
+        (1usize..400).prop_map(Event::Hold),
+        (0.0..=200.0f64).prop_map(Event::Override),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+
+    /// Holds (resumed after a random wait) and override changes mixed at random instants of
+    /// random programs: every joint within its velocity, acceleration and jerk limits by
+    /// finite differences at the 0.5 % margin (motion's verifier), on the path, and the
+    /// whole path traced once to the program's end.
+    #[test]
+    fn holds_and_overrides_mixed(seed in any::<u64>(),
+                                 events in proptest::collection::vec((0.0..1.0f64, event()), 1..6)) {
+        let program = random_program(seed, 6);
+        let full = reference(&program);
+        let n = full.len();
+        let mut at: Vec<(usize, Event)> =
+            events.iter().map(|&(f, e)| ((f * n as f64) as usize, e)).collect();
+        at.sort_by_key(|e| e.0);
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load { program: program.clone() }).unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        let mut resume_at = None;
+        let mut k = 0usize;
+        // Periods while held produce nothing: count them on the same clock.
+        while k < 50 * n + 20_000 {
+            for &(when, e) in &at {
+                if when == k {
+                    match e {
+                        Event::Hold(wait) => {
+                            exec.command(Command::FeedHold).unwrap();
+                            resume_at = Some(k + wait);
+                        }
+                        Event::Override(pct) => {
+                            exec.command(Command::FeedOverride { percent: pct }).unwrap();
+                        }
+                    }
+                }
+            }
+            if resume_at == Some(k) {
+                exec.command(Command::Resume).unwrap();
+            }
+            if k == at.last().unwrap().0 + 1000 {
+                // Back to 100 % so a program slowed to 0 % still finishes.
+                exec.command(Command::FeedOverride { percent: 100.0 }).unwrap();
+            }
+            match exec.step().unwrap() {
+                Some(p) => trace.push(&exec, &p),
+                None if exec.state() == RunState::Idle => break,
+                None => {}
+            }
+            k += 1;
+        }
+        prop_assert_eq!(exec.state(), RunState::Idle, "did not finish");
+        let (out, report) = trace.report();
+        assert_within_limits(&report);
+        assert_continuous(&out);
+        let (a, b) = (full.last().unwrap(), out.last().unwrap());
+        prop_assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0), "{} vs {}", a.path, b.path);
+        prop_assert!((a.tip - b.tip).norm() <= 1e-9);
     }
 }
 
@@ -410,7 +520,8 @@ fn holds_found_by_random_search() {
         let program = random_program(seed, 12);
         let full = reference(&program);
         let at = ((full.len() as f64) * frac) as usize;
-        let out = hold_and_resume(&program, at);
+        let (out, d) = hold_and_resume(&program, at);
+        assert_hold_distance(&d);
         assert!((full.last().unwrap().tip - out.last().unwrap().tip).norm() <= 1e-9);
     }
 }
@@ -453,7 +564,7 @@ fn override_scales_the_programmed_feed() {
 }
 
 /// At cruise a hold acts in the next period and stops in the time-optimal jerk-limited time
-/// (from 10 mm/s under mill3's path limits) plus the last periods of the discrete approach.
+/// (from 10 mm/s under mill3's path limits), rounded up to whole periods.
 #[test]
 fn hold_acts_at_once() {
     let program = "G21 G90 F600\nG1 X150\nM2\n";
@@ -485,10 +596,17 @@ fn hold_acts_at_once() {
     } else {
         2.0 * (v / j).sqrt()
     };
-    let took = (out.len() - at) as f64 * exec.period();
-    // The discrete approach of r = 0 ends with a few periods of crawl (µm/s): 33 vs 28.3 ms.
+    // From cruise the stop is two jerk ramps: distance v·√(v/J).
+    let travelled = out.last().unwrap().path - out[at - 1].path;
     assert!(
-        took <= optimal + 6.0 * exec.period(),
+        (travelled - v * (v / j).sqrt()).abs() < 1e-9,
+        "{travelled} vs {}",
+        v * (v / j).sqrt()
+    );
+    let took = (out.len() - at) as f64 * exec.period();
+    // The stop along the path is that optimum, ending inside the last period.
+    assert!(
+        took <= optimal + exec.period() + 1e-12,
         "{took} s vs {optimal} s"
     );
     let (out, report) = trace.report();
@@ -540,4 +658,39 @@ fn dwell_runs_in_wall_time() {
     let (dh, held) = periods(dwell, 100.0, Some(m100 + 100));
     assert!(held > 0, "held inside the dwell");
     assert!((dh as i64 - d100 as i64).abs() <= 2, "{dh} vs {d100}");
+}
+
+/// The distribution of hold distances over the optimum on random holds (for the notes:
+/// `cargo test -p tezgah-executor --test executor hold_distance_distribution -- --ignored
+/// --nocapture`); the bound itself is asserted in every hold.
+#[test]
+#[ignore]
+fn hold_distance_distribution() {
+    let mut ratios = vec![];
+    for seed in 0..40u64 {
+        let program = random_program(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15), 12);
+        let n = reference(&program).len();
+        for k in 1..=5 {
+            let at = n * k / 6;
+            if let (_, Some(d)) = hold_and_resume(&program, at) {
+                if d.optimal > 1e-4 {
+                    let ratio = (d.travelled - d.allowance) / d.optimal;
+                    if ratio > HOLD_RATIO {
+                        eprintln!("seed {seed} at {at}: {ratio} of {}", d.optimal);
+                    }
+                    ratios.push(d.travelled / d.optimal);
+                }
+            }
+        }
+    }
+    ratios.sort_by(f64::total_cmp);
+    let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
+    eprintln!(
+        "{} holds: min {:.4} median {:.4} p90 {:.4} max {:.4}",
+        ratios.len(),
+        q(0.0),
+        q(0.5),
+        q(0.9),
+        q(1.0)
+    );
 }
