@@ -13,7 +13,7 @@ use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
 use tezgah_motion::path::smooth::{SmoothOptions, CHORD_SHARE};
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
-use tezgah_motion::{Junction, Segment};
+use tezgah_motion::{Junction, Limits, Segment};
 
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
@@ -21,6 +21,7 @@ use crate::job::{Job, JobOptions, PlannedItem};
 use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
+use crate::overspeed::overspeed_limits;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::SetPoint;
 
@@ -78,6 +79,8 @@ enum Current {
         cursor: PieceCursor,
         tau: f64,
         factor: f64,
+        /// Its limits above the planned speed, if it may run faster (override > 100 %).
+        fast: Option<Limits>,
     },
     Dwell {
         left: f64,
@@ -104,6 +107,8 @@ pub struct Executor {
     current: Option<Current>,
     /// The planned item after the current one, taken early for the time scale's look-ahead.
     peeked: Option<PlannedItem>,
+    /// The peeked piece's overspeed limits (worked out once, when it is peeked).
+    peeked_fast: Option<Limits>,
     scale: TimeScale,
     /// A feed hold's (or abort's) stop along the path in progress.
     hold: Option<hold::Hold>,
@@ -197,6 +202,7 @@ impl Executor {
             job: None,
             current: None,
             peeked: None,
+            peeked_fast: None,
             scale: TimeScale::default(),
             hold: None,
             mode: Mode::Auto,
@@ -553,7 +559,8 @@ impl Executor {
 
     fn target(&self, factor: f64) -> f64 {
         match self.state {
-            RunState::Running => (self.override_pct / 100.0 / factor).min(1.0),
+            // Above 1 only as far as the pieces' overspeed limits allow (the time scale caps it).
+            RunState::Running => self.override_pct / 100.0 / factor,
             _ => 0.0,
         }
     }
@@ -613,6 +620,13 @@ impl Executor {
             if let Some(job) = self.job.as_mut() {
                 self.peeked = job.next(factor)?;
             }
+            self.peeked_fast = match &self.peeked {
+                Some(PlannedItem {
+                    item: Planned::Motion(p),
+                    ..
+                }) => self.fast_limits(p),
+                _ => None,
+            };
         }
         let next = match &self.peeked {
             Some(PlannedItem {
@@ -621,22 +635,26 @@ impl Executor {
             }) => Some(PieceView {
                 profile: &p.profile,
                 limits: &p.limits,
+                fast: self.peeked_fast,
             }),
             _ => None,
         };
         let dtau = match &self.current {
-            Some(Current::Piece { cursor, tau, .. }) => {
+            Some(Current::Piece {
+                cursor, tau, fast, ..
+            }) => {
                 let p = cursor.piece();
                 let current = PieceView {
                     profile: &p.profile,
                     limits: &p.limits,
+                    fast: *fast,
                 };
                 self.scale.step(target, current, next, *tau, ts).dtau
             }
             _ => {
                 // Standing still (a dwell): r may jump, nothing moves. A dwell is wall time
                 // (override does not stretch it, as on LinuxCNC); a hold or an abort stops it.
-                self.scale.r = target;
+                self.scale.r = target.min(1.0);
                 self.scale.rate = 0.0;
                 if target > 0.0 {
                     ts
@@ -699,20 +717,22 @@ impl Executor {
             let Some(job) = self.job.as_mut() else {
                 return Ok(Some(Event::Done));
             };
-            let next = match self.peeked.take() {
-                Some(p) => Some(p),
-                None => job.next(factor)?,
+            let (next, fast) = match self.peeked.take() {
+                Some(p) => (Some(p), self.peeked_fast.take()),
+                None => (job.next(factor)?, None),
             };
             let Some(PlannedItem { item, factor }) = next else {
                 return Ok(Some(Event::Done));
             };
             match item {
                 Planned::Motion(piece) => {
+                    let fast = fast.or_else(|| self.fast_limits(&piece));
                     let cursor = PieceCursor::new(Arc::from(piece));
                     self.current = Some(Current::Piece {
                         cursor,
                         tau: 0.0,
                         factor,
+                        fast,
                     });
                     return Ok(None);
                 }
@@ -777,6 +797,12 @@ impl Executor {
                 None => return Ok(Event::Done),
             }
         }
+    }
+
+    /// A piece's limits above its planned speed ([`crate::overspeed`]); worked out only while
+    /// the override asks for more than the piece was planned for.
+    fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
+        overspeed_limits(piece, &self.machine, &self.options.plan)
     }
 
     /// Leaves the piece in hand at its exact end (every segment passed on the way counted);

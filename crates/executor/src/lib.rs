@@ -13,6 +13,7 @@ pub mod executor;
 pub mod job;
 pub mod manual;
 pub mod mdi;
+pub mod overspeed;
 pub mod path_stop;
 pub mod ring;
 pub mod rt;

@@ -70,6 +70,9 @@ pub struct Advance {
 pub struct PieceView<'a> {
     pub profile: &'a Profile,
     pub limits: &'a Limits,
+    /// The limits above the planned speed, if the piece may run faster than planned
+    /// ([`crate::overspeed`]); `None` keeps r ≤ 1 on it.
+    pub fast: Option<Limits>,
 }
 
 /// Where τ falls: the plan's state there and the limits in force, or past what is known.
@@ -86,6 +89,8 @@ struct At<'a> {
 struct Plan<'a> {
     current: PieceView<'a>,
     next: Option<PieceView<'a>>,
+    /// Largest r allowed (1, or the override's target where the pieces allow more).
+    r_max: f64,
 }
 
 impl<'a> Plan<'a> {
@@ -125,7 +130,7 @@ impl<'a> Plan<'a> {
     fn period_range(&self, r: f64, rd: f64, tau: f64, ts: f64) -> (f64, f64) {
         let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
         for f in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            let rf = (r + rd * f * ts).clamp(0.0, 1.0);
+            let rf = (r + rd * f * ts).clamp(0.0, self.r_max);
             let at = self.at(tau + f * rf * ts);
             let (st, j_max) = (at.state, at.limits.max_jerk());
             let c = st.v + 3.0 * rf * f * ts * st.a;
@@ -167,7 +172,7 @@ impl Plan<'_> {
         let mid = 0.5 * (lo + hi);
         PULL.iter().find_map(|&k| {
             let rdd = c + k * (mid - c);
-            period::check(self, r, rd, rdd, tau, ts, 1.0)
+            period::check(self, r, rd, rdd, tau, ts)
         })
     }
 }
@@ -191,11 +196,26 @@ impl TimeScale {
         self.r == 0.0 && self.rate == 0.0
     }
 
-    /// Whether from (r, ṙ) at τ the rate can be braked to 0 within the limits against the
-    /// plan ahead, with r staying within [0, 1].
+    /// The r̈ the settling test plays from (r, ṙ) at τ (a function of the state alone, so
+    /// the test's first period is always a candidate of the next step): brake ṙ to 0 at
+    /// r ≤ 1; above 1 (override past 100 %) the square-root approach down to r = 1.
+    fn settle_rdd(plan: &Plan, r: f64, rd: f64, tau: f64, ts: f64) -> f64 {
+        if r <= 1.0 + SLACK {
+            return -rd / ts;
+        }
+        let at = plan.at(tau);
+        let v = at.state.v.max(1e-9);
+        let (rd_max, rdd_max) = ramp_bounds(at.limits, v, ts);
+        approach(1.0 - r, rd, rd_max, rdd_max, ts).clamp(-rdd_max, rdd_max)
+    }
+
+    /// Whether from (r, ṙ) at τ the scale can settle — ṙ braked to 0 with r ≤ 1, where
+    /// holding r constant is admissible (s̈ = r²a, s⃛ = r³j) — within the limits against
+    /// the plan ahead ([`TimeScale::settle_rdd`] played period by period, each passing the
+    /// exact check).
     fn can_settle(plan: &Plan, mut r: f64, mut rd: f64, mut tau: f64, ts: f64) -> bool {
         for _ in 0..HORIZON {
-            if rd == 0.0 {
+            if rd == 0.0 && r <= 1.0 + SLACK {
                 return true;
             }
             let at = plan.at(tau);
@@ -211,7 +231,8 @@ impl TimeScale {
             if lo > hi {
                 return false;
             }
-            let Some(p) = plan.fit(r, rd, -rd / ts, (lo, hi), tau, ts) else {
+            let want = Self::settle_rdd(plan, r, rd, tau, ts);
+            let Some(p) = plan.fit(r, rd, want, (lo, hi), tau, ts) else {
                 return false;
             };
             // A braking step of r̈ = −ṙ/Ts lands on ṙ = 0 but for rounding; one pulled
@@ -227,8 +248,9 @@ impl TimeScale {
         false
     }
 
-    /// Advances one period `ts` toward `target` (0 ≤ target ≤ 1) at path time `tau` of the
-    /// piece in hand (`next`: the following piece, if planned already).
+    /// Advances one period `ts` toward `target` (≥ 0; above 1 only as far as the pieces'
+    /// overspeed limits allow) at path time `tau` of the piece in hand (`next`: the following
+    /// piece, if planned already).
     pub fn step(
         &mut self,
         target: f64,
@@ -237,46 +259,47 @@ impl TimeScale {
         tau: f64,
         ts: f64,
     ) -> Advance {
-        let target = target.clamp(0.0, 1.0);
-        let plan = Plan { current, next };
         let limits = current.limits;
+        // Above the planned speed no faster than the overspeed limit allows on the piece's
+        // fastest stretch (r·v ≤ V_fast wherever v ≤ V).
+        let cap = current
+            .fast
+            .map_or(1.0, |f| f.max_velocity() / limits.max_velocity())
+            .max(1.0);
+        let target = target.clamp(0.0, cap);
+        let plan = Plan {
+            current,
+            next,
+            r_max: target.max(1.0).max(self.r),
+        };
         let st = plan.at(tau).state;
         let v = st.v.max(0.0);
         if v == 0.0 && st.a == 0.0 {
-            // The plan is at rest here: r may jump (ṡ = s̈ = 0 whatever r is; s⃛ = r³j ≤ J).
-            self.r = target;
+            // The plan is at rest here: r may jump (ṡ = s̈ = 0 whatever r is; s⃛ = r³j ≤ J
+            // for r ≤ 1; above 1 the ramp starts from there).
+            self.r = target.min(1.0);
             self.rate = 0.0;
             return Advance {
-                dtau: target * ts,
+                dtau: self.r * ts,
                 checked: true,
             };
         }
         let (r, rd) = (self.r, self.rate);
-        let v_ref = v.max(1e-9);
-        // At low speed r could swing within a period; the plan's state is only sampled
-        // there, so r moves at most a few percent per period.
-        let rd_max = (RAMP_SHARE * limits.max_acceleration() / v_ref).min(MAX_SWING / ts);
-        let rdd_max = (RAMP_SHARE * limits.max_jerk() / v_ref).min(MAX_SWING / (4.0 * ts * ts));
-        let e = target - r;
-        // Discrete-time square-root approach: the rate from which braking at r̈_max in whole
-        // periods ends exactly at the target, ṙ = r̈Ts·(√(¼ + 2|e|/(r̈Ts²)) − ½).
-        let step = rdd_max * ts;
-        let brake_rate = step * ((0.25 + 2.0 * e.abs() / (step * ts)).sqrt() - 0.5);
-        let want = e.signum() * brake_rate.min(rd_max);
+        let (rd_max, rdd_max) = ramp_bounds(limits, v.max(1e-9), ts);
         // Speeding the ramp up uses its share; slowing it down may use whatever the full
         // limits leave (the range below), so a ramp never overshoots for want of braking.
-        let mut direct = (want - rd) / ts;
-        if direct * rd >= 0.0 || want * rd < 0.0 {
+        let want_rate = approach_rate(target - r, rd_max, rdd_max, ts);
+        let mut direct = (want_rate - rd) / ts;
+        if direct * rd >= 0.0 || want_rate * rd < 0.0 {
             direct = direct.clamp(-rdd_max, rdd_max);
         }
         let (lo, hi) = plan.period_range(r, rd, tau, ts);
         let (lo, hi) = (lo.min(hi), hi.max(lo));
-        let brake = (-rd / ts).clamp(lo, hi);
+        let settle = Self::settle_rdd(&plan, r, rd, tau, ts).clamp(lo, hi);
         let mut chosen = None;
         for lambda in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            let rdd = (direct * (1.0 - lambda) + brake * lambda).clamp(lo, hi);
-            let pc = plan.fit(r, rd, rdd, (lo, hi), tau, ts);
-            if let Some(p) = pc {
+            let rdd = (direct * (1.0 - lambda) + settle * lambda).clamp(lo, hi);
+            if let Some(p) = plan.fit(r, rd, rdd, (lo, hi), tau, ts) {
                 if Self::can_settle(&plan, p.r, p.rate, tau + p.dtau, ts) {
                     chosen = Some(p);
                     break;
@@ -286,8 +309,8 @@ impl TimeScale {
         let checked = chosen.is_some();
         let p = chosen.unwrap_or_else(|| {
             // Nothing passes (the state before was not settled-checked, e.g. a ramp the
-            // plan's next piece surprised): brake as hard as the sampled bounds allow.
-            let (r1, rate, dtau) = integrate(r, rd, brake, ts);
+            // plan's next piece surprised): settle as hard as the sampled bounds allow.
+            let (r1, rate, dtau) = integrate(r, rd, settle, ts);
             period::Period { r: r1, rate, dtau }
         });
         let (mut r1, mut rd1) = (p.r, p.rate);
@@ -296,13 +319,36 @@ impl TimeScale {
             r1 = target;
             rd1 = 0.0;
         }
-        self.r = r1.clamp(0.0, 1.0);
+        self.r = r1.clamp(0.0, plan.r_max);
         self.rate = if self.r == r1 { rd1 } else { 0.0 };
         Advance {
             dtau: p.dtau.max(0.0),
             checked,
         }
     }
+}
+
+/// The ramp's own bounds on ṙ and r̈ at plan speed v: its share of A/v and J/v, and at low
+/// speed at most a few percent of r per period (the plan's state is only sampled there).
+fn ramp_bounds(limits: &Limits, v: f64, ts: f64) -> (f64, f64) {
+    (
+        (RAMP_SHARE * limits.max_acceleration() / v).min(MAX_SWING / ts),
+        (RAMP_SHARE * limits.max_jerk() / v).min(MAX_SWING / (4.0 * ts * ts)),
+    )
+}
+
+/// Discrete-time square-root approach: the rate toward an error `e` from which braking at
+/// r̈_max in whole periods ends exactly on it, ṙ = r̈Ts·(√(¼ + 2|e|/(r̈Ts²)) − ½), at most
+/// `rd_max`.
+fn approach_rate(e: f64, rd_max: f64, rdd_max: f64, ts: f64) -> f64 {
+    let step = rdd_max * ts;
+    let brake_rate = step * ((0.25 + 2.0 * e.abs() / (step * ts)).sqrt() - 0.5);
+    e.signum() * brake_rate.min(rd_max)
+}
+
+/// The r̈ that takes ṙ to the square-root approach's rate toward error `e` in one period.
+fn approach(e: f64, rd: f64, rd_max: f64, rdd_max: f64, ts: f64) -> f64 {
+    (approach_rate(e, rd_max, rdd_max, ts) - rd) / ts
 }
 
 #[cfg(test)]
@@ -324,7 +370,7 @@ mod tests {
             let ts = 0.001;
             let length = v * 10.0;
             let profile = solve(length, v, v, &limits).unwrap();
-            let piece = PieceView { profile: &profile, limits: &limits };
+            let piece = PieceView { profile: &profile, limits: &limits, fast: None };
             let mut scale = TimeScale::default();
             let mut tau = 0.0;
             let mut s = vec![0.0];

@@ -694,3 +694,58 @@ fn hold_distance_distribution() {
         q(1.0)
     );
 }
+
+/// Override above 100 % reaches the moves already planned: on a long line whose feed (not
+/// the machine) caps the speed, 150 % and 200 % set after the start speed up the piece in
+/// hand to 1.5× and 2× the feed and shorten the cycle in proportion; on a line planned near
+/// the joint's speed limit (X: 200 mm/s on mill3) 200 % reaches that limit and no more. Every
+/// joint stays within its limits throughout.
+#[test]
+fn override_above_100_speeds_up_the_planned_window() {
+    let run = |program: &str, percent: f64| {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load {
+            program: program.into(),
+        })
+        .unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        drive(&mut exec, &mut trace, 100_000, |k, e| {
+            if k == 200 {
+                e.command(Command::FeedOverride { percent }).unwrap();
+            }
+        });
+        assert_eq!(exec.state(), RunState::Idle);
+        let (out, report) = trace.report();
+        assert_within_limits(&report);
+        assert_continuous(&out);
+        assert!((out.last().unwrap().tip - Vec3::new(150.0, 0.0, 0.0)).norm() < 1e-9);
+        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+    };
+    // One piece, planned at 10 mm/s before the override changes.
+    let slow = "G21 G90 F600\nG1 X150\nM2\n";
+    let (v100, n100) = run(slow, 100.0);
+    let (v150, n150) = run(slow, 150.0);
+    let (v200, n200) = run(slow, 200.0);
+    assert!((v100 - 10.0).abs() < 1e-9, "{v100}");
+    // Short of the target the discrete approach ends within its smallest move (r̈_max·Ts²,
+    // see `scale.rs`' unit test): 2.5e-4 of the speed here.
+    assert!((v150 / 15.0 - 1.0).abs() < 1e-3, "{v150}");
+    assert!((v200 / 20.0 - 1.0).abs() < 1e-3, "{v200}");
+    // 150 mm at 10 mm/s is 15 s; the first 0.2 s run at 100 %.
+    let want = |f: f64| 200.0 + (n100 as f64 - 200.0) / f;
+    assert!(
+        (n150 as f64 / want(1.5) - 1.0).abs() < 0.01,
+        "{n150} vs {}",
+        want(1.5)
+    );
+    assert!(
+        (n200 as f64 / want(2.0) - 1.0).abs() < 0.01,
+        "{n200} vs {}",
+        want(2.0)
+    );
+    // Planned at 150 mm/s, X's limit is 200 mm/s: 200 % reaches it, not 300 mm/s.
+    let fast = "G21 G90 F9000\nG1 X150\nM2\n";
+    let (top, _) = run(fast, 200.0);
+    assert!(top <= 200.0 * (1.0 + 1e-9) && top > 199.0, "{top}");
+}

@@ -11,7 +11,7 @@
 //! contains every value s̈ and s⃛ take in the period; the bound is loose only by the
 //! correlation it ignores, which is O(Ts) relative.
 
-use tezgah_motion::{Profile, State};
+use tezgah_motion::{Limits, Profile, State};
 
 use super::Plan;
 
@@ -79,6 +79,11 @@ pub(super) struct PlanRange {
     pub max_velocity: f64,
     pub max_acceleration: f64,
     pub max_jerk: f64,
+    /// The piece's limits above its planned speed, if it may run faster.
+    pub fast: Option<Limits>,
+    /// The span reaches a junction the plan passes moving: r must be ≤ 1 there (the
+    /// junction's cap holds up to the planned speed only).
+    pub junction: bool,
 }
 
 impl PlanRange {
@@ -94,10 +99,12 @@ impl PlanRange {
             max_velocity: f64::INFINITY,
             max_acceleration: f64::INFINITY,
             max_jerk: f64::INFINITY,
+            fast: None,
+            junction: false,
         }
     }
 
-    fn limit(&mut self, l: &tezgah_motion::Limits) {
+    fn limit(&mut self, l: &Limits) {
         self.max_velocity = self.max_velocity.min(l.max_velocity());
         self.max_acceleration = self.max_acceleration.min(l.max_acceleration());
         self.max_jerk = self.max_jerk.min(l.max_jerk());
@@ -159,10 +166,13 @@ impl Plan<'_> {
     pub(super) fn ranges(&self, tau0: f64, tau1: f64) -> [Option<PlanRange>; 3] {
         let mut out = [None; 3];
         let d = self.current.profile.duration();
+        let moving_junction = self.current.profile.end().v > 0.0;
         if tau0 <= d {
             let mut r = PlanRange::empty();
             r.limit(self.current.limits);
             r.profile(self.current.profile, tau0, tau1.min(d));
+            r.fast = self.current.fast;
+            r.junction = tau1 >= d && moving_junction;
             out[0] = Some(r);
         }
         if tau1 <= d {
@@ -176,6 +186,8 @@ impl Plan<'_> {
                     let mut r = PlanRange::empty();
                     r.limit(n.limits);
                     r.profile(n.profile, t0, t1.min(dn));
+                    r.fast = n.fast;
+                    r.junction = moving_junction;
                     out[1] = Some(r);
                 }
                 if t1 <= dn {
@@ -201,17 +213,12 @@ pub(super) struct Period {
     pub dtau: f64,
 }
 
-/// The period from (r, ṙ) at τ with r̈ = `c` over `ts`, if r stays within [0, `r_max`], the
-/// path speed within the plan's limit, and |s̈| ≤ A, |s⃛| ≤ J at every instant of it.
-pub(super) fn check(
-    plan: &Plan,
-    r: f64,
-    rd: f64,
-    c: f64,
-    tau: f64,
-    ts: f64,
-    r_max: f64,
-) -> Option<Period> {
+/// The period from (r, ṙ) at τ with r̈ = `c` over `ts`, if r stays within [0, r_max], the
+/// path speed within the plan's limit, and |s̈| ≤ A, |s⃛| ≤ J at every instant of it. Where
+/// r exceeds 1 in the period the piece's overspeed limits apply, and no junction may lie in
+/// it.
+pub(super) fn check(plan: &Plan, r: f64, rd: f64, c: f64, tau: f64, ts: f64) -> Option<Period> {
+    let r_max = plan.r_max;
     let r1 = r + rd * ts + c * ts * ts / 2.0;
     let rd1 = rd + c * ts;
     let dtau = r * ts + rd * ts * ts / 2.0 + c * ts * ts * ts / 6.0;
@@ -241,12 +248,22 @@ pub(super) fn check(
         .iter()
         .flatten()
         .all(|p| {
+            let (v_max, a_max, j_max) = if rr.hi > 1.0 + super::SLACK {
+                match p.fast {
+                    Some(f) if !p.junction => (
+                        f.max_velocity(),
+                        f.max_acceleration().min(p.max_acceleration),
+                        f.max_jerk().min(p.max_jerk),
+                    ),
+                    _ => return false,
+                }
+            } else {
+                (p.max_velocity, p.max_acceleration, p.max_jerk)
+            };
             let speed = rr.mul(p.v);
             let acc = rdr.mul(p.v).add(rr2.mul(p.a));
             let jerk = p.v.scale(c).add(cross.mul(p.a)).add(rr3.mul(p.j));
-            speed.hi <= p.max_velocity * slack
-                && acc.within(p.max_acceleration * slack)
-                && jerk.within(p.max_jerk * slack)
+            speed.hi <= v_max * slack && acc.within(a_max * slack) && jerk.within(j_max * slack)
         });
     ok.then_some(Period {
         r: r1.clamp(0.0, r_max),
@@ -276,8 +293,8 @@ mod tests {
             // Ends a length cannot join are not a plan.
             prop_assume!(profile.is_ok());
             let profile = profile.unwrap();
-            let piece = PieceView { profile: &profile, limits: &limits };
-            let plan = Plan { current: piece, next: None };
+            let piece = PieceView { profile: &profile, limits: &limits, fast: None };
+            let plan = Plan { current: piece, next: None, r_max: 1.0 };
             let d = profile.duration();
             let t0 = tau0 * d;
             let t1 = (t0 + span).min(d);
@@ -288,7 +305,7 @@ mod tests {
                 prop_assert!(range.a.lo - 1e-9 <= x.a && x.a <= range.a.hi + 1e-9);
             }
             let ts = 0.001;
-            if let Some(p) = check(&plan, r, rd, c, t0, ts, 1.0) {
+            if let Some(p) = check(&plan, r, rd, c, t0, ts) {
                 for k in 0..=200 {
                     let t = ts * k as f64 / 200.0;
                     let rt = r + rd * t + c * t * t / 2.0;
