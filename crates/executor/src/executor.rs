@@ -112,6 +112,8 @@ pub struct Executor {
     scale: TimeScale,
     /// A feed hold's (or abort's) stop along the path in progress.
     hold: Option<hold::Hold>,
+    /// Periods the time scale could not verify within the limits (see `unchecked_periods`).
+    unchecked: u64,
     mode: Mode,
     state: RunState,
     override_pct: f64,
@@ -205,6 +207,7 @@ impl Executor {
             peeked_fast: None,
             scale: TimeScale::default(),
             hold: None,
+            unchecked: 0,
             mode: Mode::Auto,
             state: RunState::Idle,
             override_pct: 100.0,
@@ -267,6 +270,12 @@ impl Executor {
             Some(Current::Piece { cursor, .. }) => Some(cursor.piece().limits),
             _ => None,
         }
+    }
+
+    /// Periods the time scale found no r̈ that passes its exact check (|s̈| ≤ A, |s⃛| ≤ J over
+    /// the whole period) and braked regardless: a diagnostic, zero in every test run.
+    pub fn unchecked_periods(&self) -> u64 {
+        self.unchecked
     }
 
     /// The segments the tool passed since the previous set-point, ending with its own.
@@ -649,7 +658,9 @@ impl Executor {
                     limits: &p.limits,
                     fast: *fast,
                 };
-                self.scale.step(target, current, next, *tau, ts).dtau
+                let adv = self.scale.step(target, current, next, *tau, ts);
+                self.unchecked += u64::from(!adv.checked);
+                adv.dtau
             }
             _ => {
                 // Standing still (a dwell): r may jump, nothing moves. A dwell is wall time

@@ -267,10 +267,12 @@ impl TimeScale {
             .map_or(1.0, |f| f.max_velocity() / limits.max_velocity())
             .max(1.0);
         let target = target.clamp(0.0, cap);
+        // The bound on r depends on the pieces only, not on the target: a settling test passed
+        // under one bound must still pass next period whatever the override did meanwhile.
         let plan = Plan {
             current,
             next,
-            r_max: target.max(1.0).max(self.r),
+            r_max: cap.max(self.r),
         };
         let st = plan.at(tau).state;
         let v = st.v.max(0.0);
@@ -288,7 +290,7 @@ impl TimeScale {
         let (rd_max, rdd_max) = ramp_bounds(limits, v.max(1e-9), ts);
         // Speeding the ramp up uses its share; slowing it down may use whatever the full
         // limits leave (the range below), so a ramp never overshoots for want of braking.
-        let want_rate = approach_rate(target - r, rd_max, rdd_max, ts);
+        let want_rate = rd + approach(target - r, rd, rd_max, rdd_max, ts) * ts;
         let mut direct = (want_rate - rd) / ts;
         if direct * rd >= 0.0 || want_rate * rd < 0.0 {
             direct = direct.clamp(-rdd_max, rdd_max);
@@ -346,9 +348,17 @@ fn approach_rate(e: f64, rd_max: f64, rdd_max: f64, ts: f64) -> f64 {
     e.signum() * brake_rate.min(rd_max)
 }
 
-/// The r̈ that takes ṙ to the square-root approach's rate toward error `e` in one period.
+/// The r̈ that takes ṙ to the square-root approach's rate toward error `e` in one period,
+/// the rate being the one for the error left at the period's end: with r̈ = (ṙ₁ − ṙ₀)/Ts
+/// the period moves r by (ṙ₀ + ṙ₁)·Ts/2, so ṙ₁ = rate(e − (ṙ₀ + ṙ₁)·Ts/2), solved by a few
+/// fixed-point steps. (Aiming at the rate for the error at the period's start brakes a
+/// period late: a ramp to 150 % overshot to 152.4 %.)
 fn approach(e: f64, rd: f64, rd_max: f64, rdd_max: f64, ts: f64) -> f64 {
-    (approach_rate(e, rd_max, rdd_max, ts) - rd) / ts
+    let mut rate = approach_rate(e, rd_max, rdd_max, ts);
+    for _ in 0..4 {
+        rate = approach_rate(e - (rd + rate) * ts / 2.0, rd_max, rdd_max, ts);
+    }
+    (rate - rd) / ts
 }
 
 #[cfg(test)]
