@@ -39,6 +39,10 @@ const SLACK: f64 = 1e-9;
 /// `Plan::fit`).
 const PULL: [f64; 5] = [0.0, 0.02, 0.1, 0.3, 1.0];
 
+/// Share of a piece's speed limit below which its end speed is rest (rounding of the profile's
+/// integration leaves ~1e-16 mm/s where it stops).
+const REST: f64 = 1e-9;
+
 /// Periods the settling test looks ahead at most.
 const HORIZON: usize = 4000;
 
@@ -156,9 +160,9 @@ impl<'a> Plan<'a> {
 }
 
 impl Plan<'_> {
-    /// The period with r̈ nearest `want` that passes the exact check: `want` within the
-    /// sampled range, else pulled toward the range's middle (the exact bound is a little
-    /// stricter than the samples near the range's ends).
+    /// The period with r̈ nearest `want` that passes the exact check: `want`, or `want`
+    /// within the sampled range, else pulled toward the range's middle (the exact bound is a
+    /// little stricter than the samples near the range's ends).
     fn fit(
         &self,
         r: f64,
@@ -168,6 +172,13 @@ impl Plan<'_> {
         tau: f64,
         ts: f64,
     ) -> Option<period::Period> {
+        // The wanted r̈ itself first: the sampled range has no rounding slack and may leave
+        // out what the exact check accepts (r = 1 + 1e-10 against a plan at full jerk).
+        if !(lo..=hi).contains(&want) {
+            if let Some(p) = period::check(self, r, rd, want, tau, ts) {
+                return Some(p);
+            }
+        }
         let c = want.clamp(lo, hi);
         let mid = 0.5 * (lo + hi);
         PULL.iter().find_map(|&k| {
@@ -224,8 +235,9 @@ impl TimeScale {
             }
             if at.unknown {
                 // The limits past the pieces known may be far lower: a ramp must have settled
-                // by then, unless the plan stops there.
-                return false;
+                // by then, unless the plan stops there (its end speed is zero but for
+                // rounding: a hold that ended just short of the program's end resumes).
+                return at.state.v <= REST * at.limits.max_velocity();
             }
             let (lo, hi) = plan.period_range(r, rd, tau, ts);
             if lo > hi {
@@ -237,7 +249,7 @@ impl TimeScale {
             };
             // A braking step of r̈ = −ṙ/Ts lands on ṙ = 0 but for rounding; one pulled
             // further (see `Plan::fit`) swings ṙ past 0, and that swing must settle too.
-            r = p.r;
+            r = snap_to_one(p.r);
             rd = if p.rate.abs() <= 1e-12 * rd.abs().max(1.0) {
                 0.0
             } else {
@@ -297,10 +309,12 @@ impl TimeScale {
         }
         let (lo, hi) = plan.period_range(r, rd, tau, ts);
         let (lo, hi) = (lo.min(hi), hi.max(lo));
-        let settle = Self::settle_rdd(&plan, r, rd, tau, ts).clamp(lo, hi);
+        // Unclamped: `fit` tries it as it is first, exactly as the settling test does, so the
+        // last candidate is the test's first period.
+        let settle = Self::settle_rdd(&plan, r, rd, tau, ts);
         let mut chosen = None;
         for lambda in [0.0, 0.25, 0.5, 0.75, 1.0] {
-            let rdd = (direct * (1.0 - lambda) + settle * lambda).clamp(lo, hi);
+            let rdd = direct * (1.0 - lambda) + settle * lambda;
             if let Some(p) = plan.fit(r, rd, rdd, (lo, hi), tau, ts) {
                 if Self::can_settle(&plan, p.r, p.rate, tau + p.dtau, ts) {
                     chosen = Some(p);
@@ -312,7 +326,7 @@ impl TimeScale {
         let p = chosen.unwrap_or_else(|| {
             // Nothing passes (the state before was not settled-checked, e.g. a ramp the
             // plan's next piece surprised): settle as hard as the sampled bounds allow.
-            let (r1, rate, dtau) = integrate(r, rd, settle, ts);
+            let (r1, rate, dtau) = integrate(r, rd, settle.clamp(lo, hi), ts);
             period::Period { r: r1, rate, dtau }
         });
         let (mut r1, mut rd1) = (p.r, p.rate);
@@ -321,12 +335,24 @@ impl TimeScale {
             r1 = target;
             rd1 = 0.0;
         }
+        let r1 = snap_to_one(r1);
         self.r = r1.clamp(0.0, plan.r_max);
         self.rate = if self.r == r1 { rd1 } else { 0.0 };
         Advance {
             dtau: p.dtau.max(0.0),
             checked,
         }
+    }
+}
+
+/// Back from above 1 to within rounding of it: exactly 1, where holding r is admissible
+/// whatever the plan does (just above, a plan at full jerk leaves no room to brake ṙ). The
+/// step and the settling test both apply it, so the test plays what the step will do.
+fn snap_to_one(r: f64) -> f64 {
+    if r > 1.0 && r - 1.0 < SLACK {
+        1.0
+    } else {
+        r
     }
 }
 

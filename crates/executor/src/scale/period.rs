@@ -218,36 +218,71 @@ pub(super) struct Period {
 /// r exceeds 1 in the period the piece's overspeed limits apply, and no junction may lie in
 /// it.
 pub(super) fn check(plan: &Plan, r: f64, rd: f64, c: f64, tau: f64, ts: f64) -> Option<Period> {
-    let r_max = plan.r_max;
-    let r1 = r + rd * ts + c * ts * ts / 2.0;
-    let rd1 = rd + c * ts;
-    let dtau = r * ts + rd * ts * ts / 2.0 + c * ts * ts * ts / 6.0;
-    let mut rr = Span::point(r);
-    rr.include(r1);
-    if c != 0.0 {
-        let vertex = -rd / c;
-        if vertex > 0.0 && vertex < ts {
-            rr.include(r - rd * rd / (2.0 * c));
-        }
-    }
-    if rr.lo < -super::SLACK || rr.hi > r_max + super::SLACK {
+    let motion = Motion { r, rd, c, tau };
+    let rr = motion.r_range(0.0, ts);
+    if rr.lo < -super::SLACK || rr.hi > plan.r_max + super::SLACK {
         return None;
     }
-    let rr = Span {
-        lo: rr.lo.max(0.0),
-        hi: rr.hi,
-    };
-    let mut rdr = Span::point(rd);
-    rdr.include(rd1);
-    let slack = 1.0 + super::SLACK;
-    let rr2 = rr.mul(rr);
-    let rr3 = rr.cube();
-    let cross = rr.mul(rdr).scale(3.0);
-    let ok = plan
-        .ranges(tau, tau + dtau.max(0.0))
-        .iter()
-        .flatten()
-        .all(|p| {
+    motion.within(plan, 0.0, ts, SPLITS).then(|| Period {
+        r: motion.r_at(ts).clamp(0.0, plan.r_max),
+        rate: rd + c * ts,
+        dtau: (motion.tau_at(ts) - tau).max(0.0),
+    })
+}
+
+/// Halvings of a period the check may make where the bound over a whole span is too loose:
+/// the interval product ignores that the plan's acceleration and r's rate take their extremes
+/// at different instants (a ramp braking ṙ as the plan comes to rest read as 126 mm/s³ of
+/// cross term where the true one is below 1). Sound at every depth; 4 gives spans of Ts/16.
+const SPLITS: u32 = 4;
+
+/// r over the period: r(t) = r₀ + ṙ₀t + ct²/2 from path time τ₀.
+#[derive(Debug, Clone, Copy)]
+struct Motion {
+    r: f64,
+    rd: f64,
+    c: f64,
+    tau: f64,
+}
+
+impl Motion {
+    fn r_at(&self, t: f64) -> f64 {
+        self.r + t * (self.rd + t * self.c / 2.0)
+    }
+
+    fn tau_at(&self, t: f64) -> f64 {
+        self.tau + t * (self.r + t * (self.rd / 2.0 + t * self.c / 6.0))
+    }
+
+    /// r over [t0, t1]: its ends and the parabola's vertex if inside.
+    fn r_range(&self, t0: f64, t1: f64) -> Span {
+        let mut rr = Span::point(self.r_at(t0));
+        rr.include(self.r_at(t1));
+        if self.c != 0.0 {
+            let vertex = -self.rd / self.c;
+            if vertex > t0 && vertex < t1 {
+                rr.include(self.r_at(vertex));
+            }
+        }
+        rr
+    }
+
+    /// Whether ṡ ≤ V, |s̈| ≤ A and |s⃛| ≤ J hold over [t0, t1], halving the span up to
+    /// `depth` times where the bound over it is too loose.
+    fn within(&self, plan: &Plan, t0: f64, t1: f64, depth: u32) -> bool {
+        let rr = self.r_range(t0, t1);
+        let rr = Span {
+            lo: rr.lo.max(0.0),
+            hi: rr.hi,
+        };
+        let mut rdr = Span::point(self.rd + self.c * t0);
+        rdr.include(self.rd + self.c * t1);
+        let slack = 1.0 + super::SLACK;
+        let rr2 = rr.mul(rr);
+        let rr3 = rr.cube();
+        let cross = rr.mul(rdr).scale(3.0);
+        let (tau0, tau1) = (self.tau_at(t0), self.tau_at(t1));
+        let ok = plan.ranges(tau0, tau1.max(tau0)).iter().flatten().all(|p| {
             let (v_max, a_max, j_max) = if rr.hi > 1.0 + super::SLACK {
                 match p.fast {
                     Some(f) if !p.junction => (
@@ -262,14 +297,15 @@ pub(super) fn check(plan: &Plan, r: f64, rd: f64, c: f64, tau: f64, ts: f64) -> 
             };
             let speed = rr.mul(p.v);
             let acc = rdr.mul(p.v).add(rr2.mul(p.a));
-            let jerk = p.v.scale(c).add(cross.mul(p.a)).add(rr3.mul(p.j));
+            let jerk = p.v.scale(self.c).add(cross.mul(p.a)).add(rr3.mul(p.j));
             speed.hi <= v_max * slack && acc.within(a_max * slack) && jerk.within(j_max * slack)
         });
-    ok.then_some(Period {
-        r: r1.clamp(0.0, r_max),
-        rate: rd1,
-        dtau: dtau.max(0.0),
-    })
+        if ok {
+            return true;
+        }
+        let tm = 0.5 * (t0 + t1);
+        depth > 0 && self.within(plan, t0, tm, depth - 1) && self.within(plan, tm, t1, depth - 1)
+    }
 }
 
 #[cfg(test)]
