@@ -6,10 +6,10 @@
 //! motion has ṡ = r·v, s̈ = ṙ·v + r²·a and s⃛ = r̈·v + 3r·ṙ·a + r³·j (chain rule). With
 //! 0 ≤ r ≤ 1 the speed stays within the plan's; each period r̈ is held constant and chosen so
 //! that |s̈| ≤ A and |s⃛| ≤ J of each piece's path limits hold at every instant of the period
-//! (the exact check of [`period`]) — which keeps every joint within its limits, since the
+//! (the exact check of `period`) — which keeps every joint within its limits, since the
 //! planner derived the path limits for any speed up to the piece's V. The candidates come from
-//! the linear bound at five instants ([`Plan::period_range`]); the exact check then accepts or
-//! refuses them ([`Plan::fit`] pulls a refused one toward the middle of that range). Above
+//! the linear bound at five instants (`Plan::period_range`); the exact check then accepts or
+//! refuses them (`Plan::fit` pulls a refused one toward the middle of that range). Above
 //! 100 % override r may exceed 1 on pieces whose overspeed limits allow it
 //! ([`crate::overspeed`]; `PieceView::fast`), never across a junction the plan passes moving.
 //!
@@ -17,7 +17,7 @@
 //! no r̈ can brake ṙ; a ramp that runs into such a stretch with ṙ ≠ 0 cannot stop in time and
 //! would overshoot r = 0 or 1 (an acceleration step). Holding r constant is always admissible
 //! (s̈ = r²a, s⃛ = r³j), so a state is kept only if from it ṙ can be braked to 0 within the
-//! limits against the plan's actual states ahead ([`TimeScale::can_settle`]; above 1, brought
+//! limits against the plan's actual states ahead (`TimeScale::can_settle`; above 1, brought
 //! back down to 1 first). Each period takes the most direct of a few candidate r̈ (the
 //! square-root approach to the target, blended toward the settling law) that passes that test.
 
