@@ -440,5 +440,43 @@ mod tests {
                 prop_assert!(jerk.abs() <= j * 1.005, "j {jerk} of {j}");
             }
         }
+
+        /// A piece planned below its overspeed limit (cruise at v, V_fast = k·v), targets up to
+        /// 2.5 switching at random periods, the piece ending in a junction passed moving: the
+        /// speed stays within V_fast, A and J hold by third differences, and r is back to 1 or
+        /// below before the piece ends.
+        #[test]
+        fn above_one_within_the_overspeed_limits(v in 1.0..100.0f64, k in 1.0..3.0f64,
+                                                 a in 100.0..5000.0f64, j in 1e3..1e6f64,
+                                                 targets in proptest::collection::vec((0.0..=2.5f64, 1usize..400), 1..6)) {
+            let limits = Limits::new(v, a, j).unwrap();
+            let fast = Limits::new(k * v, a, j).unwrap();
+            let ts = 0.001;
+            let profile = solve(v * 2.0, v, v, &limits).unwrap();
+            let piece = PieceView { profile: &profile, limits: &limits, fast: Some(fast) };
+            let mut scale = TimeScale::default();
+            let mut tau = 0.0;
+            let mut s = vec![0.0];
+            'run: for &(target, periods) in &targets {
+                for _ in 0..periods {
+                    let adv = scale.step(target, piece, None, tau, ts);
+                    prop_assert!(adv.checked);
+                    tau += adv.dtau;
+                    if tau >= profile.duration() {
+                        prop_assert!(scale.r <= 1.0, "r {} at the junction", scale.r);
+                        break 'run;
+                    }
+                    s.push(profile.state_at(tau).s);
+                }
+            }
+            for w in s.windows(4) {
+                let speed = (w[3] - w[2]) / ts;
+                let acc = (w[3] - 2.0 * w[2] + w[1]) / (ts * ts);
+                let jerk = (w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0]) / (ts * ts * ts);
+                prop_assert!(speed <= k * v * (1.0 + 1e-9), "v {speed} of {}", k * v);
+                prop_assert!(acc.abs() <= a * 1.005 + 1e-6, "a {acc} of {a}");
+                prop_assert!(jerk.abs() <= j * 1.005, "j {jerk} of {j}");
+            }
+        }
     }
 }
