@@ -584,13 +584,25 @@ fn hold_acts_at_once() {
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
     let at = 3000;
+    let mut scale_mid_stop = None;
     drive(&mut exec, &mut trace, 100_000, |k, e| {
         if k == at {
             e.command(Command::FeedHold).unwrap();
         }
+        if k == at + 15 {
+            scale_mid_stop = Some(e.status().time_scale);
+        }
     });
     assert_eq!(exec.state(), RunState::Held);
     let out = &trace.out;
+    // The status reads the stop's speed over the plan's (10 mm/s cruise) while stopping.
+    let mid = scale_mid_stop.unwrap();
+    assert!(
+        (mid - out[at + 14].feed / 10.0).abs() < 1e-9,
+        "{mid} vs {}",
+        out[at + 14].feed
+    );
+    assert_eq!(exec.status().time_scale, 0.0);
     assert!((out[at - 1].feed - 10.0).abs() < 1e-9, "cruising");
     assert!(
         out[at].feed < out[at - 1].feed,

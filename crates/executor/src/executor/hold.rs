@@ -195,15 +195,20 @@ impl Executor {
             }
         };
         self.sample_at(x.s)?;
+        // The plan's time follows the tool (where resume starts), and the status' time scale
+        // reads the stop's speed over the plan's there.
+        if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
+            let profile = &cursor.piece().profile;
+            *tau = time_at(profile, x.s, *tau);
+            let v = profile.state_at(*tau).v;
+            self.scale.r = if v > 0.0 { x.v / v } else { 0.0 };
+            self.scale.rate = 0.0;
+        }
         if hold.t < hold.duration() {
             self.hold = Some(hold);
             return Ok(Some(self.emit(false, x.v)));
         }
         self.hold = None;
-        if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
-            let from = if hold.crossed { 0.0 } else { *tau };
-            *tau = time_at(&cursor.piece().profile, x.s, from);
-        }
         self.scale = TimeScale::held();
         match self.state {
             RunState::Holding => self.state = RunState::Held,
