@@ -13,7 +13,7 @@ use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
 use tezgah_motion::path::smooth::{SmoothOptions, CHORD_SHARE};
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
-use tezgah_motion::{Junction, Segment};
+use tezgah_motion::{Junction, Limits, Segment};
 
 use crate::command::{Command, Mode, PauseReason, RunState, Status};
 use crate::error::ExecError;
@@ -21,10 +21,12 @@ use crate::job::{BuiltPath, Job, JobOptions, PlannedItem};
 use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
+use crate::overspeed::overspeed_limits;
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::{History, SetPoint};
 use crate::speed_override::Override;
 
+mod hold;
 mod manual;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
@@ -78,6 +80,8 @@ enum Current {
         cursor: PieceCursor,
         tau: f64,
         factor: f64,
+        /// Its limits above the planned speed, if it may run faster (override > 100 %).
+        fast: Option<Limits>,
     },
     Dwell {
         left: f64,
@@ -104,7 +108,13 @@ pub struct Executor {
     current: Option<Current>,
     /// The planned item after the current one, taken early for the time scale's look-ahead.
     peeked: Option<PlannedItem>,
+    /// The peeked piece's overspeed limits (worked out once, when it is peeked).
+    peeked_fast: Option<Limits>,
     scale: TimeScale,
+    /// A feed hold's (or abort's) stop along the path in progress.
+    hold: Option<hold::Hold>,
+    /// Periods the time scale could not verify within the limits (see `unchecked_periods`).
+    unchecked: u64,
     mode: Mode,
     state: RunState,
     override_pct: f64,
@@ -195,7 +205,10 @@ impl Executor {
             job: None,
             current: None,
             peeked: None,
+            peeked_fast: None,
             scale: TimeScale::default(),
+            hold: None,
+            unchecked: 0,
             mode: Mode::Auto,
             state: RunState::Idle,
             override_pct: 100.0,
@@ -257,6 +270,12 @@ impl Executor {
             Some(Current::Piece { cursor, .. }) => Some(cursor.piece().limits),
             _ => None,
         }
+    }
+
+    /// Periods the time scale found no r̈ that passes its exact check (|s̈| ≤ A, |s⃛| ≤ J over
+    /// the whole period) and braked regardless: a diagnostic, zero in every test run.
+    pub fn unchecked_periods(&self) -> u64 {
+        self.unchecked
     }
 
     /// The segments the tool passed since the previous set-point, ending with its own.
@@ -369,6 +388,7 @@ impl Executor {
         self.job = Some(job);
         self.current = None;
         self.peeked = None;
+        self.hold = None;
         self.mode = mode;
         self.state = RunState::Running;
         self.scale = TimeScale::held();
@@ -512,6 +532,7 @@ impl Executor {
         self.peeked = None;
         self.manual = None;
         self.last_manual = None;
+        self.hold = None;
         self.state = RunState::Idle;
         self.scale = TimeScale::held();
     }
@@ -542,7 +563,8 @@ impl Executor {
 
     fn target(&self, factor: f64) -> f64 {
         match self.state {
-            RunState::Running => (self.override_pct / 100.0 / factor).min(1.0),
+            // Above 1 only as far as the pieces' overspeed limits allow (the time scale caps it).
+            RunState::Running => self.override_pct / 100.0 / factor,
             _ => 0.0,
         }
     }
@@ -584,6 +606,12 @@ impl Executor {
                 return Ok(self.finish_event(ev));
             }
         }
+        // A hold stops along the path where it can (a stop begun runs to its end).
+        if self.hold.is_some()
+            || (matches!(self.state, RunState::Holding | RunState::Aborting) && self.begin_hold())
+        {
+            return self.step_hold();
+        }
         // The time scale moves with the plan's state where the tool is.
         let factor = match &self.current {
             Some(Current::Piece { factor, .. }) => *factor,
@@ -596,6 +624,13 @@ impl Executor {
             if let Some(job) = self.job.as_mut() {
                 self.peeked = job.next(factor)?;
             }
+            self.peeked_fast = match &self.peeked {
+                Some(PlannedItem {
+                    item: Planned::Motion(p),
+                    ..
+                }) => self.fast_limits(p),
+                _ => None,
+            };
         }
         let next = match &self.peeked {
             Some(PlannedItem {
@@ -604,22 +639,28 @@ impl Executor {
             }) => Some(PieceView {
                 profile: &p.profile,
                 limits: &p.limits,
+                fast: self.peeked_fast,
             }),
             _ => None,
         };
         let dtau = match &self.current {
-            Some(Current::Piece { cursor, tau, .. }) => {
+            Some(Current::Piece {
+                cursor, tau, fast, ..
+            }) => {
                 let p = cursor.piece();
                 let current = PieceView {
                     profile: &p.profile,
                     limits: &p.limits,
+                    fast: *fast,
                 };
-                self.scale.step(target, current, next, *tau, ts).dtau
+                let adv = self.scale.step(target, current, next, *tau, ts);
+                self.unchecked += u64::from(!adv.checked);
+                adv.dtau
             }
             _ => {
                 // Standing still (a dwell): r may jump, nothing moves. A dwell is wall time
                 // (override does not stretch it, as on LinuxCNC); a hold or an abort stops it.
-                self.scale.r = target;
+                self.scale.r = target.min(1.0);
                 self.scale.rate = 0.0;
                 if target > 0.0 {
                     ts
@@ -682,20 +723,22 @@ impl Executor {
             let Some(job) = self.job.as_mut() else {
                 return Ok(Some(Event::Done));
             };
-            let next = match self.peeked.take() {
-                Some(p) => Some(p),
-                None => job.next(factor)?,
+            let (next, fast) = match self.peeked.take() {
+                Some(p) => (Some(p), self.peeked_fast.take()),
+                None => (job.next(factor)?, None),
             };
             let Some(PlannedItem { item, factor }) = next else {
                 return Ok(Some(Event::Done));
             };
             match item {
                 Planned::Motion(piece) => {
+                    let fast = fast.or_else(|| self.fast_limits(&piece));
                     let cursor = PieceCursor::new(Arc::from(piece));
                     self.current = Some(Current::Piece {
                         cursor,
                         tau: 0.0,
                         factor,
+                        fast,
                     });
                     return Ok(None);
                 }
@@ -739,18 +782,7 @@ impl Executor {
                     }
                     left -= d - *tau;
                     *tau = d;
-                    // The piece's exact end, and every segment passed on the way.
-                    let end = cursor.piece().length();
-                    self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
-                    self.done_length += end;
-                    self.s = 0.0;
-                    self.passed.extend(cursor.passed().iter().cloned());
-                    let stop = cursor
-                        .piece()
-                        .segments
-                        .last()
-                        .is_some_and(|s| s.end == Junction::Stop);
-                    self.current = None;
+                    let stop = self.finish_piece()?;
                     if stop
                         && self.single_block
                         && self.mode == Mode::Auto
@@ -773,10 +805,44 @@ impl Executor {
         }
     }
 
+    /// A piece's limits above its planned speed ([`crate::overspeed`]); worked out only while
+    /// the override asks for more than the piece was planned for.
+    fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
+        overspeed_limits(piece, &self.machine, &self.options.plan)
+    }
+
+    /// Leaves the piece in hand at its exact end (every segment passed on the way counted);
+    /// whether the path stops there.
+    fn finish_piece(&mut self) -> Result<bool, ExecError> {
+        let Some(Current::Piece { cursor, .. }) = self.current.as_mut() else {
+            return Ok(false);
+        };
+        let end = cursor.piece().length();
+        self.pose = cursor.pose(&self.machine, end, &self.pose.joints)?;
+        self.done_length += end;
+        self.s = 0.0;
+        self.passed.extend(cursor.passed().iter().cloned());
+        let stop = cursor
+            .piece()
+            .segments
+            .last()
+            .is_some_and(|s| s.end == Junction::Stop);
+        self.current = None;
+        Ok(stop)
+    }
+
     /// The pose at the current path time.
     fn sample(&mut self) -> Result<(), ExecError> {
-        if let Some(Current::Piece { cursor, tau, .. }) = self.current.as_mut() {
+        if let Some(Current::Piece { cursor, tau, .. }) = &self.current {
             let s = cursor.piece().profile.state_at(*tau).s;
+            self.sample_at(s)?;
+        }
+        Ok(())
+    }
+
+    /// The pose at path coordinate `s` of the piece in hand.
+    fn sample_at(&mut self, s: f64) -> Result<(), ExecError> {
+        if let Some(Current::Piece { cursor, .. }) = self.current.as_mut() {
             self.s = s.clamp(0.0, cursor.piece().length());
             self.pose = cursor.pose(&self.machine, s, &self.pose.joints)?;
             // Segments passed inside this piece (its cursor keeps the current one).

@@ -13,6 +13,8 @@ pub mod executor;
 pub mod job;
 pub mod manual;
 pub mod mdi;
+pub mod overspeed;
+pub mod path_stop;
 pub mod realtime;
 pub mod ring;
 pub mod rt;

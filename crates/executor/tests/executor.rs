@@ -109,8 +109,18 @@ fn five_axis_tcp_plays_the_interpolator_samples() {
     plays_the_interpolator_samples(&machine, program);
 }
 
-/// Holds at period `at`, checks the stop, resumes; returns the whole trace.
-fn hold_and_resume(program: &str, at: usize) -> Vec<Produced> {
+/// The distance a hold at period `at` travelled, the time-optimal jerk-limited stop from the
+/// hold state (speed, and acceleration by backward difference, under the path limits where it
+/// began and ended), and the allowance the bound adds: one period's travel.
+struct HoldDistance {
+    travelled: f64,
+    optimal: f64,
+    allowance: f64,
+}
+
+/// Holds at period `at`, checks the stop, resumes; returns the whole trace and, if it held
+/// before the program ended, the hold's distance.
+fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDistance>) {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
     exec.command(Command::Load {
@@ -118,45 +128,69 @@ fn hold_and_resume(program: &str, at: usize) -> Vec<Produced> {
     })
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
+    let mut start = None;
     drive(&mut exec, &mut trace, 2_000_000, |k, e| {
         if k == at {
+            start = e.path_limits();
             e.command(Command::FeedHold).unwrap();
         }
     });
+    let mut distance = None;
     // Held, or the program ended before the hold.
     if exec.state() == RunState::Held {
         let out = &trace.out;
         let before = &out[at.saturating_sub(1)];
         let prev = &out[at.saturating_sub(2)];
         let a = (before.feed - prev.feed) / exec.period();
-        let l = exec.path_limits().expect("held inside a piece");
-        let bound = tezgah_executor::stop::stopping_distance(
-            before.feed,
-            a.max(0.0),
-            l.max_acceleration(),
-            l.max_jerk(),
-        );
-        // The time-optimal stop from the hold state is the floor; re-timing reaches it (median
-        // 1.00 of it, p90 1.23) except where the plan's own terms leave the ramp less room —
-        // the 3rṙa term while the plan accelerates or brakes at low speed: seen up to 3.7× (at
-        // 5 mm/s, 0.16 mm) — plus a crawl allowance for holds at near-zero speed, where r
-        // swings at most 10 % per period.
-        let travelled = out.last().unwrap().path - before.path;
-        assert!(
-            travelled <= 4.0 * bound + 0.01,
-            "hold travelled {travelled}, jerk-limited stop {bound} from v {} a {a}",
-            before.feed
-        );
+        let end = exec.path_limits().expect("held inside a piece");
+        // Under the limits of the piece where the hold began; if it stopped in another piece,
+        // the larger of the stops under either's limits (braking as each piece allows lies
+        // between them).
+        let optimal = [start.unwrap_or(end), end]
+            .iter()
+            .map(|l| {
+                tezgah_executor::stop::stopping_distance(
+                    before.feed,
+                    a.clamp(-l.max_acceleration(), l.max_acceleration()),
+                    l.max_acceleration(),
+                    l.max_jerk(),
+                )
+            })
+            .fold(0.0, f64::max);
+        let d = HoldDistance {
+            travelled: out.last().unwrap().path - before.path,
+            optimal,
+            allowance: before.feed * exec.period() + 1e-9,
+        };
+        distance = Some(d);
         // Standing: nothing produced while held.
         assert_eq!(exec.step().unwrap(), None);
         exec.command(Command::Resume).unwrap();
         drive(&mut exec, &mut trace, 2_000_000, |_, _| {});
     }
     assert_eq!(exec.state(), RunState::Idle);
+    assert_eq!(exec.unchecked_periods(), 0);
     let (out, report) = trace.report();
     assert_within(&report, RETIME_JERK);
     assert_continuous(&out);
-    out
+    (out, distance)
+}
+
+/// Bound on a hold's distance over the optimum (plus a period's travel).
+const HOLD_RATIO: f64 = 1.2;
+
+/// The stop along the path is the optimum (up to the backward difference's view of the
+/// acceleration); where it would leave the piece the time scale brakes along the plan, which
+/// slows for what lies past the piece anyway.
+fn assert_hold_distance(d: &Option<HoldDistance>) {
+    if let Some(d) = d {
+        assert!(
+            d.travelled <= HOLD_RATIO * d.optimal + d.allowance,
+            "hold travelled {}, jerk-limited stop {}",
+            d.travelled,
+            d.optimal
+        );
+    }
 }
 
 proptest! {
@@ -170,7 +204,8 @@ proptest! {
         let program = random_program(seed, 12);
         let full = reference(&program);
         let at = ((full.len() as f64) * frac) as usize;
-        let out = hold_and_resume(&program, at);
+        let (out, d) = hold_and_resume(&program, at);
+        assert_hold_distance(&d);
         let (a, b) = (full.last().unwrap(), out.last().unwrap());
         prop_assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0), "{} vs {}", a.path, b.path);
         prop_assert!((a.tip - b.tip).norm() <= 1e-9);
@@ -204,6 +239,7 @@ proptest! {
         });
         prop_assert!(k < 40 * n + 10_000, "did not finish");
         prop_assert_eq!(exec.state(), RunState::Idle);
+        prop_assert_eq!(exec.unchecked_periods(), 0);
         let (out, report) = trace.report();
         assert_within(&report, RETIME_JERK);
         assert_continuous(&out);
@@ -235,6 +271,83 @@ proptest! {
         assert_within(&report, RETIME_JERK);
         assert_continuous(&out);
         prop_assert!(out.last().unwrap().tip.norm() <= 1e-9);
+    }
+}
+
+/// What happens at a random instant of a run.
+#[derive(Debug, Clone, Copy)]
+enum Event {
+    /// Feed hold, resumed this many periods later.
+    Hold(usize),
+    Override(f64),
+}
+
+fn event() -> impl Strategy<Value = Event> {
+    prop_oneof![
+        (1usize..400).prop_map(Event::Hold),
+        (0.0..=200.0f64).prop_map(Event::Override),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, .. ProptestConfig::default() })]
+
+    /// Holds (resumed after a random wait) and override changes mixed at random instants of
+    /// random programs: every joint within its velocity, acceleration and jerk limits by
+    /// finite differences at the 0.5 % margin (motion's verifier), on the path, and the
+    /// whole path traced once to the program's end.
+    #[test]
+    fn holds_and_overrides_mixed(seed in any::<u64>(),
+                                 events in proptest::collection::vec((0.0..1.0f64, event()), 1..6)) {
+        let program = random_program(seed, 6);
+        let full = reference(&program);
+        let n = full.len();
+        let mut at: Vec<(usize, Event)> =
+            events.iter().map(|&(f, e)| ((f * n as f64) as usize, e)).collect();
+        at.sort_by_key(|e| e.0);
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load { program: program.clone() }).unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        let mut resume_at = None;
+        let mut k = 0usize;
+        // Periods while held produce nothing: count them on the same clock.
+        while k < 50 * n + 20_000 {
+            for &(when, e) in &at {
+                if when == k {
+                    match e {
+                        Event::Hold(wait) => {
+                            exec.command(Command::FeedHold).unwrap();
+                            resume_at = Some(k + wait);
+                        }
+                        Event::Override(pct) => {
+                            exec.command(Command::FeedOverride { percent: pct }).unwrap();
+                        }
+                    }
+                }
+            }
+            if resume_at == Some(k) {
+                exec.command(Command::Resume).unwrap();
+            }
+            if k == at.last().unwrap().0 + 1000 {
+                // Back to 100 % so a program slowed to 0 % still finishes.
+                exec.command(Command::FeedOverride { percent: 100.0 }).unwrap();
+            }
+            match exec.step().unwrap() {
+                Some(p) => trace.push(&exec, &p),
+                None if exec.state() == RunState::Idle => break,
+                None => {}
+            }
+            k += 1;
+        }
+        prop_assert_eq!(exec.state(), RunState::Idle, "did not finish");
+        prop_assert_eq!(exec.unchecked_periods(), 0);
+        let (out, report) = trace.report();
+        assert_within_limits(&report);
+        assert_continuous(&out);
+        let (a, b) = (full.last().unwrap(), out.last().unwrap());
+        prop_assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0), "{} vs {}", a.path, b.path);
+        prop_assert!((a.tip - b.tip).norm() <= 1e-9);
     }
 }
 
@@ -397,8 +510,11 @@ fn commands_and_status_are_json() {
 /// Cases random search found: a hold just before a piece whose limits are far lower (the
 /// ramp overshot r = 1 on resume there: jerk 2× the limit), a hold near a piece end
 /// (before the scale looked into the next piece it had to settle first and travelled 4.4×
-/// the jerk-limited distance), and the longest hold relative to the optimum seen since
-/// (3.7× at 5 mm/s while the plan brakes).
+/// the jerk-limited distance), the longest hold relative to the optimum seen since
+/// (3.7× at 5 mm/s while the plan brakes, before holds stopped along the path), and two
+/// resumes the exact check first found no admissible r̈ for (a ramp braking as the plan comes
+/// to rest, read too loosely over a whole period; a ramp at the 10 %-per-period swing the
+/// step offered only clamped to the sampled range, unlike the settling test).
 #[test]
 fn holds_found_by_random_search() {
     for (seed, frac) in [
@@ -406,11 +522,14 @@ fn holds_found_by_random_search() {
         (9140456590163406861, 0.4674030868806516),
         (14994837013506972269, 0.24545552370152987),
         (6793599893845973526, 0.7627745976792988),
+        (14994833438458997899, 0.24545552370152987),
+        (14994837011761343493, 0.24545552370152987),
     ] {
         let program = random_program(seed, 12);
         let full = reference(&program);
         let at = ((full.len() as f64) * frac) as usize;
-        let out = hold_and_resume(&program, at);
+        let (out, d) = hold_and_resume(&program, at);
+        assert_hold_distance(&d);
         assert!((full.last().unwrap().tip - out.last().unwrap().tip).norm() <= 1e-9);
     }
 }
@@ -453,7 +572,7 @@ fn override_scales_the_programmed_feed() {
 }
 
 /// At cruise a hold acts in the next period and stops in the time-optimal jerk-limited time
-/// (from 10 mm/s under mill3's path limits) plus the last periods of the discrete approach.
+/// (from 10 mm/s under mill3's path limits), rounded up to whole periods.
 #[test]
 fn hold_acts_at_once() {
     let program = "G21 G90 F600\nG1 X150\nM2\n";
@@ -465,13 +584,25 @@ fn hold_acts_at_once() {
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
     let at = 3000;
+    let mut scale_mid_stop = None;
     drive(&mut exec, &mut trace, 100_000, |k, e| {
         if k == at {
             e.command(Command::FeedHold).unwrap();
         }
+        if k == at + 15 {
+            scale_mid_stop = Some(e.status().time_scale);
+        }
     });
     assert_eq!(exec.state(), RunState::Held);
     let out = &trace.out;
+    // The status reads the stop's speed over the plan's (10 mm/s cruise) while stopping.
+    let mid = scale_mid_stop.unwrap();
+    assert!(
+        (mid - out[at + 14].feed / 10.0).abs() < 1e-9,
+        "{mid} vs {}",
+        out[at + 14].feed
+    );
+    assert_eq!(exec.status().time_scale, 0.0);
     assert!((out[at - 1].feed - 10.0).abs() < 1e-9, "cruising");
     assert!(
         out[at].feed < out[at - 1].feed,
@@ -485,10 +616,17 @@ fn hold_acts_at_once() {
     } else {
         2.0 * (v / j).sqrt()
     };
-    let took = (out.len() - at) as f64 * exec.period();
-    // The discrete approach of r = 0 ends with a few periods of crawl (µm/s): 33 vs 28.3 ms.
+    // From cruise the stop is two jerk ramps: distance v·√(v/J).
+    let travelled = out.last().unwrap().path - out[at - 1].path;
     assert!(
-        took <= optimal + 6.0 * exec.period(),
+        (travelled - v * (v / j).sqrt()).abs() < 1e-9,
+        "{travelled} vs {}",
+        v * (v / j).sqrt()
+    );
+    let took = (out.len() - at) as f64 * exec.period();
+    // The stop along the path is that optimum, ending inside the last period.
+    assert!(
+        took <= optimal + exec.period() + 1e-12,
         "{took} s vs {optimal} s"
     );
     let (out, report) = trace.report();
@@ -540,4 +678,235 @@ fn dwell_runs_in_wall_time() {
     let (dh, held) = periods(dwell, 100.0, Some(m100 + 100));
     assert!(held > 0, "held inside the dwell");
     assert!((dh as i64 - d100 as i64).abs() <= 2, "{dh} vs {d100}");
+}
+
+/// The distribution of hold distances over the optimum on random holds (for the notes:
+/// `cargo test -p tezgah-executor --test executor hold_distance_distribution -- --ignored
+/// --nocapture`); the bound itself is asserted in every hold.
+#[test]
+#[ignore]
+fn hold_distance_distribution() {
+    let mut ratios = vec![];
+    let mut net = 0.0f64;
+    for seed in 0..40u64 {
+        let program = random_program(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15), 12);
+        let n = reference(&program).len();
+        for k in 1..=5 {
+            let at = n * k / 6;
+            if let (_, Some(d)) = hold_and_resume(&program, at) {
+                if d.optimal > 1e-4 {
+                    let ratio = (d.travelled - d.allowance) / d.optimal;
+                    net = net.max(ratio);
+                    if ratio > HOLD_RATIO {
+                        eprintln!("seed {seed} at {at}: {ratio} of {}", d.optimal);
+                    }
+                    ratios.push(d.travelled / d.optimal);
+                }
+            }
+        }
+    }
+    ratios.sort_by(f64::total_cmp);
+    let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
+    eprintln!(
+        "{} holds: min {:.4} median {:.4} p90 {:.4} max {:.4}; less a period's travel, max {:.4}",
+        ratios.len(),
+        q(0.0),
+        q(0.5),
+        q(0.9),
+        q(1.0),
+        net
+    );
+}
+
+/// Override above 100 % reaches the moves already planned: on a long line whose feed (not
+/// the machine) caps the speed, 150 % and 200 % set after the start speed up the piece in
+/// hand to 1.5× and 2× the feed and shorten the cycle in proportion; on a line planned near
+/// the joint's speed limit (X: 200 mm/s on mill3) 200 % reaches that limit and no more. Every
+/// joint stays within its limits throughout.
+#[test]
+fn override_above_100_speeds_up_the_planned_window() {
+    let run = |program: &str, percent: f64| {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load {
+            program: program.into(),
+        })
+        .unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        drive(&mut exec, &mut trace, 100_000, |k, e| {
+            if k == 200 {
+                e.command(Command::FeedOverride { percent }).unwrap();
+            }
+        });
+        assert_eq!(exec.state(), RunState::Idle);
+        let (out, report) = trace.report();
+        assert_within_limits(&report);
+        assert_continuous(&out);
+        assert!((out.last().unwrap().tip - Vec3::new(150.0, 0.0, 0.0)).norm() < 1e-9);
+        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+    };
+    // One piece, planned at 10 mm/s before the override changes.
+    let slow = "G21 G90 F600\nG1 X150\nM2\n";
+    let (v100, n100) = run(slow, 100.0);
+    let (v150, n150) = run(slow, 150.0);
+    let (v200, n200) = run(slow, 200.0);
+    assert!((v100 - 10.0).abs() < 1e-9, "{v100}");
+    // The discrete approach lands within a small overshoot (3.5e-4 of the speed at 150 %)
+    // and then circles the target by less (see `scale.rs`' unit test).
+    assert!((v150 / 15.0 - 1.0).abs() < 1e-3, "{v150}");
+    assert!((v200 / 20.0 - 1.0).abs() < 1e-3, "{v200}");
+    // 150 mm at 10 mm/s is 15 s; the first 0.2 s run at 100 %.
+    let want = |f: f64| 200.0 + (n100 as f64 - 200.0) / f;
+    assert!(
+        (n150 as f64 / want(1.5) - 1.0).abs() < 0.01,
+        "{n150} vs {}",
+        want(1.5)
+    );
+    assert!(
+        (n200 as f64 / want(2.0) - 1.0).abs() < 0.01,
+        "{n200} vs {}",
+        want(2.0)
+    );
+    // Planned at 150 mm/s, X's limit is 200 mm/s: 200 % reaches it, not 300 mm/s.
+    let fast = "G21 G90 F9000\nG1 X150\nM2\n";
+    let (top, _) = run(fast, 200.0);
+    assert!(top <= 200.0 * (1.0 + 1e-9) && top > 199.0, "{top}");
+}
+
+/// Worst joint speed, acceleration and jerk over their limits in a verifier's report.
+fn worst_ratios(report: &tezgah_motion::verify::Report) -> [f64; 3] {
+    let mut w = [0.0f64; 3];
+    for j in &report.joints {
+        w[0] = w[0].max(j.velocity / j.max_velocity);
+        w[1] = w[1].max(j.acceleration / j.max_acceleration);
+        w[2] = w[2].max(j.jerk / j.max_jerk);
+    }
+    w
+}
+
+/// Figures for the notes (`cargo test -p tezgah-executor --test executor
+/// retime_limit_figures -- --ignored --nocapture`): 60 random programs, each with an override
+/// change (150, 200, 30, 0 or 120 %) back to 100 % 0.8 s later and a hold resumed 0.3 s
+/// later at deterministic pseudo-random instants; worst joint ratios by finite differences
+/// and the periods the time scale could not verify. The limits themselves are asserted by
+/// the property tests above.
+#[test]
+#[ignore]
+fn retime_limit_figures() {
+    let mut all = vec![];
+    let mut unchecked = 0;
+    for seed in 100..160u64 {
+        let program = random_program(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15), 10);
+        let n = reference(&program).len();
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load { program }).unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        let hold = (seed as usize * 7919) % n;
+        let change = (seed as usize * 104_729) % n;
+        let percent = [150.0, 200.0, 30.0, 0.0, 120.0][seed as usize % 5];
+        for k in 0..100 * n + 100_000 {
+            if k == change {
+                exec.command(Command::FeedOverride { percent }).unwrap();
+            }
+            if k == change + 800 {
+                exec.command(Command::FeedOverride { percent: 100.0 })
+                    .unwrap();
+            }
+            if k == hold {
+                exec.command(Command::FeedHold).unwrap();
+            }
+            if k == hold + 300 {
+                exec.command(Command::Resume).unwrap();
+            }
+            match exec.step().unwrap() {
+                Some(p) => trace.push(&exec, &p),
+                None if exec.state() == RunState::Idle => break,
+                None => {}
+            }
+        }
+        assert_eq!(exec.state(), RunState::Idle);
+        unchecked += exec.unchecked_periods();
+        all.push(worst_ratios(&trace.report().1));
+    }
+    let column = |i: usize| {
+        let mut c: Vec<f64> = all.iter().map(|w| w[i]).collect();
+        c.sort_by(f64::total_cmp);
+        (c[c.len() / 2], c[c.len() - 1])
+    };
+    eprintln!(
+        "{} runs: jerk/J median {:.6} max {:.6}; acceleration/A max {:.6}; speed/V max {:.5}; \
+         unchecked periods {unchecked}",
+        all.len(),
+        column(2).0,
+        column(2).1,
+        column(1).1,
+        column(0).1
+    );
+}
+
+/// On a table-tilting 5-axis machine under TCP (joints curved along every move, so no piece
+/// runs faster than planned) holds at several instants, resumed, with the override moved
+/// to 150 % and 40 % on the way: every joint within its limits, the path traced once to
+/// the same end.
+#[test]
+fn five_axis_holds_and_override() {
+    use tezgah_executor::executor::{ExecOptions, Executor};
+    let mut machine = tezgah_kinematics::Machine::builtin("table-ac").unwrap();
+    machine.tcp = tezgah_kinematics::TcpSwitch::Always;
+    let program = "G21 G90 G94 G64\nG1 X10 Y0 Z10 A10 C0 F900\nG1 X30 Y5 Z8 A25 C40\n\
+                   G1 X35 Y25 Z6 A20 C80\nG1 X15 Y30 Z8 A12 C100\nM2\n";
+    let new = || {
+        Executor::new(
+            &machine,
+            ExecOptions::for_machine(&machine).unwrap(),
+            tezgah_geom::Pose::ZERO,
+        )
+        .unwrap()
+    };
+    let mut exec = new();
+    let mut trace = Trace::new(&exec);
+    run_program(&mut exec, &mut trace, program);
+    let full = trace.out;
+    let n = full.len();
+    let mut exec = new();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::Load {
+        program: program.into(),
+    })
+    .unwrap();
+    exec.command(Command::CycleStart).unwrap();
+    let holds = [n / 7, 2 * n / 5, 3 * n / 4];
+    let mut held = 0;
+    for k in 0..20 * n {
+        if holds.contains(&k) {
+            exec.command(Command::FeedHold).unwrap();
+        }
+        if k == n / 4 {
+            exec.command(Command::FeedOverride { percent: 150.0 })
+                .unwrap();
+        }
+        if k == n / 2 {
+            exec.command(Command::FeedOverride { percent: 40.0 })
+                .unwrap();
+        }
+        match exec.step().unwrap() {
+            Some(p) => trace.push(&exec, &p),
+            None if exec.state() == RunState::Held => {
+                held += 1;
+                exec.command(Command::Resume).unwrap();
+            }
+            None => break,
+        }
+    }
+    assert_eq!(exec.state(), RunState::Idle);
+    assert_eq!(held, holds.len());
+    assert_eq!(exec.unchecked_periods(), 0);
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
+    let (a, b) = (full.last().unwrap(), out.last().unwrap());
+    assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0));
+    assert!((a.tip - b.tip).norm() <= 1e-9);
+    assert!((a.rotary[0] - b.rotary[0]).abs() <= 1e-9 && (a.rotary[2] - b.rotary[2]).abs() <= 1e-9);
 }
