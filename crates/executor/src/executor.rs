@@ -75,6 +75,9 @@ impl ExecOptions {
     }
 }
 
+/// What is being played now. One value lives in the executor, so the size difference between
+/// the variants costs nothing; boxing the cursor would allocate per piece instead.
+#[allow(clippy::large_enum_variant)]
 enum Current {
     Piece {
         cursor: PieceCursor,
