@@ -406,33 +406,52 @@ fn least_squares(
     let mut ctrl = Vec::with_capacity(n + 1);
     ctrl.push(q0);
     if unknowns > 0 {
-        let mut a = Banded::new(unknowns, p, p);
+        // The normal matrix is symmetric: its upper band is summed here (`upper[i][d]` is
+        // entry `(i, i + d)`, each a sum over the data in the same order as a full assembly,
+        // so bit for bit the same) and mirrored once at the end.
+        let mut upper = vec![[0.0; W]; unknowns];
         let mut rhs = vec![Vec3::zeros(); unknowns];
         let mut b = [0.0; W];
+        // The data are sorted by parameter (densify keeps them so): the span only moves
+        // forward, a step instead of a binary search per point.
+        let mut s = p;
         for &(u, q) in &data[1..data.len() - 1] {
-            let s = find_span(&knots, p, n, u);
+            while s < n && u >= knots[s + 1] {
+                s += 1;
+            }
+            if u < knots[s] {
+                s = find_span(&knots, p, n, u);
+            }
             basis_funs(&knots, s, u, p, &mut b);
             let mut r = q;
-            for (j, v) in b[..=p].iter().enumerate() {
-                let i = s - p + j;
-                if i == 0 {
-                    r -= q0 * *v;
-                } else if i == n {
-                    r -= qm * *v;
-                }
+            if s == p {
+                r -= q0 * b[0];
             }
-            for (j, bj) in b[..=p].iter().enumerate() {
+            if s == n {
+                r -= qm * b[p];
+            }
+            for j in 0..=p {
                 let i = s - p + j;
                 if i == 0 || i == n {
                     continue;
                 }
-                rhs[i - 1] += r * *bj;
-                for (l, bl) in b[..=p].iter().enumerate() {
-                    let c = s - p + l;
-                    if c != 0 && c != n {
-                        a.add(i - 1, c - 1, bj * bl);
+                let bj = b[j];
+                rhs[i - 1] += r * bj;
+                let row = &mut upper[i - 1];
+                for l in j..=p {
+                    if s - p + l == n {
+                        break;
                     }
+                    row[l - j] += bj * b[l];
                 }
+            }
+        }
+        let mut a = Banded::new(unknowns, p, p);
+        for (i, row) in upper.iter().enumerate() {
+            a.add(i, i, row[0]);
+            for d in 1..=p.min(unknowns - 1 - i) {
+                a.add(i, i + d, row[d]);
+                a.add(i + d, i, row[d]);
             }
         }
         if lambda > 0.0 {
