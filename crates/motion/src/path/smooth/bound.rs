@@ -110,10 +110,25 @@ impl Chords {
     /// `min_j (max_i d(P_i, L_j) + h_j)`: an upper bound of the Bézier piece's distance from
     /// the neighbours.
     fn upper(&self, ctrl: &[Vec3; 6]) -> f64 {
-        self.list.iter().fold(f64::INFINITY, |best, c| {
-            let far = ctrl.iter().map(|q| c.distance2(q)).fold(0.0, f64::max);
-            best.min(far.sqrt() + c.slack)
-        })
+        let mut best = f64::INFINITY;
+        'chords: for c in &self.list {
+            // Squared-distance cut-off: a chord whose bound cannot beat `best` is dropped at
+            // the first control point that shows it (most chords are far from most pieces).
+            let reach = best - c.slack;
+            if reach <= 0.0 {
+                continue;
+            }
+            let reach2 = reach * reach;
+            let mut far = 0.0f64;
+            for q in ctrl {
+                far = far.max(c.distance2(q));
+                if far >= reach2 {
+                    continue 'chords;
+                }
+            }
+            best = far.sqrt() + c.slack;
+        }
+        best
     }
 
     /// `min_j (d(q, L_j) − h_j)`: a lower bound of `q`'s distance from the neighbours.
