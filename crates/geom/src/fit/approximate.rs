@@ -386,6 +386,56 @@ fn densify(data: &mut Vec<(f64, Vec3)>, interior: &[f64], p: usize, t: &[f64], p
     }
 }
 
+/// The data's share of the normal equations: the upper band of `NᵀN` (`upper[i][d]` is entry
+/// `(i, i + d)` of the unknown interior control points) and `Nᵀr`, `r` the data less the pinned
+/// end control points' share.
+struct Sums<'a> {
+    upper: &'a mut [[f64; W]],
+    rhs: &'a mut [Vec3],
+}
+
+impl Sums<'_> {
+    /// Add every datum but the two ends (they pin the end control points). The data are
+    /// sorted by parameter (densify keeps them so): the span only moves forward, a step
+    /// instead of a binary search per point.
+    #[inline(always)]
+    fn add_data(self, data: &[(f64, Vec3)], knots: &[f64], p: usize, n: usize, q0: Vec3, qm: Vec3) {
+        let mut b = [0.0; W];
+        let mut s = p;
+        for &(u, q) in &data[1..data.len() - 1] {
+            while s < n && u >= knots[s + 1] {
+                s += 1;
+            }
+            if u < knots[s] {
+                s = find_span(knots, p, n, u);
+            }
+            basis_funs(knots, s, u, p, &mut b);
+            let mut r = q;
+            if s == p {
+                r -= q0 * b[0];
+            }
+            if s == n {
+                r -= qm * b[p];
+            }
+            for j in 0..=p {
+                let i = s - p + j;
+                if i == 0 || i == n {
+                    continue;
+                }
+                let bj = b[j];
+                self.rhs[i - 1] += r * bj;
+                let row = &mut self.upper[i - 1];
+                for l in j..=p {
+                    if s - p + l == n {
+                        break;
+                    }
+                    row[l - j] += bj * b[l];
+                }
+            }
+        }
+    }
+}
+
 /// Least squares with the end control points pinned to the end data (A9.7's formulation):
 /// minimise `Σ |C(t_k) − Q_k|²` over the interior control points.
 fn least_squares(
@@ -411,40 +461,15 @@ fn least_squares(
         // so bit for bit the same) and mirrored once at the end.
         let mut upper = vec![[0.0; W]; unknowns];
         let mut rhs = vec![Vec3::zeros(); unknowns];
-        let mut b = [0.0; W];
-        // The data are sorted by parameter (densify keeps them so): the span only moves
-        // forward, a step instead of a binary search per point.
-        let mut s = p;
-        for &(u, q) in &data[1..data.len() - 1] {
-            while s < n && u >= knots[s + 1] {
-                s += 1;
-            }
-            if u < knots[s] {
-                s = find_span(&knots, p, n, u);
-            }
-            basis_funs(&knots, s, u, p, &mut b);
-            let mut r = q;
-            if s == p {
-                r -= q0 * b[0];
-            }
-            if s == n {
-                r -= qm * b[p];
-            }
-            for j in 0..=p {
-                let i = s - p + j;
-                if i == 0 || i == n {
-                    continue;
-                }
-                let bj = b[j];
-                rhs[i - 1] += r * bj;
-                let row = &mut upper[i - 1];
-                for l in j..=p {
-                    if s - p + l == n {
-                        break;
-                    }
-                    row[l - j] += bj * b[l];
-                }
-            }
+        let sums = Sums {
+            upper: &mut upper,
+            rhs: &mut rhs,
+        };
+        // The cubic (every compressed run) with the degree a constant, so the loops unroll.
+        if p == 3 {
+            sums.add_data(data, &knots, 3, n, q0, qm);
+        } else {
+            sums.add_data(data, &knots, p, n, q0, qm);
         }
         let mut a = Banded::new(unknowns, p, p);
         for (i, row) in upper.iter().enumerate() {
