@@ -427,6 +427,11 @@ impl Curve for Nurbs {
         self.rat_derivs(u, 1)[1]
     }
 
+    /// From the Bézier span cache's hodograph (non-rational, degree ≤ 3), else unknown.
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        self.spans.as_ref()?.speed_ratio(a, b)
+    }
+
     fn breakpoints(&self) -> Vec<f64> {
         let (a, b) = self.domain();
         let mut out = vec![a];
