@@ -474,9 +474,10 @@ fn least_squares(
         let mut a = Banded::new(unknowns, p, p);
         for (i, row) in upper.iter().enumerate() {
             a.add(i, i, row[0]);
-            for d in 1..=p.min(unknowns - 1 - i) {
-                a.add(i, i + d, row[d]);
-                a.add(i + d, i, row[d]);
+            let width = p.min(unknowns - 1 - i);
+            for (d, &v) in row.iter().enumerate().take(width + 1).skip(1) {
+                a.add(i, i + d, v);
+                a.add(i + d, i, v);
             }
         }
         if lambda > 0.0 {
