@@ -124,9 +124,11 @@ fn refine(
             Err(e) => return Err(e),
         };
         // (The curve evaluates from its Bézier span cache: cubic, non-rational.)
-        let check = |quick| measure(&curve, points, t, &interior, tolerance, quick);
         // A samples-only pass finds the violations of the early rounds at a fraction of the
-        // cost; only when it finds none does the refined check (the one that can accept) run.
+        // cost; only when it finds none does the refined check (the one that can accept) run,
+        // reusing the hull bounds the first pass proved (same curve, same bounds).
+        let mut hulls = vec![f64::NAN; points.len() - 1];
+        let mut check = |quick| measure(&curve, points, t, &interior, tolerance, quick, &mut hulls);
         let (mut worst, mut worst_in_span) = check(true);
         if worst <= tolerance {
             (worst, worst_in_span) = check(false);
@@ -176,7 +178,8 @@ fn span_bounds(interior: &[f64]) -> Vec<f64> {
 
 /// Largest deviation over all pieces and points (or its convex-hull bound where that proves
 /// a piece inside), and the worst violation `(distance, u)` in each knot span (None where the
-/// span is within tolerance).
+/// span is within tolerance). `hulls[k]` holds piece `k`'s squared hull bound once computed
+/// (NaN before): the refined pass after a quick one reuses them.
 fn measure(
     curve: &Nurbs,
     points: &[Vec3],
@@ -184,6 +187,7 @@ fn measure(
     interior: &[f64],
     tolerance: f64,
     quick: bool,
+    hulls: &mut [f64],
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
     let bounds = span_bounds(interior);
@@ -212,11 +216,14 @@ fn measure(
         // segment k is convex, so the largest vertex distance bounds the piece's distance from
         // above (and the distance to the three segments is at most that to segment k): when it
         // is inside the tolerance no sample can find a violation, and the bound is recorded.
-        if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
-            if h2 <= tol2 {
-                marks.note(h2.sqrt(), t[k]);
-                continue;
+        if hulls[k].is_nan() {
+            if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
+                hulls[k] = h2;
             }
+        }
+        if hulls[k] <= tol2 {
+            marks.note(hulls[k].sqrt(), t[k]);
+            continue;
         }
         // More samples where knots fall inside the piece: each span may bend on its own.
         let inside =
