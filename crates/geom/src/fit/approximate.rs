@@ -102,6 +102,12 @@ fn refine(
     let mut interior: Vec<f64> = Vec::new();
     let mut data: Vec<(f64, Vec3)> = t.iter().copied().zip(points.iter().copied()).collect();
     let mut best = f64::INFINITY;
+    // Each segment once, with its inverse squared length: the distance tests run several
+    // times per piece and round, and a division and square root each was their cost.
+    let segs: Vec<Segment> = points
+        .windows(2)
+        .map(|w| Segment::new(&w[0], &w[1]))
+        .collect();
     for round in 1..=MAX_ROUNDS {
         densify(&mut data, &interior, p, t, points);
         if fair && interior.len() + p + 1 > points.len() {
@@ -128,7 +134,11 @@ fn refine(
         // cost; only when it finds none does the refined check (the one that can accept) run,
         // reusing the hull bounds the first pass proved (same curve, same bounds).
         let mut hulls = vec![f64::NAN; points.len() - 1];
-        let mut check = |quick| measure(&curve, points, t, &interior, tolerance, quick, &mut hulls);
+        let mut check = |quick| {
+            measure(
+                &curve, points, t, &interior, tolerance, quick, &segs, &mut hulls,
+            )
+        };
         let (mut worst, mut worst_in_span) = check(true);
         if worst <= tolerance {
             (worst, worst_in_span) = check(false);
@@ -179,7 +189,8 @@ fn span_bounds(interior: &[f64]) -> Vec<f64> {
 /// Largest deviation over all pieces and points (or its convex-hull bound where that proves
 /// a piece inside), and the worst violation `(distance, u)` in each knot span (None where the
 /// span is within tolerance). `hulls[k]` holds piece `k`'s squared hull bound once computed
-/// (NaN before): the refined pass after a quick one reuses them.
+/// (NaN before): the refined pass after a quick one reuses them. `segs` are the polyline's.
+#[allow(clippy::too_many_arguments)]
 fn measure(
     curve: &Nurbs,
     points: &[Vec3],
@@ -187,6 +198,7 @@ fn measure(
     interior: &[f64],
     tolerance: f64,
     quick: bool,
+    segs: &[Segment],
     hulls: &mut [f64],
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
@@ -197,12 +209,6 @@ fn measure(
         worst: 0.0,
         tolerance,
     };
-    // Each segment once, with its inverse squared length: the distance tests below run
-    // several times per piece and round, and a division and square root each was their cost.
-    let segs: Vec<Segment> = points
-        .windows(2)
-        .map(|w| Segment::new(&w[0], &w[1]))
-        .collect();
     let tol2 = tolerance * tolerance;
     let mut span = 0;
     for k in 0..m {
