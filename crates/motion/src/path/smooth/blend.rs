@@ -480,8 +480,13 @@ mod tests {
             let a = piece(Geo::Spline(Shared::new(
                 Nurbs::bspline(3, &ctrl, knots).unwrap(),
             )));
-            // Outgoing: a line or a spline, turning 20–150°.
-            let turn = (20.0 + 130.0 * (0.5 + 0.5 * rnd())).to_radians();
+            // Outgoing: a line or a spline, turning 20–150°, or (one case in five) nearly
+            // tangent, 0.001–0.01 rad: long blends, as where two splines meet at a window.
+            let turn = if case % 5 == 4 {
+                0.001 + 0.009 * (0.5 + 0.5 * rnd())
+            } else {
+                (20.0 + 130.0 * (0.5 + 0.5 * rnd())).to_radians()
+            };
             let side = dir.cross(&Vec3::new(rnd(), rnd(), rnd())).normalize();
             let out = dir * turn.cos() + side * turn.sin();
             let b = if case % 2 == 0 {
