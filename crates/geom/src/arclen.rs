@@ -5,7 +5,8 @@
 //! # Error bound
 //!
 //! Each knot span (breakpoint interval, where the integrand `|C'(u)|` is smooth) starts as 8
-//! panels and is split adaptively. A panel `[a, b]` is accepted when the 8-point Gauss–Legendre value `G(a, b)`
+//! panels (2 where the curve proves its speed varies by at most 2× there,
+//! [`Curve::speed_ratio`]: no narrow feature to hide) and is split adaptively. A panel `[a, b]` is accepted when the 8-point Gauss–Legendre value `G(a, b)`
 //! and the sum of the two half-panel values `G(a, m) + G(m, b)` differ by at most
 //! `tol · (b − a) / (u_end − u_start)`; the halves are kept. The difference bounds the error
 //! of the coarse value, and the kept halves are more accurate by the rule's order (error
@@ -47,6 +48,13 @@ const GL_W: [f64; 4] = [
 
 /// Panels each knot span starts with before adaptive halving.
 const MIN_PANELS: usize = 8;
+
+/// Panels an evenly paced span starts with: one whose speed provably varies by at most
+/// [`EVEN_SPEED`] ([`Curve::speed_ratio`]) has no narrow feature of `|C'|` to fool the halving
+/// test, which the eight panels are there for; the test still decides every panel.
+const EVEN_PANELS: usize = 2;
+/// Largest `max |C'| / min |C'|` of an evenly paced span.
+const EVEN_SPEED: f64 = 2.0;
 
 /// Deepest halving of one panel (2⁻⁴⁰ of a span) before it is accepted regardless.
 const MAX_DEPTH: u32 = 40;
@@ -120,10 +128,15 @@ impl ArcLengthMap {
             // Start every span at MIN_PANELS panels: a narrow feature of |C'| (a near-cusp,
             // a heavy weight) can fool the halving test on a panel that spans it whole, when
             // neither rule sees the feature and both agree on the wrong value.
-            let h = (b - a) / MIN_PANELS as f64;
-            for i in (0..MIN_PANELS).rev() {
+            let panels = if curve.speed_ratio(a, b).is_some_and(|r| r <= EVEN_SPEED) {
+                EVEN_PANELS
+            } else {
+                MIN_PANELS
+            };
+            let h = (b - a) / panels as f64;
+            for i in (0..panels).rev() {
                 let x0 = a + h * i as f64;
-                let x1 = if i + 1 == MIN_PANELS {
+                let x1 = if i + 1 == panels {
                     b
                 } else {
                     a + h * (i + 1) as f64

@@ -42,8 +42,18 @@ pub fn find_span(knots: &[f64], first: usize, last: usize, u: f64) -> usize {
 
 /// A2.2 BasisFuns: `n[j] = N_{span-p+j, p}(u)` for `j = 0..=p`.
 pub fn basis_funs(knots: &[f64], span: usize, u: f64, p: usize, n: &mut [f64; W]) {
-    let mut left = [0.0; W];
-    let mut right = [0.0; W];
+    // Scratch sized to the degree, as in ders_basis_funs: zeroing two 16-wide arrays per call
+    // was a third of a cubic's cost (the least-squares fitter calls this once per data point).
+    match p {
+        0..=3 => basis_impl::<4>(knots, span, u, p, n),
+        4..=5 => basis_impl::<6>(knots, span, u, p, n),
+        _ => basis_impl::<W>(knots, span, u, p, n),
+    }
+}
+
+fn basis_impl<const N: usize>(knots: &[f64], span: usize, u: f64, p: usize, n: &mut [f64; W]) {
+    let mut left = [0.0; N];
+    let mut right = [0.0; N];
     n[0] = 1.0;
     for j in 1..=p {
         left[j] = u - knots[span + 1 - j];

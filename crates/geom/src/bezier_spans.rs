@@ -128,6 +128,26 @@ impl BezierSpans {
         Some(crate::arclen::gauss_legendre_8(speed, a, b))
     }
 
+    /// An upper bound of `max |C'| / min |C'|` over `[u0, u1]` when it lies in one span: the
+    /// derivative of a Bézier span lies in the convex hull of its hodograph's control points
+    /// `3(b_{i+1} − b_i)` (Farin, *Curves and Surfaces for CAGD*, §4.5), so its length is at
+    /// most the longest of them and at least their smallest component along their mean
+    /// direction, when that is positive. `None` across a knot or when the hull nears zero.
+    pub(crate) fn speed_ratio(&self, u0: f64, u1: f64) -> Option<f64> {
+        let k = self.index(0.5 * (u0 + u1));
+        if u0 < self.starts[k] || u1 > self.starts[k + 1] {
+            return None;
+        }
+        let b = &self.spans[k];
+        let h = [b[1] - b[0], b[2] - b[1], b[3] - b[2]];
+        let mean = h[0] + h[1] + h[2];
+        let d = mean / mean.norm();
+        let low = h.iter().map(|v| v.dot(&d)).fold(f64::INFINITY, f64::min);
+        let high = h.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let ratio = high / low;
+        (low > 0.0 && ratio.is_finite()).then_some(ratio)
+    }
+
     /// An upper bound of `f` over the curve piece `u` in `[u0, u1]` when `f` is convex (a
     /// distance to a convex set): the piece is cut at the knots, each part's Bézier control
     /// points are found by blossoming, and the part lies in their convex hull (Piegl & Tiller
@@ -312,5 +332,45 @@ mod tests {
                 assert!(bound - sampled < 1e-5, "[{u0}, {u1}]: {bound} vs {sampled}");
             }
         }
+    }
+
+    #[test]
+    fn speed_ratio_bounds_the_sampled_speeds() {
+        // Random cubic spans: wherever a ratio is claimed, every sampled |C'| lies within it
+        // (max/min over 400 samples ≤ the ratio), and straight-ish spans do get one.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let (mut claimed, mut tried) = (0, 0);
+        for case in 0..2000 {
+            // From nearly straight to wild: control points off a line by `bend`.
+            let bend = [0.01, 0.1, 0.5, 2.0][case % 4];
+            let mut p = |i: f64| Vec3::new(i, bend * rnd(), bend * rnd());
+            let b = [p(0.0), p(1.0), p(2.0), p(3.0)];
+            let spans = BezierSpans::new(std::iter::once((0.0, 2.0, b)));
+            tried += 1;
+            let Some(r) = spans.speed_ratio(0.0, 2.0) else {
+                continue;
+            };
+            claimed += 1;
+            let speeds: Vec<f64> = (0..=400)
+                .map(|i| d1(&b, i as f64 / 400.0, 0.5).norm())
+                .collect();
+            let (lo, hi) = speeds
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+            assert!(
+                hi / lo <= r * (1.0 + 1e-12),
+                "case {case}: {} > {r}",
+                hi / lo
+            );
+            // Inside one span only.
+            assert!(spans.speed_ratio(-0.5, 1.0).is_none());
+        }
+        assert!(claimed * 2 > tried, "{claimed} of {tried}");
     }
 }

@@ -56,6 +56,14 @@ pub trait Curve {
         vec![a, b]
     }
 
+    /// An upper bound of `max |C'| / min |C'|` over `[a, b]` (within one breakpoint span)
+    /// where the curve can prove one cheaply; `None` when it cannot (a near-cusp may be
+    /// there). The arc-length map starts an evenly paced span with fewer panels.
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        let _ = (a, b);
+        None
+    }
+
     /// Arc length over the whole domain, mm (closed form where one exists, else adaptive
     /// Gauss–Legendre to [`LENGTH_TOLERANCE`]).
     fn length(&self) -> f64 {
@@ -118,6 +126,9 @@ macro_rules! forward_curve {
             }
             fn breakpoints(&self) -> Vec<f64> {
                 (**self).breakpoints()
+            }
+            fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+                (**self).speed_ratio(a, b)
             }
             fn length(&self) -> f64 {
                 (**self).length()

@@ -465,6 +465,11 @@ impl Curve for Nurbs {
         crate::arclen::gauss_legendre_8(|u| self.speed(u), a, b)
     }
 
+    /// From the Bézier span cache's hodograph (non-rational, degree ≤ 3), else unknown.
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        self.spans.as_ref()?.speed_ratio(a, b)
+    }
+
     fn breakpoints(&self) -> Vec<f64> {
         let (a, b) = self.domain();
         let mut out = vec![a];

@@ -4,7 +4,9 @@
 //! [PROGRAM]`: STAGE is `gen` (the program text only), `parse`, `smooth`, `plan` or `whole`
 //! (each runs the stages before it too, so a stage's cost is its count minus the previous
 //! one's), PROGRAM `surfacing` (default), `lines_arcs` or `surfacing_1m` (the path bench's
-//! 1 M-move raster, smoothing only; `gen` and `smooth` apply).
+//! 1 M-move raster, smoothing only; `gen` and `smooth` apply). With `STAGES_DUMP=FILE` the
+//! `smooth` stage writes every path item (`{:?}`) to FILE, to check that a speed change leaves
+//! the built path bit for bit the same (`cmp` two dumps).
 
 use std::hint::black_box;
 
@@ -12,7 +14,7 @@ use std::hint::black_box;
 mod common;
 use common::{lines_and_arcs, plan_options, raster_1m, smooth_items, surfacing};
 
-use tezgah_geom::{Pose, Vec3};
+use tezgah_geom::{Curve, Pose, Vec3};
 use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::run;
 use tezgah_motion::path::smooth::{SmoothOptions, Smoother};
@@ -39,8 +41,11 @@ fn main() {
         )
         .unwrap_or_else(|e| panic!("{e}"));
         let mut n = 0usize;
+        let mut dump = Dump::open();
         for item in sm {
-            black_box(item.unwrap_or_else(|e| panic!("{e}")));
+            let item = item.unwrap_or_else(|e| panic!("{e}"));
+            dump.item(&item);
+            black_box(item);
             n += 1;
         }
         eprintln!("surfacing_1m: {n} items");
@@ -63,6 +68,8 @@ fn main() {
     let items = smooth_items(&moves, &machine);
     if stage == "smooth" {
         eprintln!("{} moves -> {} items", moves.len(), items.len());
+        let mut dump = Dump::open();
+        items.iter().for_each(|i| dump.item(i));
         black_box(items);
         return;
     }
@@ -90,4 +97,33 @@ fn main() {
     .unwrap_or_else(|e| panic!("run failed: {e}"));
     black_box(acc);
     eprintln!("program {d:.3} s, {n} samples");
+}
+
+/// The optional `STAGES_DUMP` file of built path items.
+struct Dump(Option<std::io::BufWriter<std::fs::File>>);
+
+impl Dump {
+    fn open() -> Dump {
+        Dump(std::env::var_os("STAGES_DUMP").map(|p| {
+            std::io::BufWriter::new(
+                std::fs::File::create(&p).unwrap_or_else(|e| panic!("STAGES_DUMP: {e}")),
+            )
+        }))
+    }
+
+    fn item(&mut self, item: &tezgah_motion::path::PathItem) {
+        if let Some(w) = &mut self.0 {
+            use std::io::Write;
+            writeln!(w, "{item:?}").unwrap_or_else(|e| panic!("STAGES_DUMP: {e}"));
+            // And the curve itself, at a few parameters (the item's Debug leaves it out).
+            if let tezgah_motion::path::PathItem::Segment(s) = item {
+                let (u0, u1) = s.curve.domain();
+                for i in 0..=4 {
+                    let p = s.point(u0 + (u1 - u0) * f64::from(i) / 4.0);
+                    writeln!(w, "  {:?}", [p.x, p.y, p.z])
+                        .unwrap_or_else(|e| panic!("STAGES_DUMP: {e}"));
+                }
+            }
+        }
+    }
 }

@@ -102,6 +102,12 @@ fn refine(
     let mut interior: Vec<f64> = Vec::new();
     let mut data: Vec<(f64, Vec3)> = t.iter().copied().zip(points.iter().copied()).collect();
     let mut best = f64::INFINITY;
+    // Each segment once, with its inverse squared length: the distance tests run several
+    // times per piece and round, and a division and square root each was their cost.
+    let segs: Vec<Segment> = points
+        .windows(2)
+        .map(|w| Segment::new(&w[0], &w[1]))
+        .collect();
     for round in 1..=MAX_ROUNDS {
         densify(&mut data, &interior, p, t, points);
         if fair && interior.len() + p + 1 > points.len() {
@@ -124,9 +130,15 @@ fn refine(
             Err(e) => return Err(e),
         };
         // (The curve evaluates from its Bézier span cache: cubic, non-rational.)
-        let check = |quick| measure(&curve, points, t, &interior, tolerance, quick);
         // A samples-only pass finds the violations of the early rounds at a fraction of the
-        // cost; only when it finds none does the refined check (the one that can accept) run.
+        // cost; only when it finds none does the refined check (the one that can accept) run,
+        // reusing the hull bounds the first pass proved (same curve, same bounds).
+        let mut hulls = vec![f64::NAN; points.len() - 1];
+        let mut check = |quick| {
+            measure(
+                &curve, points, t, &interior, tolerance, quick, &segs, &mut hulls,
+            )
+        };
         let (mut worst, mut worst_in_span) = check(true);
         if worst <= tolerance {
             (worst, worst_in_span) = check(false);
@@ -176,7 +188,9 @@ fn span_bounds(interior: &[f64]) -> Vec<f64> {
 
 /// Largest deviation over all pieces and points (or its convex-hull bound where that proves
 /// a piece inside), and the worst violation `(distance, u)` in each knot span (None where the
-/// span is within tolerance).
+/// span is within tolerance). `hulls[k]` holds piece `k`'s squared hull bound once computed
+/// (NaN before): the refined pass after a quick one reuses them. `segs` are the polyline's.
+#[allow(clippy::too_many_arguments)]
 fn measure(
     curve: &Nurbs,
     points: &[Vec3],
@@ -184,6 +198,8 @@ fn measure(
     interior: &[f64],
     tolerance: f64,
     quick: bool,
+    segs: &[Segment],
+    hulls: &mut [f64],
 ) -> (f64, Vec<Option<(f64, f64)>>) {
     let m = points.len() - 1;
     let bounds = span_bounds(interior);
@@ -193,12 +209,6 @@ fn measure(
         worst: 0.0,
         tolerance,
     };
-    // Each segment once, with its inverse squared length: the distance tests below run
-    // several times per piece and round, and a division and square root each was their cost.
-    let segs: Vec<Segment> = points
-        .windows(2)
-        .map(|w| Segment::new(&w[0], &w[1]))
-        .collect();
     let tol2 = tolerance * tolerance;
     let mut span = 0;
     for k in 0..m {
@@ -212,11 +222,14 @@ fn measure(
         // segment k is convex, so the largest vertex distance bounds the piece's distance from
         // above (and the distance to the three segments is at most that to segment k): when it
         // is inside the tolerance no sample can find a violation, and the bound is recorded.
-        if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
-            if h2 <= tol2 {
-                marks.note(h2.sqrt(), t[k]);
-                continue;
+        if hulls[k].is_nan() {
+            if let Some(h2) = curve.hull_max(t[k], t[k + 1], |q| segs[k].distance2(q)) {
+                hulls[k] = h2;
             }
+        }
+        if hulls[k] <= tol2 {
+            marks.note(hulls[k].sqrt(), t[k]);
+            continue;
         }
         // More samples where knots fall inside the piece: each span may bend on its own.
         let inside =
@@ -386,6 +399,56 @@ fn densify(data: &mut Vec<(f64, Vec3)>, interior: &[f64], p: usize, t: &[f64], p
     }
 }
 
+/// The data's share of the normal equations: the upper band of `NᵀN` (`upper[i][d]` is entry
+/// `(i, i + d)` of the unknown interior control points) and `Nᵀr`, `r` the data less the pinned
+/// end control points' share.
+struct Sums<'a> {
+    upper: &'a mut [[f64; W]],
+    rhs: &'a mut [Vec3],
+}
+
+impl Sums<'_> {
+    /// Add every datum but the two ends (they pin the end control points). The data are
+    /// sorted by parameter (densify keeps them so): the span only moves forward, a step
+    /// instead of a binary search per point.
+    #[inline(always)]
+    fn add_data(self, data: &[(f64, Vec3)], knots: &[f64], p: usize, n: usize, q0: Vec3, qm: Vec3) {
+        let mut b = [0.0; W];
+        let mut s = p;
+        for &(u, q) in &data[1..data.len() - 1] {
+            while s < n && u >= knots[s + 1] {
+                s += 1;
+            }
+            if u < knots[s] {
+                s = find_span(knots, p, n, u);
+            }
+            basis_funs(knots, s, u, p, &mut b);
+            let mut r = q;
+            if s == p {
+                r -= q0 * b[0];
+            }
+            if s == n {
+                r -= qm * b[p];
+            }
+            for j in 0..=p {
+                let i = s - p + j;
+                if i == 0 || i == n {
+                    continue;
+                }
+                let bj = b[j];
+                self.rhs[i - 1] += r * bj;
+                let row = &mut self.upper[i - 1];
+                for l in j..=p {
+                    if s - p + l == n {
+                        break;
+                    }
+                    row[l - j] += bj * b[l];
+                }
+            }
+        }
+    }
+}
+
 /// Least squares with the end control points pinned to the end data (A9.7's formulation):
 /// minimise `Σ |C(t_k) − Q_k|²` over the interior control points.
 fn least_squares(
@@ -406,33 +469,28 @@ fn least_squares(
     let mut ctrl = Vec::with_capacity(n + 1);
     ctrl.push(q0);
     if unknowns > 0 {
-        let mut a = Banded::new(unknowns, p, p);
+        // The normal matrix is symmetric: its upper band is summed here (`upper[i][d]` is
+        // entry `(i, i + d)`, each a sum over the data in the same order as a full assembly,
+        // so bit for bit the same) and mirrored once at the end.
+        let mut upper = vec![[0.0; W]; unknowns];
         let mut rhs = vec![Vec3::zeros(); unknowns];
-        let mut b = [0.0; W];
-        for &(u, q) in &data[1..data.len() - 1] {
-            let s = find_span(&knots, p, n, u);
-            basis_funs(&knots, s, u, p, &mut b);
-            let mut r = q;
-            for (j, v) in b[..=p].iter().enumerate() {
-                let i = s - p + j;
-                if i == 0 {
-                    r -= q0 * *v;
-                } else if i == n {
-                    r -= qm * *v;
-                }
-            }
-            for (j, bj) in b[..=p].iter().enumerate() {
-                let i = s - p + j;
-                if i == 0 || i == n {
-                    continue;
-                }
-                rhs[i - 1] += r * *bj;
-                for (l, bl) in b[..=p].iter().enumerate() {
-                    let c = s - p + l;
-                    if c != 0 && c != n {
-                        a.add(i - 1, c - 1, bj * bl);
-                    }
-                }
+        let sums = Sums {
+            upper: &mut upper,
+            rhs: &mut rhs,
+        };
+        // The cubic (every compressed run) with the degree a constant, so the loops unroll.
+        if p == 3 {
+            sums.add_data(data, &knots, 3, n, q0, qm);
+        } else {
+            sums.add_data(data, &knots, p, n, q0, qm);
+        }
+        let mut a = Banded::new(unknowns, p, p);
+        for (i, row) in upper.iter().enumerate() {
+            a.add(i, i, row[0]);
+            let width = p.min(unknowns - 1 - i);
+            for (d, &v) in row.iter().enumerate().take(width + 1).skip(1) {
+                a.add(i, i + d, v);
+                a.add(i + d, i, v);
             }
         }
         if lambda > 0.0 {

@@ -15,6 +15,7 @@ use tezgah_geom::arclen::gauss_legendre;
 use tezgah_geom::deviation::{closest_point, maximise, point_segment_distance};
 use tezgah_geom::{Curve, Quintic, State, Vec3};
 
+use super::bound::away_bound;
 use super::piece::{Geo, Piece};
 
 /// Largest share of a neighbour's (remaining) length a leg may take: two legs on one piece
@@ -83,6 +84,11 @@ impl Blend {
     pub fn arc_length(&self) -> f64 {
         let whole = gauss_legendre(self, 0.0, 1.0);
         self.panel(0.0, 1.0, whole, 0)
+    }
+
+    /// Power coefficients `[c0 … c5]` on `u ∈ [0, 1]` (for the Bernstein form of [`super::bound`]).
+    pub(crate) fn coefficients(&self) -> [Vec3; 6] {
+        self.q.coefficients()
     }
 
     fn panel(&self, a: f64, b: f64, whole: f64, depth: u32) -> f64 {
@@ -305,22 +311,10 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             // programmed pieces around the corner.
             let to_corner = closest_point(&curve, &corner, 0.0, 1.0, 16).distance;
             let (ca, cb) = (cuts(a, ua, a.geo.domain().1), cuts(b, b.geo.domain().0, ub));
-            let away = maximise(
-                |u| {
-                    let q = curve.point(u);
-                    // The cheaper neighbour first (a spline is searched, a line or arc is
-                    // closed form): its distance lets the spline skip knot spans.
-                    if matches!(a.geo, Geo::Spline(_)) {
-                        distance_to(a, &q, &ca, distance_to(b, &q, &cb, f64::INFINITY))
-                    } else {
-                        distance_to(b, &q, &cb, distance_to(a, &q, &ca, f64::INFINITY))
-                    }
-                },
-                0.0,
-                1.0,
-                16,
-            )
-            .distance;
+            // A hull bound first (a few control-point distances); it is ≥ the sampled
+            // maximum, so where it is within the share, sampling would accept too.
+            let bound = away_bound(&curve, a, &ca, b, &cb, share);
+            let away = bound.unwrap_or_else(|| away_sampled(&curve, a, &ca, b, &cb));
             to_corner.max(away)
         };
         if deviation <= share {
@@ -344,6 +338,28 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         leg *= 0.5;
     }
     Err(NoBlend::Corner)
+}
+
+/// The blend's largest distance from the pieces `a` over `ca` and `b` over `cb`, sampled and
+/// refined (geom's `maximise`): a lower estimate of the true value, used where the hull bound
+/// of [`away_bound`] cannot decide.
+pub(crate) fn away_sampled(curve: &Blend, a: &Piece, ca: &[f64], b: &Piece, cb: &[f64]) -> f64 {
+    maximise(
+        |u| {
+            let q = curve.point(u);
+            // The cheaper neighbour first (a spline is searched, a line or arc is
+            // closed form): its distance lets the spline skip knot spans.
+            if matches!(a.geo, Geo::Spline(_)) {
+                distance_to(a, &q, ca, distance_to(b, &q, cb, f64::INFINITY))
+            } else {
+                distance_to(b, &q, cb, distance_to(a, &q, ca, f64::INFINITY))
+            }
+        },
+        0.0,
+        1.0,
+        16,
+    )
+    .distance
 }
 
 #[cfg(test)]
@@ -411,5 +427,115 @@ mod tests {
             "{} {exact}",
             c.arc_length()
         );
+    }
+
+    /// Random corners between splines and lines: wherever the hull bound decides, it is at
+    /// least the sampled maximum (it bounds the true value) and within the share; and it
+    /// decides most placed blends (else it saves nothing).
+    #[test]
+    fn hull_bound_is_above_the_sampled_distance() {
+        use super::super::piece::Mode;
+        use crate::path::SegmentFeed;
+        use std::sync::Arc as Shared;
+        use tezgah_geom::{Line, Nurbs};
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let piece = |geo| {
+            Piece::new(
+                geo,
+                [[0.0; 3]; 2],
+                1,
+                SegmentFeed::Feed(10.0),
+                0.01,
+                Mode::Continuous,
+            )
+        };
+        let (mut decided, mut placed) = (0, 0);
+        for case in 0..300 {
+            let corner = Vec3::new(rnd(), rnd(), rnd());
+            // Incoming spline ending at the corner: a wavy cubic over 1–3 mm, 4–9 spans.
+            let spans = 4 + (case % 6);
+            let dir = Vec3::new(1.0, 0.3 * rnd(), 0.2 * rnd()).normalize();
+            let len = 2.0 + rnd();
+            let n = spans + 3;
+            let ctrl: Vec<Vec3> = (0..n)
+                .map(|i| {
+                    let f = i as f64 / (n - 1) as f64 - 1.0;
+                    let wiggle = if i == 0 || i + 1 == n {
+                        Vec3::zeros()
+                    } else {
+                        Vec3::new(rnd(), rnd(), rnd()) * 0.05
+                    };
+                    corner + dir * (f * len) + wiggle
+                })
+                .collect();
+            let mut knots = vec![0.0; 4];
+            knots.extend((1..spans).map(|i| i as f64 / spans as f64));
+            knots.extend([1.0; 4]);
+            let a = piece(Geo::Spline(Shared::new(
+                Nurbs::bspline(3, &ctrl, knots).unwrap(),
+            )));
+            // Outgoing: a line or a spline, turning 20–150°, or (one case in five) nearly
+            // tangent, 0.001–0.01 rad: long blends, as where two splines meet at a window.
+            let turn = if case % 5 == 4 {
+                0.001 + 0.009 * (0.5 + 0.5 * rnd())
+            } else {
+                (20.0 + 130.0 * (0.5 + 0.5 * rnd())).to_radians()
+            };
+            let side = dir.cross(&Vec3::new(rnd(), rnd(), rnd())).normalize();
+            let out = dir * turn.cos() + side * turn.sin();
+            let b = if case % 2 == 0 {
+                piece(Geo::Line(
+                    Line::new(corner, corner + out * (1.0 + 0.5 * rnd())).unwrap(),
+                ))
+            } else {
+                let ctrl: Vec<Vec3> = (0..6)
+                    .map(|i| {
+                        corner
+                            + out * (0.3 * i as f64)
+                            + if i == 0 {
+                                Vec3::zeros()
+                            } else {
+                                side * (0.02 * rnd())
+                            }
+                    })
+                    .collect();
+                let knots = vec![0.0, 0.0, 0.0, 0.0, 0.4, 0.7, 1.0, 1.0, 1.0, 1.0];
+                piece(Geo::Spline(Shared::new(
+                    Nurbs::bspline(3, &ctrl, knots).unwrap(),
+                )))
+            };
+            for share in [0.004, 0.02, 0.1] {
+                let Ok(p) = place(&a, &b, share, 175f64.to_radians()) else {
+                    continue;
+                };
+                placed += 1;
+                let (ca, cb) = (
+                    cuts(&a, p.ua, a.geo.domain().1),
+                    cuts(&b, b.geo.domain().0, p.ub),
+                );
+                let sampled = away_sampled(&p.curve, &a, &ca, &b, &cb);
+                // Also a tighter share than the blend was placed for: must not claim it.
+                for s in [share, 0.5 * sampled] {
+                    if let Some(bound) = away_bound(&p.curve, &a, &ca, &b, &cb, s) {
+                        if s == share {
+                            decided += 1;
+                        }
+                        assert!(bound <= s, "case {case}: bound {bound} > share {s}");
+                        assert!(
+                            bound >= sampled * (1.0 - 1e-12),
+                            "case {case}: bound {bound} < sampled {sampled}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(placed > 600, "{placed}");
+        assert!(decided * 10 >= placed * 9, "decided {decided} of {placed}");
     }
 }

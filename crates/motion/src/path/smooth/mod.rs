@@ -16,6 +16,7 @@
 
 mod axis;
 pub mod blend;
+pub(crate) mod bound;
 mod compress;
 mod error;
 mod piece;

@@ -79,6 +79,14 @@ impl Curve for Geo {
             Geo::Spline(c) => c.speed_integral(a, b),
         }
     }
+    // Forwarded so that the arc-length map can start evenly paced spline spans with fewer
+    // panels (lines and arcs take no map, or run at constant speed).
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        match self {
+            Geo::Spline(c) => c.speed_ratio(a, b),
+            _ => None,
+        }
+    }
     fn curvature(&self, u: f64) -> f64 {
         match self {
             Geo::Line(c) => c.curvature(u),
