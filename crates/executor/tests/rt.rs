@@ -384,6 +384,16 @@ fn five_axis_program(seed: u64) -> String {
     text
 }
 
+/// Starved: ticks until the underrun stop has brought the machine to a halt (3 s at most).
+fn play_out_the_stop(rt: &mut RtLoop<Recording>) {
+    for _ in 0..3000 {
+        rt.tick();
+        if rt.state() == RtState::Halted {
+            break;
+        }
+    }
+}
+
 /// Velocity, acceleration and jerk of every joint by differences at the period over the
 /// positions played (led by the start at rest), within the joint limits and 0.5 %, and no
 /// jump (a step is at most the velocity limit's period).
@@ -446,12 +456,7 @@ fn underrun_at(
         side.pump();
         rt.tick();
     }
-    for _ in 0..3000 {
-        rt.tick();
-        if rt.state() == RtState::Halted {
-            break;
-        }
-    }
+    play_out_the_stop(&mut rt);
     let m = side.executor().machine();
     played_within_limits(
         &start.position,
@@ -534,12 +539,7 @@ proptest::proptest! {
             side.pump();
             rt.tick();
         }
-        for _ in 0..3000 {
-            rt.tick();
-            if rt.state() == RtState::Halted {
-                break;
-            }
-        }
+        play_out_the_stop(&mut rt);
         let m = side.executor().machine();
         let r = played_within_limits(&start.position, &rt.drive().seen, m, side.executor().period());
         proptest::prop_assert!(r.is_ok(), "{}", r.unwrap_err());
