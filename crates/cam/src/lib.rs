@@ -25,5 +25,5 @@ pub mod verify;
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};
 pub use effective_radius::LeadTilt;
 pub use error::CamError;
-pub use strategy::{plan, FeedDirection, Plan, Settings, StrategyKind, ToolAxis};
+pub use strategy::{plan, Band, ToleranceShares, FeedDirection, Plan, Settings, StrategyKind, ToolAxis};
 pub use toolpath::{CutterLocation, Pass, ToolPath};

@@ -3,8 +3,11 @@
 //! the gouge checks corrected or refused. Iso-parametric zig-zag (one-way and two-way) lives in
 //! `iso_parametric`, iso-scallop in `iso_scallop`; both step along their passes by the true
 //! chord error (`forward_step`), size side steps by the exact scallop model (`scallop`) and place
-//! every contact here (orientation, CC → CL, gouge checks and correction).
+//! every contact here (orientation, CC → CL, gouge checks and correction). With a
+//! [`Band`] the placed passes are then held to one side of the exact cutter-location surface
+//! (`band`).
 
+mod band;
 mod iso_parametric;
 mod iso_scallop;
 
@@ -25,6 +28,7 @@ use crate::orientation::ContactFrame;
 use crate::scallop::stepover_exact;
 use crate::toolpath::{CutterLocation, Pass, ToolPath};
 
+pub use band::{Band, ChordSag, ToleranceShares};
 pub use iso_parametric::iso_parametric_side_step;
 
 /// The finishing strategy, by DESIGN.md's `tezgah cam --strategy NAME`.
@@ -119,6 +123,14 @@ pub struct Settings {
     /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
     pub max_axis_tilt_deg: Option<f64>,
     pub gouge: GougeSettings,
+    /// The one-sided tolerance band (DESIGN.md "Tolerance"): `Some` shifts every cutter
+    /// location out of the material by its chords' inward sag plus [`Band::motion`] (chords
+    /// sagging more than `tolerance` either way are halved first), so the motion between the
+    /// emitted points never cuts into the part, and plans side steps for
+    /// `scallop − band.outward(tolerance)` so the scallop stays within `scallop`. `None`: the
+    /// locations touch the surface exactly and chords straddle it (the contact-point chord
+    /// error within `tolerance`).
+    pub band: Option<Band>,
 }
 
 impl Settings {
@@ -139,6 +151,7 @@ impl Settings {
             max_lead_change_deg: None,
             max_axis_tilt_deg: None,
             gouge: GougeSettings::default(),
+            band: None,
         }
     }
 
@@ -148,6 +161,17 @@ impl Settings {
         positive("max_step", self.max_step)?;
         if let Some(rate) = self.max_lead_change_deg {
             positive("max_lead_change", rate)?;
+        }
+        if let Some(band) = self.band {
+            band.validate()?;
+            let planned = self.scallop - band.outward(self.tolerance);
+            if !(planned > 0.0) {
+                return Err(CamError::Setting {
+                    name: "tolerance band (chord tolerance + 2 × band motion)",
+                    want: "below the scallop height, which it is taken from",
+                    got: band.outward(self.tolerance),
+                });
+            }
         }
         if let Some(t) = self.max_axis_tilt_deg {
             if !(t.is_finite() && (0.0..=180.0).contains(&t)) {
@@ -243,6 +267,18 @@ pub fn plan(
 ) -> Result<Plan, CamError> {
     settings.validate()?;
     validate_cutter(cutter)?;
+    // The band's outward width comes off the scallop the side steps are sized for.
+    let banded;
+    let settings = match settings.band {
+        Some(band) => {
+            banded = Settings {
+                scallop: settings.scallop - band.outward(settings.tolerance),
+                ..settings.clone()
+            };
+            &banded
+        }
+        None => settings,
+    };
     let ctx = Context::new(surface, cutter, settings)?;
     let paths = match settings.strategy {
         StrategyKind::ZigZag | StrategyKind::ZigZagOneWay => iso_parametric::passes(&ctx)?,
@@ -575,22 +611,29 @@ impl<'a> Context<'a> {
             corrected: 0,
         };
         let sign = if reverse { -1.0 } else { 1.0 };
-        let contacts: Vec<Contact> = ts
+        let contact_at = |t: f64| {
+            let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
+            Contact {
+                uv: path.uv(t),
+                tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
+            }
+        };
+        let mut placed: Vec<Result<Placed, GougeReport>> = ts
             .iter()
             .map(|&t| {
-                let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
-                Contact {
-                    uv: path.uv(t),
-                    tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
-                }
+                let c = contact_at(t);
+                self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
-        let mut placed: Vec<Result<Placed, GougeReport>> = contacts
-            .iter()
-            .map(|c| self.place(c.uv.0, c.uv.1, c.tangent, 0.0))
-            .collect();
+        if self.settings.band.is_some() {
+            self.refine_chords(path, &mut ts, &mut placed, &contact_at);
+        }
         if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
+            let contacts: Vec<Contact> = ts.iter().map(|&t| contact_at(t)).collect();
             self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
+        }
+        if let Some(band) = self.settings.band {
+            self.shift_outward(path, &ts, &mut placed, band);
         }
         let mut current = Pass::default();
         for item in placed {
