@@ -11,17 +11,21 @@ use tezgah_cam::step::Face;
 use tezgah_cam::strategy::Refusal;
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{
-    Band, Cutter, CutterShape, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
+    Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
 };
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
+
+use crate::cam_tool::{self, ToolSpec};
 
 /// The command line of `tezgah cam` (DESIGN.md "Command-line contract").
 #[derive(clap::Args)]
 pub struct CamArgs {
     /// The surface (STEP file).
     pub surface: PathBuf,
-    /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm).
+    /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm), or auto: the
+    /// largest ball end mill that fits the face's tightest concave curvature, from the tool
+    /// table's ball end mills (--tool-table) or else the standard set.
     #[arg(long)]
     pub tool: String,
     /// zigzag, zigzag-oneway or iso-scallop.
@@ -61,9 +65,10 @@ pub struct CamArgs {
     /// A tool table in LinuxCNC's format (the tool's length).
     #[arg(long)]
     pub tool_table: Option<PathBuf>,
-    /// The tool number for T and H words.
-    #[arg(long, default_value_t = 1)]
-    pub tool_number: u32,
+    /// The tool number for T and H words (default: the tool `--tool auto` chose from the
+    /// table, else 1).
+    #[arg(long)]
+    pub tool_number: Option<u32>,
     /// The STEP `#id` of the face to machine (needed when the file has several faces).
     #[arg(long)]
     pub face: Option<u64>,
@@ -92,8 +97,6 @@ pub struct PlanRequest {
     pub band: Option<Band>,
     pub lead_deg: f64,
     pub tilt_deg: f64,
-    /// The STEP `#id` of the face to machine (needed when the file has several).
-    pub face: Option<u64>,
     /// The most the tool axis may lean from +Z, degrees.
     pub max_tilt_deg: f64,
 }
@@ -145,15 +148,20 @@ fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -
     Ok(face)
 }
 
-/// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
-/// points the strategy could not correct are left out of the path and listed here.
+/// The face of the STEP file at `path` to machine (`--face`, or its only face).
+fn read_face(path: &Path, id: Option<u64>) -> Result<Face> {
+    let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
+    pick_face(path, model, id)
+}
+
+/// The face's surface and the tool path the strategy plans on it. Gouging contact points the
+/// strategy could not correct are left out of the path and listed here.
 fn plan_surface(
     path: &Path,
+    face: Face,
     cutter: Cutter,
     request: &PlanRequest,
 ) -> Result<(NurbsSurface, ToolPath)> {
-    let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
-    let face = pick_face(path, model, request.face)?;
     let mut settings = Settings::new(request.strategy, request.scallop_mm, request.tolerance_mm);
     if let ToolAxis::Surface {
         lead_deg, tilt_deg, ..
@@ -165,6 +173,11 @@ fn plan_surface(
     settings.reverse_normal = !face.same_sense;
     settings.max_axis_tilt_deg = Some(request.max_tilt_deg);
     settings.band = request.band;
+    if request.band.is_some() {
+        // The rear check accepts penetrations up to its depth tolerance: keep that within
+        // issue 7's 1 µm.
+        settings.gouge.depth_tolerance = 0.5 * GOUGE_LIMIT_MM;
+    }
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let out_of_reach = plan
@@ -223,7 +236,7 @@ fn tool_length(table: Option<&Path>, number: u32) -> Result<f64> {
 
 pub fn cam(args: CamArgs) -> Result<ExitCode> {
     // Everything the command line can get wrong is refused before any work.
-    let shape: CutterShape = args.tool.parse().into_diagnostic()?;
+    let spec = ToolSpec::parse(&args.tool)?;
     let scallop = positive("--scallop", args.scallop)?;
     let tolerance = positive("--tolerance", args.tolerance)?;
     if tolerance >= scallop {
@@ -270,7 +283,20 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
     }
-    let length = tool_length(args.tool_table.as_deref(), args.tool_number)?;
+    let face = read_face(&args.surface, args.face)?;
+    let (shape, tool_number) = match spec {
+        ToolSpec::Given(shape) => (shape, args.tool_number.unwrap_or(1)),
+        ToolSpec::Auto => {
+            let table = match args.tool_table.as_deref() {
+                Some(p) => Some((p, crate::library::load_tool_table(Some(p))?)),
+                None => None,
+            };
+            let pick = cam_tool::choose(&face, table.as_ref().map(|(p, t)| (*p, t)))?;
+            println!("tool auto: {} — {}", pick.shape, pick.why);
+            (pick.shape, args.tool_number.or(pick.number).unwrap_or(1))
+        }
+    };
+    let length = tool_length(args.tool_table.as_deref(), tool_number)?;
     let cutter = Cutter::standard(shape);
     // One guarantee (DESIGN.md "Tolerance"), one-sided: the machine's motion runs between
     // the exact cutter-location surface and the tolerance outside it. Chords get half,
@@ -283,10 +309,9 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         band: Some(shares.band()),
         lead_deg: args.lead_deg,
         tilt_deg: args.tilt_deg,
-        face: args.face,
         max_tilt_deg,
     };
-    let (surface, path) = plan_surface(&args.surface, cutter, &request)?;
+    let (surface, path) = plan_surface(&args.surface, face, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
             OutputForm::Joints
@@ -298,7 +323,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         } else {
             FeedOutput::PerMinute
         },
-        tool_number: args.tool_number,
+        tool_number,
         tool_length_mm: length,
         part_top_z: Some(part_top(&surface)),
         title: format!(
@@ -315,7 +340,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
-    let json = report_json(&args, &machine, &path, &done, scallop);
+    let json = report_json(&args, &machine, &path, &done, scallop, tool_number);
     if let Some(p) = &args.report {
         crate::library::write_json(p, &json)?;
     }
@@ -416,6 +441,7 @@ fn report_json(
     path: &ToolPath,
     done: &Finished,
     scallop: f64,
+    tool_number: u32,
 ) -> serde_json::Value {
     let s = &done.posted.stats;
     let v = &done.verification;
@@ -424,7 +450,8 @@ fn report_json(
     };
     serde_json::json!({
         "surface": args.surface.display().to_string(),
-        "tool": args.tool,
+        "tool": path.cutter.shape.to_string(),
+        "tool_number": tool_number,
         "strategy": args.strategy,
         "machine": machine.name,
         "output": if args.joints { "joints" } else { "tcp" },
@@ -493,7 +520,7 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tezgah_cam::{CutterLocation, Pass};
+    use tezgah_cam::{CutterLocation, CutterShape, Pass};
     use tezgah_geom::Vec3;
 
     /// The plane z = 0 over 12 × 10 mm, and a ball R = 1.5 zig-zag with 10° of lead.

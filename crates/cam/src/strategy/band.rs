@@ -218,3 +218,59 @@ impl ToleranceShares {
         }
     }
 }
+
+/// Halvings of a run-out that gouges before it is left out.
+const RUN_OUT_TRIALS: usize = 4;
+
+impl Context<'_> {
+    /// A flat or bull-nose cutter's run-out past the end of a pass (`prev` then `last`):
+    /// its footprint's front edge curves back from the contact, so where the pass stops the
+    /// strip across the feed beside the contact is never swept and keeps the full cusp. The
+    /// cusp lies `w/2` beside the pass (`w` the side step there); an edge circle of radius ρ
+    /// trails the contact by `ρ − √(ρ² − y²)` at a lateral offset `y`, so moving on along the
+    /// feed (tangent to the surface, same axis) by that at `y = 0.75 w` (a margin for
+    /// neighbouring passes spaced wider) with ρ the smallest edge circle (`R − r`, the flat
+    /// part's rim; `y` itself where that circle is narrower) sweeps the strip. A ball's
+    /// footprint is symmetric about the contact: no run-out. Kept short because the tangent
+    /// move leaves the surface's curvature behind; shortened while it would gouge, left out if
+    /// it still does.
+    pub(super) fn run_out(
+        &self,
+        prev: &CutterLocation,
+        last: &CutterLocation,
+    ) -> Option<CutterLocation> {
+        if matches!(self.shape(), crate::cutter::CutterShape::Ball { .. }) {
+            return None;
+        }
+        let n = last.normal;
+        let along = last.tip - prev.tip;
+        let feed = along - n * along.dot(&n);
+        let len = feed.norm();
+        if !(len.is_finite() && len > 0.0) {
+            return None;
+        }
+        let feed = feed / len;
+        let tangent_uv = (last.uv.0 - prev.uv.0, last.uv.1 - prev.uv.1);
+        let radius = self.shape().radius();
+        let w = self
+            .local(last.uv.0, last.uv.1, tangent_uv)
+            .and_then(|l| self.side_step(&l))
+            .unwrap_or(radius);
+        let axis = Unit::new_normalize(last.axis);
+        let y = 0.75 * w;
+        let rho = radius - self.shape().corner_radius();
+        let mut d = if y < rho {
+            rho - (rho * rho - y * y).sqrt()
+        } else {
+            y.min(radius)
+        };
+        for _ in 0..RUN_OUT_TRIALS {
+            let tip = last.tip + feed * d;
+            if self.checker.check(&tip, &axis).is_none() {
+                return Some(CutterLocation { tip, ..*last });
+            }
+            d *= 0.5;
+        }
+        None
+    }
+}

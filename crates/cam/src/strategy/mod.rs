@@ -644,18 +644,24 @@ impl<'a> Context<'a> {
                 }
                 Err(report) => {
                     out.refused.push(report);
-                    if current.points.len() >= 2 {
-                        out.passes.push(std::mem::take(&mut current));
-                    } else {
-                        current.points.clear();
-                    }
+                    self.close_pass(&mut out.passes, std::mem::take(&mut current));
                 }
             }
         }
-        if current.points.len() >= 2 {
-            out.passes.push(current);
-        }
+        self.close_pass(&mut out.passes, current);
         Ok(out)
+    }
+
+    /// Keeps a pass of two or more locations, with its run-out when the band is on.
+    fn close_pass(&self, passes: &mut Vec<Pass>, mut pass: Pass) {
+        if let [.., prev, last] = pass.points.as_slice() {
+            if self.settings.band.is_some() {
+                if let Some(extra) = self.run_out(prev, last) {
+                    pass.points.push(extra);
+                }
+            }
+            passes.push(pass);
+        }
     }
 
     /// Raises leads so consecutive placed locations differ by at most `rate` (radians): each
