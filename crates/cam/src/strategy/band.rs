@@ -243,7 +243,8 @@ impl Context<'_> {
             return None;
         }
         let n = last.normal;
-        let along = last.tip - prev.tip;
+        // Along the contacts' path: the tips may also step sideways where the lean changes.
+        let along = last.contact - prev.contact;
         let feed = along - n * along.dot(&n);
         let len = feed.norm();
         if !(len.is_finite() && len > 0.0) {

@@ -14,7 +14,9 @@
 //!   between two; the material left between two placements is at most the sagitta of the
 //!   cutter's section where the dexel meets it: at a scallop of height h that section of the
 //!   corner (radius ρ: the corner radius, the tool radius for a flat end) is a circle of radius
-//!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`.
+//!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`. A flat end's
+//!   section along the motion also has a corner at the rim, behind which its bottom rises at
+//!   the tool's lean θ from the normal: `δ·tan θ` more (θ the largest lean of the path).
 //! * grid: the highest scallop is sampled at a node at most `c/√2` from it (c the largest
 //!   node spacing); the scallop's flank rises with slope at most `tan φ`, `cos φ = 1 − h/ρ`
 //!   (the cutter's profile meeting the surface at the height h; on a convex surface ρ is
@@ -286,7 +288,12 @@ pub fn simulate(
     measure(&dexels, up, &mut out);
     let solid = sweeper.solid;
     let rho = if solid.corner > 0.0 { solid.corner } else { r };
-    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    let edge = if solid.corner > 0.0 {
+        0.0
+    } else {
+        rim_bound(spacing, &cls, r)
+    };
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm) + edge;
     let rho_flank = 1.0 / (1.0 / rho + convex);
     let coarse = grid_bound(&out, rho_flank, achieved);
 
@@ -332,7 +339,7 @@ pub fn simulate(
         sweeper.run(&mut fine, poses);
         measure(&fine, up, &mut out);
     }
-    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm) + edge;
     out.grid_bound_mm = if complete {
         grid_bound(&out, rho_flank, achieved / REFINE as f64)
     } else {
@@ -411,6 +418,22 @@ const REFINE_CAP: usize = 4096;
 
 /// The refinement lattice is this many times finer than the grid.
 const REFINE: usize = 2;
+
+/// A flat end's section along its motion has a corner at the rim: behind the front rim point
+/// the bottom face rises at the tool's lean θ from the surface normal, so between two
+/// placements δ apart it leaves up to `δ·tan θ` — θ the largest lean over the cutter
+/// locations (capped at the tool radius).
+fn rim_bound(spacing: f64, cls: &[&crate::toolpath::CutterLocation], radius: f64) -> f64 {
+    let lean = cls
+        .iter()
+        .map(|c| {
+            let cos = c.axis.dot(&c.normal) / (c.axis.norm() * c.normal.norm());
+            cos.clamp(-1.0, 1.0).acos()
+        })
+        .filter(|a| a.is_finite())
+        .fold(0.0, f64::max);
+    (spacing * lean.tan()).min(radius)
+}
 
 /// `δ²/(8(ρ − h))`: the sagitta between two placements δ apart of the cutter's section at
 /// the height h of the highest scallop, a circle of radius at least ρ − h (ρ when h ≥ ρ would
