@@ -10,9 +10,7 @@ use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions, Posted};
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::Refusal;
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
-use tezgah_cam::{
-    Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
-};
+use tezgah_cam::{Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
 

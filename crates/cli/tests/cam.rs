@@ -192,7 +192,14 @@ fn cam_refuses_bad_options_without_a_panic() {
     }
     // The one-sided band takes the tolerance from the scallop: it must be smaller.
     let out = tezgah()
-        .args(["cam", "surface.stp", "--tool", "ball:3", "--strategy", "zigzag"])
+        .args([
+            "cam",
+            "surface.stp",
+            "--tool",
+            "ball:3",
+            "--strategy",
+            "zigzag",
+        ])
         .args(["--scallop", "0.01", "--tolerance", "0.01", "-o"])
         .arg(&out_ngc)
         .output()

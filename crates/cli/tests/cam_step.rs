@@ -141,7 +141,10 @@ fn free_form_patch_iso_scallop_is_verified_and_runs_on_table_ac() {
     );
     assert!(f(&report, "gouge_depth_mm") <= 0.001, "{report}");
     // Linearisation gets an eighth of the tolerance, the blending written as G64 P another.
-    assert!(f(&report, "max_linearisation_mm") <= 0.125 * tol, "{report}");
+    assert!(
+        f(&report, "max_linearisation_mm") <= 0.125 * tol,
+        "{report}"
+    );
     assert!(program.contains("G64 P0.00125"), "{}", &program[..400]);
     // The cutting path covers the patch: at least its area over the step-over.
     assert!(

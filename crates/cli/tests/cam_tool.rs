@@ -57,7 +57,14 @@ fn auto_without_a_table_picks_from_the_standard_set() {
         .arg("cam")
         .arg(fixture("rational_sphere.stp"))
         .args(["--tool", "auto", "--strategy", "zigzag", "--scallop", "0.3"])
-        .args(["--tolerance", "0.01", "--max-tilt", "30", "--verify-cell", "1.5"])
+        .args([
+            "--tolerance",
+            "0.01",
+            "--max-tilt",
+            "30",
+            "--verify-cell",
+            "1.5",
+        ])
         .arg("-o")
         .arg(&ngc)
         .arg("--report")
@@ -83,7 +90,14 @@ fn auto_with_a_table_without_balls_is_refused() {
         .arg(fixture("freeform_patch.stp"))
         .args(["--tool", "auto", "--tool-table"])
         .arg(&table)
-        .args(["--strategy", "zigzag", "--scallop", "0.3", "--tolerance", "0.01"])
+        .args([
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.3",
+            "--tolerance",
+            "0.01",
+        ])
         .arg("-o")
         .arg(&ngc)
         .output()

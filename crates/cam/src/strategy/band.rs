@@ -135,7 +135,8 @@ impl Context<'_> {
             let split: Vec<bool> = (0..ts.len().saturating_sub(1))
                 .map(|i| match (&placed[i], &placed[i + 1]) {
                     (Ok(a), Ok(b)) => {
-                        let sag = self.chord_sag(path, (ts[i], ts[i + 1]), &a.location, &b.location);
+                        let sag =
+                            self.chord_sag(path, (ts[i], ts[i + 1]), &a.location, &b.location);
                         sag.inward.max(sag.outward) > tolerance
                     }
                     _ => false,

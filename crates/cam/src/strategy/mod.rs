@@ -165,7 +165,7 @@ impl Settings {
         if let Some(band) = self.band {
             band.validate()?;
             let planned = self.scallop - band.outward(self.tolerance);
-            if !(planned > 0.0) {
+            if planned <= 0.0 || planned.is_nan() {
                 return Err(CamError::Setting {
                     name: "tolerance band (chord tolerance + 2 × band motion)",
                     want: "below the scallop height, which it is taken from",
@@ -626,7 +626,7 @@ impl<'a> Context<'a> {
             })
             .collect();
         if self.settings.band.is_some() {
-            self.refine_chords(path, &mut ts, &mut placed, &contact_at);
+            self.refine_chords(path, &mut ts, &mut placed, contact_at);
         }
         if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
             let contacts: Vec<Contact> = ts.iter().map(|&t| contact_at(t)).collect();
