@@ -16,6 +16,7 @@ pub mod orientation;
 pub mod post;
 pub mod scallop;
 pub mod select;
+pub mod silhouette;
 pub mod step;
 pub mod strategy;
 #[doc(hidden)]

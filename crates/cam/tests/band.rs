@@ -7,11 +7,9 @@
 //! 10° lead (at 5° their heels still touched by up to 4 µm on the STEP patch).
 //! Flat end mills are swept at closer poses: the rim is a corner along the motion, so the
 //! simulation's sweep bound grows by `δ·tan(lean)`.
-//!
-//! Open, not asserted: a bull-nose D8 r2 on the saddle measures 0.125 mm at h = 0.1. Its side
-//! step (3.7 mm) puts the cusp 1.87 mm beside the contact, comparable to the corner ring's
-//! radius, where the torus silhouette has risen 0.151 mm against the osculating circle's
-//! (r_e = 13.5 mm) 0.130: the strategy's scallop model, not the band.
+//! The bull-nose on the saddle measured 0.125 mm at h = 0.1 before side steps were checked
+//! against the cutter's true silhouette (`silhouette`): its 3.7 mm step put the cusp where the
+//! torus has risen 0.151 mm against its osculating circle's 0.130.
 
 use tezgah_cam::verify::{path_poses, simulate, step_over, Verification, VerifyOptions};
 use tezgah_cam::{
@@ -169,7 +167,7 @@ fn sphere_patch_ball_flat_and_bull_nose() {
 }
 
 #[test]
-fn saddle_ball_and_flat() {
+fn saddle_ball_flat_and_bull_nose() {
     let s = testing::saddle(10.0, 40.0);
     let z = StrategyKind::IsoScallop;
     assert_within("saddle ball D6", &s, &ball(6.0), &banded(z, 0.1, 0.0), 0.15);
@@ -177,6 +175,13 @@ fn saddle_ball_and_flat() {
         "saddle flat D8",
         &s,
         &flat(8.0),
+        &banded(z, 0.1, 10.0),
+        0.15,
+    );
+    assert_within(
+        "saddle bull D8 r2",
+        &s,
+        &bull(8.0, 2.0),
         &banded(z, 0.1, 10.0),
         0.15,
     );

@@ -382,6 +382,8 @@ struct Local {
 
 /// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
 const MATCH_MARGIN: f64 = 0.05;
+/// Bisections of a side step against the true silhouette (the bracket shrinks by 2⁻³⁰).
+const SILHOUETTE_BISECTIONS: usize = 30;
 /// Lean added per correction trial, degrees.
 const CORRECTION_STEP_DEG: f64 = 1.0;
 
@@ -510,7 +512,40 @@ impl<'a> Context<'a> {
         let angles = self.nominal_angles(local)?;
         let r_e = self.shape().effective_radius(angles);
         let w = stepover_exact(r_e, local.curvature.tt, self.settings.scallop)?;
-        Some(w.min(self.shape().radius()))
+        Some(self.fit_silhouette(local, angles, w.min(self.shape().radius())))
+    }
+
+    /// `w`, shrunk (bisection) until the cusp on the cutter's true silhouette across the feed
+    /// is within the target (`silhouette`): a flat or bull-nose profile rises faster than its
+    /// osculating circle away from the contact. A ball's profile is its circle.
+    fn fit_silhouette(&self, local: &Local, angles: LeadTilt, w: f64) -> f64 {
+        if matches!(self.shape(), CutterShape::Ball { .. }) {
+            return w;
+        }
+        let a = self.axis_for(&local.frame, angles).into_inner();
+        let (n, t) = (
+            local.frame.normal.into_inner(),
+            local.frame.cross.into_inner(),
+        );
+        let (h, kappa, len) = (
+            self.settings.scallop,
+            local.curvature.tt,
+            self.cutter.flute_length,
+        );
+        let cusp = |w: f64| crate::silhouette::cusp(self.shape(), len, &a, &n, &t, kappa, w);
+        if cusp(w) <= h {
+            return w;
+        }
+        let (mut lo, mut hi) = (0.0, w);
+        for _ in 0..SILHOUETTE_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if cusp(mid) <= h {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
     }
 
     /// Places the cutter at the contact `(u, v)` on a path running along `tangent_uv`, leaning
