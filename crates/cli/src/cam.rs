@@ -407,7 +407,22 @@ pub fn finish(
         _ => path.cutter.shape.radius(),
     };
     // δ²/(8ρ) = tolerance/10.
-    let spacing = (0.8 * rho * options.tolerance_mm).sqrt();
+    let circle = (0.8 * rho * options.tolerance_mm).sqrt();
+    // A flat end's rim adds δ·tan θ (θ its largest lean from the normal) to the sweep bound:
+    // that share is kept within the tolerance too, down to a twentieth of the circle's δ.
+    let lean = path
+        .passes
+        .iter()
+        .flat_map(|p| &p.points)
+        .map(|c| (c.axis.dot(&c.normal) / (c.axis.norm() * c.normal.norm())).clamp(-1.0, 1.0))
+        .map(f64::acos)
+        .filter(|a| a.is_finite())
+        .fold(0.0, f64::max);
+    let spacing = if path.cutter.shape.corner_radius() == 0.0 && lean > 0.0 {
+        circle.min((options.tolerance_mm / lean.tan()).max(circle / 20.0))
+    } else {
+        circle
+    };
     let mut verify_options = VerifyOptions {
         cell_mm: cell_mm.unwrap_or(step_over / 20.0),
         sweep_spacing_mm: spacing,
