@@ -24,9 +24,10 @@ const GOUGE_LIMIT: f64 = 0.001;
 const TOLERANCE: f64 = 0.01;
 /// Sweep error allowed in the simulation, mm: far below the gouge limit.
 const SWEEP_BOUND: f64 = 1e-4;
-/// Pose spacing for flat end mills, mm: at 10° lean the rim's share of the sweep bound is
-/// 0.0035 mm.
-const FLAT_SPACING: f64 = 0.02;
+/// A flat end's rim adds `δ·tan(lean)` to the sweep bound: its poses are spaced so that share
+/// is this fraction of h at the tests' 10° lead (larger where curvature matching leans further;
+/// the bound reported covers it).
+const FLAT_RIM_SHARE: f64 = 0.05;
 
 fn ball(d: f64) -> Cutter {
     Cutter::standard(CutterShape::Ball { radius: 0.5 * d })
@@ -75,9 +76,12 @@ fn assert_within(
     };
     // δ²/(8ρ) = SWEEP_BOUND; a flat end's rim adds δ·tan(lean) (verify's sweep bound), so
     // its poses are closer.
+    let circle = (8.0 * rho * SWEEP_BOUND).sqrt();
     let spacing = match cutter.shape {
-        CutterShape::Flat { .. } => FLAT_SPACING,
-        _ => (8.0 * rho * SWEEP_BOUND).sqrt(),
+        CutterShape::Flat { .. } => {
+            circle.min(FLAT_RIM_SHARE * settings.scallop / 10f64.to_radians().tan())
+        }
+        _ => circle,
     };
     let options = VerifyOptions {
         cell_mm: cell,
