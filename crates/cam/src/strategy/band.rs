@@ -3,8 +3,9 @@
 //! chord's sag against the exact cutter-location (CL) surface is measured, chords sagging more
 //! than the chord tolerance either way get a midpoint, and every location is shifted out along
 //! the surface normal by the inward sag of its chords plus what the later stages (the post's
-//! linearisation, the controller's blending) may add inward. The strategies then size side
-//! steps for the scallop minus the band's outward width ([`Band::outward`]).
+//! linearisation, the controller's blending) may add inward. Flat and bull-nose passes also
+//! run on past their ends (`run_out`). The strategies then size side steps for the scallop
+//! minus the band's outward width ([`Band::outward`]).
 //!
 //! The sag of a chord is the chord-height (sagitta) error of CAM stepping (Choi 1991, 001
 //! §2.8, `ε ≈ L²κ/8` on a path of curvature κ) taken on the CL surface, not on the contact
