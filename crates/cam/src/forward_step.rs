@@ -5,20 +5,19 @@
 //! 001 §2.8 tests one mid-point per chord, which cannot see an inflection: on the reference's
 //! own boundary curve it lets 0.424 mm through at ε = 0.05 mm (001 §5.2). Here the deviation
 //! of a chord is measured as the maximum distance from the curve to the segment over
-//! [`CHORD_SAMPLES`] interior samples, refined around the worst one by golden-section search,
-//! so both humps of an S-shaped span are seen; the step is then grown or shrunk by the
+//! [`CHORD_SAMPLES`] interior samples, refined by golden-section search around every local
+//! maximum among them (`tezgah_geom::deviation::maximise`), so both humps of an S-shaped span
+//! are seen; the step is then grown or shrunk by the
 //! `ε ∝ Δt²` law until the error lies in `[ε/2, ε]` (or the span ends or reaches the length
 //! cap).
 
-use tezgah_geom::deviation::point_segment_distance;
+use tezgah_geom::deviation::{maximise, point_segment_distance};
 use tezgah_geom::{NurbsSurface, Vec3};
 
 use crate::error::CamError;
 
 /// Interior samples per chord for the deviation measurement.
 pub const CHORD_SAMPLES: usize = 16;
-/// Golden-section iterations around the worst sample (shrinks its bracket by 0.618¹²).
-const REFINE_ITERATIONS: usize = 12;
 /// Trials allowed for one forward step before the search is declared stalled.
 const MAX_TRIALS: usize = 60;
 /// Contact points allowed on one path.
@@ -89,37 +88,9 @@ fn at(surface: &NurbsSurface, path: &impl SurfacePath, t: f64) -> Vec3 {
 pub fn chord_error(surface: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb: f64) -> f64 {
     let (a, b) = (at(surface, path, ta), at(surface, path, tb));
     let dist = |t: f64| point_segment_distance(&at(surface, path, t), &a, &b);
-    let n = CHORD_SAMPLES + 1;
-    let step = (tb - ta) / n as f64;
-    let (mut worst, mut worst_k) = (0.0, 1);
-    for k in 1..n {
-        let d = dist(ta + step * k as f64);
-        if d > worst {
-            (worst, worst_k) = (d, k);
-        }
-    }
-    // Golden-section search for the maximum on the bracket around the worst sample.
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut lo, mut hi) = (
-        ta + step * (worst_k - 1) as f64,
-        ta + step * (worst_k + 1) as f64,
-    );
-    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (dist(x1), dist(x2));
-    for _ in 0..REFINE_ITERATIONS {
-        if f1 > f2 {
-            hi = x2;
-            (x2, f2) = (x1, f1);
-            x1 = hi - g * (hi - lo);
-            f1 = dist(x1);
-        } else {
-            lo = x1;
-            (x1, f1) = (x2, f2);
-            x2 = lo + g * (hi - lo);
-            f2 = dist(x2);
-        }
-    }
-    worst.max(f1).max(f2)
+    // geom's maximiser refines around every local peak among the samples, not only the
+    // highest: of an S-shaped span's two humps the lower-sampled one may be the taller.
+    maximise(dist, ta, tb, CHORD_SAMPLES + 1).distance
 }
 
 /// The chord of a circle of radius `rho` whose sagitta is `eps`: `λ = 2√(2ρε − ε²)` (001

@@ -6,6 +6,7 @@
 //! that into G-code for a table-tilting machine, and the dexel simulation ([`verify`])
 //! measures scallop and gouge independently.
 
+pub mod arc_grid;
 pub mod cutter;
 pub mod effective_radius;
 pub mod error;
@@ -15,6 +16,7 @@ pub mod orientation;
 pub mod post;
 pub mod scallop;
 pub mod select;
+pub mod silhouette;
 pub mod step;
 pub mod strategy;
 #[doc(hidden)]
@@ -25,5 +27,7 @@ pub mod verify;
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};
 pub use effective_radius::LeadTilt;
 pub use error::CamError;
-pub use strategy::{plan, FeedDirection, Plan, Settings, StrategyKind, ToolAxis};
+pub use strategy::{
+    plan, Band, FeedDirection, Plan, Settings, StrategyKind, ToleranceShares, ToolAxis,
+};
 pub use toolpath::{CutterLocation, Pass, ToolPath};

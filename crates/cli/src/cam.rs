@@ -10,16 +10,20 @@ use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Poste
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
-use tezgah_cam::{Cutter, CutterShape, Settings, StrategyKind, ToolAxis, ToolPath};
+use tezgah_cam::{Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
+
+use crate::cam_tool::{self, ToolSpec};
 
 /// The command line of `tezgah cam` (DESIGN.md "Command-line contract").
 #[derive(clap::Args)]
 pub struct CamArgs {
     /// The surface (STEP file).
     pub surface: PathBuf,
-    /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm).
+    /// The cutter: ball:D, flat:D or bull:D:r (diameter D, corner radius r, mm), or auto: the
+    /// largest ball end mill that fits the face's tightest concave curvature, from the tool
+    /// table's ball end mills (--tool-table) or else the standard set.
     #[arg(long)]
     pub tool: String,
     /// zigzag, zigzag-oneway or iso-scallop.
@@ -28,7 +32,8 @@ pub struct CamArgs {
     /// Largest scallop height, mm.
     #[arg(long)]
     pub scallop: f64,
-    /// Chord and linearisation tolerance, mm.
+    /// How far the machine's motion may run outside the exact cutter-location surface, mm
+    /// (shared by chords, linearisation and blending; taken from the scallop budget).
     #[arg(long)]
     pub tolerance: f64,
     /// Lead angle: the tool tilted from the normal toward the feed, degrees.
@@ -58,9 +63,10 @@ pub struct CamArgs {
     /// A tool table in LinuxCNC's format (the tool's length).
     #[arg(long)]
     pub tool_table: Option<PathBuf>,
-    /// The tool number for T and H words.
-    #[arg(long, default_value_t = 1)]
-    pub tool_number: u32,
+    /// The tool number for T and H words (default: the tool `--tool auto` chose from the
+    /// table, else 1).
+    #[arg(long)]
+    pub tool_number: Option<u32>,
     /// The STEP `#id` of the face to machine (needed when the file has several faces).
     #[arg(long)]
     pub face: Option<u64>,
@@ -88,11 +94,12 @@ pub const MAX_TILT_DEG: f64 = 180.0;
 pub struct PlanRequest {
     pub strategy: StrategyKind,
     pub scallop_mm: f64,
+    /// The strategy's chord tolerance, mm.
     pub tolerance_mm: f64,
+    /// The one-sided band (`None`: chords straddle the exact CL surface).
+    pub band: Option<Band>,
     pub lead_deg: f64,
     pub tilt_deg: f64,
-    /// The STEP `#id` of the face to machine (needed when the file has several).
-    pub face: Option<u64>,
     /// The most the tool axis may lean from +Z, degrees.
     pub max_tilt_deg: f64,
     /// The parameter the passes run along (`None`: chosen for the surface).
@@ -177,12 +184,23 @@ struct Planned {
     direction: FeedDirection,
 }
 
-/// The surface of a STEP file and the tool path the strategy plans on it. Gouging contact
-/// points the strategy could not correct are left out of the path and listed here.
-fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Planned> {
+/// The face of the STEP file at `path` to machine (`--face`, or its only face) and a box
+/// around every face of the file (the part the links keep clear of).
+fn read_face(path: &Path, id: Option<u64>) -> Result<(Face, Option<PartBox>)> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
     let part = part_box(&model);
-    let face = pick_face(path, model, request.face)?;
+    Ok((pick_face(path, model, id)?, part))
+}
+
+/// The face's surface and the tool path the strategy plans on it. Gouging contact points the
+/// strategy could not correct are left out of the path and listed here.
+fn plan_surface(
+    path: &Path,
+    face: Face,
+    part: Option<PartBox>,
+    cutter: Cutter,
+    request: &PlanRequest,
+) -> Result<Planned> {
     let mut settings = Settings::new(request.strategy, request.scallop_mm, request.tolerance_mm);
     if let ToolAxis::Surface {
         lead_deg, tilt_deg, ..
@@ -196,6 +214,12 @@ fn plan_surface(path: &Path, cutter: Cutter, request: &PlanRequest) -> Result<Pl
     settings.direction = request
         .direction
         .unwrap_or_else(|| FeedDirection::for_surface(&face.surface));
+    settings.band = request.band;
+    if request.band.is_some() {
+        // The rear check accepts penetrations up to its depth tolerance: keep that within
+        // issue 7's 1 µm.
+        settings.gouge.depth_tolerance = 0.5 * GOUGE_LIMIT_MM;
+    }
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let out_of_reach = plan
@@ -259,9 +283,16 @@ fn tool_length(table: Option<&Path>, number: u32) -> Result<f64> {
 
 pub fn cam(args: CamArgs) -> Result<ExitCode> {
     // Everything the command line can get wrong is refused before any work.
-    let shape: CutterShape = args.tool.parse().into_diagnostic()?;
+    let spec = ToolSpec::parse(&args.tool)?;
     let scallop = positive("--scallop", args.scallop)?;
     let tolerance = positive("--tolerance", args.tolerance)?;
+    if tolerance >= scallop {
+        return Err(miette!(
+            "--tolerance {tolerance} must be below --scallop {scallop}: the motion may run up to \
+             the tolerance outside the exact path, which raises the scallop by as much, so the \
+             side steps are planned for the scallop minus the tolerance"
+        ));
+    }
     let feed = positive("--feed", args.feed)?;
     for (name, v) in [("--lead", args.lead_deg), ("--tilt", args.tilt_deg)] {
         if !(v.is_finite() && v.abs() < 90.0) {
@@ -309,18 +340,32 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
     }
-    let length = tool_length(args.tool_table.as_deref(), args.tool_number)?;
+    let (face, part) = read_face(&args.surface, args.face)?;
+    let (shape, tool_number) = match spec {
+        ToolSpec::Given(shape) => (shape, args.tool_number.unwrap_or(1)),
+        ToolSpec::Auto => {
+            let table = match args.tool_table.as_deref() {
+                Some(p) => Some((p, crate::library::load_tool_table(Some(p))?)),
+                None => None,
+            };
+            let pick = cam_tool::choose(&face, table.as_ref().map(|(p, t)| (*p, t)))?;
+            println!("tool auto: {} — {}", pick.shape, pick.why);
+            (pick.shape, args.tool_number.or(pick.number).unwrap_or(1))
+        }
+    };
+    let length = tool_length(args.tool_table.as_deref(), tool_number)?;
     let cutter = Cutter::standard(shape);
-    // One guarantee (DESIGN.md "Tolerance"): the strategy's chords and the post's
-    // linearisation each get half, so the machine's motion stays within the tolerance of the
-    // exact cutter-location path (the two add up where they meet, as on a convex surface).
+    // One guarantee (DESIGN.md "Tolerance"), one-sided: the machine's motion runs between
+    // the exact cutter-location surface and the tolerance outside it. Chords get half,
+    // linearisation and blending an eighth each (`ToleranceShares`).
+    let shares = ToleranceShares::of(tolerance);
     let request = PlanRequest {
         strategy,
         scallop_mm: scallop,
-        tolerance_mm: 0.5 * tolerance,
+        tolerance_mm: shares.chord,
+        band: Some(shares.band()),
         lead_deg: args.lead_deg,
         tilt_deg: args.tilt_deg,
-        face: args.face,
         max_tilt_deg,
         direction,
     };
@@ -329,7 +374,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         path,
         part,
         direction,
-    } = plan_surface(&args.surface, cutter, &request)?;
+    } = plan_surface(&args.surface, face, part, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
             OutputForm::Joints
@@ -341,7 +386,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         } else {
             FeedOutput::PerMinute
         },
-        tool_number: args.tool_number,
+        tool_number,
         tool_length_mm: length,
         part,
         title: format!(
@@ -351,13 +396,14 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             args.strategy,
             scallop
         ),
-        ..PostOptions::new(feed, 0.5 * tolerance)
+        blend_mm: Some(shares.blend),
+        ..PostOptions::new(feed, shares.linearisation)
     };
     let done = finish(&surface, &path, &machine, &options, args.verify_cell_mm)?;
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
-    let mut json = report_json(&args, &machine, &path, &done, scallop);
+    let mut json = report_json(&args, &machine, &path, &done, scallop, tool_number);
     json["feed_along"] = serde_json::json!(match direction {
         FeedDirection::AlongU => "u",
         FeedDirection::AlongV => "v",
@@ -365,13 +411,16 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(p) = &args.report {
         crate::library::write_json(p, &json)?;
     }
-    summary(&args, &done, scallop, tolerance);
-    Ok(if done.verified(scallop, tolerance) {
+    summary(&args, &done, scallop);
+    Ok(if done.verified(scallop) {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
     })
 }
+
+/// The deepest gouge a verified program may leave (issue 7: "no gouge deeper than 1 µm"), mm.
+pub const GOUGE_LIMIT_MM: f64 = 0.001;
 
 /// A posted program and its verification.
 pub struct Finished {
@@ -381,15 +430,14 @@ pub struct Finished {
 }
 
 impl Finished {
-    /// No gouge deeper than the tolerance and no scallop above the target plus the tolerance
-    /// (each measured within its stated bound). The tolerance is what the machine's motion
-    /// may stray from the exact cutter-location path (chords and linearisation), and a pass
-    /// that strays away from the surface raises the ridge beside it by as much, so the
-    /// scallop the program leaves is the target plus at most the tolerance.
-    pub fn verified(&self, scallop: f64, tolerance: f64) -> bool {
+    /// Issue 7's check: the measured scallop within the target (measured heights may exceed
+    /// the true ones by the sweep bound, so that much over is allowed), no gouge deeper than
+    /// [`GOUGE_LIMIT_MM`], and every dexel of the region cut. The grid bound (how much the
+    /// sampled maxima may miss) is reported beside it, kept small by the cell size.
+    pub fn verified(&self, scallop: f64) -> bool {
         let v = &self.verification;
-        v.gouge_depth_mm <= tolerance
-            && v.max_scallop_mm - v.sweep_bound_mm <= scallop + tolerance
+        v.gouge_depth_mm <= GOUGE_LIMIT_MM
+            && v.max_scallop_mm - v.sweep_bound_mm <= scallop
             && v.uncut == 0
     }
 }
@@ -411,7 +459,22 @@ pub fn finish(
         _ => path.cutter.shape.radius(),
     };
     // δ²/(8ρ) = tolerance/10.
-    let spacing = (0.8 * rho * options.tolerance_mm).sqrt();
+    let circle = (0.8 * rho * options.tolerance_mm).sqrt();
+    // A flat end's rim adds δ·tan θ (θ its largest lean from the normal) to the sweep bound:
+    // that share is kept within the tolerance too, down to a twentieth of the circle's δ.
+    let lean = path
+        .passes
+        .iter()
+        .flat_map(|p| &p.points)
+        .map(|c| (c.axis.dot(&c.normal) / (c.axis.norm() * c.normal.norm())).clamp(-1.0, 1.0))
+        .map(f64::acos)
+        .filter(|a| a.is_finite())
+        .fold(0.0, f64::max);
+    let spacing = if path.cutter.shape.corner_radius() == 0.0 && lean > 0.0 {
+        circle.min((options.tolerance_mm / lean.tan()).max(circle / 20.0))
+    } else {
+        circle
+    };
     let mut verify_options = VerifyOptions {
         cell_mm: cell_mm.unwrap_or(step_over / 20.0),
         sweep_spacing_mm: spacing,
@@ -443,6 +506,7 @@ fn report_json(
     path: &ToolPath,
     done: &Finished,
     scallop: f64,
+    tool_number: u32,
 ) -> serde_json::Value {
     let s = &done.posted.stats;
     let v = &done.verification;
@@ -451,7 +515,8 @@ fn report_json(
     };
     serde_json::json!({
         "surface": args.surface.display().to_string(),
-        "tool": args.tool,
+        "tool": path.cutter.shape.to_string(),
+        "tool_number": tool_number,
         "strategy": args.strategy,
         "machine": machine.name,
         "output": if args.joints { "joints" } else { "tcp" },
@@ -486,11 +551,13 @@ fn report_json(
             "grid_bound_mm": v.grid_bound_mm,
             "sweep_bound_mm": v.sweep_bound_mm,
         },
-        "verified": done.verified(scallop, args.tolerance),
+        "gouge_limit_mm": GOUGE_LIMIT_MM,
+        "planned_scallop_mm": scallop - args.tolerance,
+        "verified": done.verified(scallop),
     })
 }
 
-fn summary(args: &CamArgs, done: &Finished, scallop: f64, tolerance: f64) {
+fn summary(args: &CamArgs, done: &Finished, scallop: f64) {
     let s = &done.posted.stats;
     let v = &done.verification;
     println!(
@@ -505,7 +572,7 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64, tolerance: f64) {
     );
     println!(
         "verified on {} dexels (cell {:.4} mm): max scallop {:.4} mm (target {scallop}), \
-         gouge {:.4} mm (tolerance {tolerance}), bounds −{:.4}/+{:.4} mm, uncut {}",
+         gouge {:.4} mm (limit {GOUGE_LIMIT_MM}), bounds −{:.4}/+{:.4} mm, uncut {}",
         v.dexels,
         v.cell_mm,
         v.max_scallop_mm,
@@ -514,7 +581,7 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64, tolerance: f64) {
         v.sweep_bound_mm,
         v.uncut
     );
-    if !done.verified(scallop, tolerance) {
+    if !done.verified(scallop) {
         eprintln!("verification FAILED: the program is written but does not meet the targets");
     }
 }
@@ -522,7 +589,7 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64, tolerance: f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tezgah_cam::{CutterLocation, Pass};
+    use tezgah_cam::{CutterLocation, CutterShape, Pass};
     use tezgah_geom::Vec3;
 
     /// The plane z = 0 over 12 × 10 mm, and a ball R = 1.5 zig-zag with 10° of lead.
@@ -589,10 +656,10 @@ mod tests {
             "{v:?}"
         );
         assert!(v.gouge_depth_mm < 1e-6, "{v:?}");
-        assert!(done.verified(h, 0.01));
+        assert!(done.verified(h + v.grid_bound_mm));
         assert!(
-            !done.verified(0.5 * h, 0.01),
-            "a scallop above the target plus the tolerance fails"
+            !done.verified(h - v.grid_bound_mm - v.sweep_bound_mm - 1e-4),
+            "a scallop above the target fails"
         );
         assert!((done.posted.stats.cutting_length_mm - path.cutting_length()).abs() < 1e-9);
     }

@@ -3,6 +3,7 @@
 //! Every command is a thin shell over a library call; see the README for the commands.
 
 mod cam;
+mod cam_tool;
 mod diagnostics;
 mod library;
 mod plot;

@@ -179,7 +179,7 @@ fn cam_refuses_bad_options_without_a_panic() {
         let out = tezgah()
             .args(["cam", "surface.stp"])
             .args(extra)
-            .args(["--scallop", "0.01", "--tolerance", "0.01", "-o"])
+            .args(["--scallop", "0.05", "--tolerance", "0.01", "-o"])
             .arg(&out_ngc)
             .output()
             .unwrap();
@@ -190,6 +190,23 @@ fn cam_refuses_bad_options_without_a_panic() {
             "{err}"
         );
     }
+    // The one-sided band takes the tolerance from the scallop: it must be smaller.
+    let out = tezgah()
+        .args([
+            "cam",
+            "surface.stp",
+            "--tool",
+            "ball:3",
+            "--strategy",
+            "zigzag",
+        ])
+        .args(["--scallop", "0.01", "--tolerance", "0.01", "-o"])
+        .arg(&out_ngc)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("must be below --scallop"), "{err}");
     let out = tezgah()
         .args([
             "cam",

@@ -48,6 +48,11 @@ impl ToolTable {
         self.tools.get_mut(&number)
     }
 
+    /// The tools in order of their numbers.
+    pub fn iter(&self) -> impl Iterator<Item = &Tool> {
+        self.tools.values()
+    }
+
     pub fn insert(&mut self, tool: Tool) {
         self.tools.insert(tool.number, tool);
     }

@@ -100,7 +100,16 @@ pub fn program(
             number(sphere.centre.z)
         ),
     );
-    let _ = writeln!(out, "G21 G17 G90 G40 G94 G64");
+    // Blending rounds corners toward the inside of the polyline, i.e. into the material on a
+    // convex part: an explicit `P` keeps it within the share the tool path's band allows.
+    match options.blend_mm {
+        Some(p) => {
+            let _ = writeln!(out, "G21 G17 G90 G40 G94 G64 P{p}");
+        }
+        None => {
+            let _ = writeln!(out, "G21 G17 G90 G40 G94 G64");
+        }
+    }
     let _ = writeln!(out, "T{tool} M6");
     if let Some(rpm) = options.spindle_rpm {
         let _ = writeln!(out, "S{} M3", number(rpm));

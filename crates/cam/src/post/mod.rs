@@ -70,6 +70,9 @@ pub struct PostOptions {
     pub spindle_rpm: Option<f64>,
     /// Largest number of halvings of one segment before the post gives up.
     pub max_halvings: u32,
+    /// The controller's corner blending tolerance written as `G64 P…`, mm; `None` writes a
+    /// bare `G64` (the controller's own default, which the tool path's band cannot count on).
+    pub blend_mm: Option<f64>,
     /// A title for the header comment.
     pub title: String,
 }
@@ -88,6 +91,7 @@ impl PostOptions {
             clearance_mm: 5.0,
             spindle_rpm: None,
             max_halvings: 24,
+            blend_mm: None,
             title: String::new(),
         }
     }
@@ -202,6 +206,9 @@ pub fn post(
 ) -> Result<Posted, PostError> {
     let feed = positive("the feed", options.feed_mm_per_min)?;
     let tolerance = positive("the tolerance", options.tolerance_mm)?;
+    if let Some(p) = options.blend_mm {
+        positive("the blending tolerance", p)?;
+    }
     if !(options.clearance_mm.is_finite() && options.clearance_mm >= 0.0) {
         return Err(PostError::Option {
             what: "the clearance",

@@ -3,8 +3,11 @@
 //! the gouge checks corrected or refused. Iso-parametric zig-zag (one-way and two-way) lives in
 //! `iso_parametric`, iso-scallop in `iso_scallop`; both step along their passes by the true
 //! chord error (`forward_step`), size side steps by the exact scallop model (`scallop`) and place
-//! every contact here (orientation, CC → CL, gouge checks and correction).
+//! every contact here (orientation, CC → CL, gouge checks and correction). With a
+//! [`Band`] the placed passes are then held to one side of the exact cutter-location surface
+//! (`band`).
 
+mod band;
 mod iso_parametric;
 mod iso_scallop;
 
@@ -25,6 +28,7 @@ use crate::orientation::ContactFrame;
 use crate::scallop::stepover_exact;
 use crate::toolpath::{CutterLocation, Pass, ToolPath};
 
+pub use band::{Band, ChordSag, ToleranceShares};
 pub use iso_parametric::iso_parametric_side_step;
 
 /// The finishing strategy, by DESIGN.md's `tezgah cam --strategy NAME`.
@@ -159,6 +163,14 @@ pub struct Settings {
     /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
     pub max_axis_tilt_deg: Option<f64>,
     pub gouge: GougeSettings,
+    /// The one-sided tolerance band (DESIGN.md "Tolerance"): `Some` shifts every cutter
+    /// location out of the material by its chords' inward sag plus [`Band::motion`] (chords
+    /// sagging more than `tolerance` either way are halved first), so the motion between the
+    /// emitted points never cuts into the part, and plans side steps for
+    /// `scallop − band.outward(tolerance)` so the scallop stays within `scallop`. `None`: the
+    /// locations touch the surface exactly and chords straddle it (the contact-point chord
+    /// error within `tolerance`).
+    pub band: Option<Band>,
 }
 
 impl Settings {
@@ -179,6 +191,7 @@ impl Settings {
             max_lead_change_deg: None,
             max_axis_tilt_deg: None,
             gouge: GougeSettings::default(),
+            band: None,
         }
     }
 
@@ -188,6 +201,17 @@ impl Settings {
         positive("max_step", self.max_step)?;
         if let Some(rate) = self.max_lead_change_deg {
             positive("max_lead_change", rate)?;
+        }
+        if let Some(band) = self.band {
+            band.validate()?;
+            let planned = self.scallop - band.outward(self.tolerance);
+            if planned <= 0.0 || planned.is_nan() {
+                return Err(CamError::Setting {
+                    name: "tolerance band (chord tolerance + 2 × band motion)",
+                    want: "below the scallop height, which it is taken from",
+                    got: band.outward(self.tolerance),
+                });
+            }
         }
         if let Some(t) = self.max_axis_tilt_deg {
             if !(t.is_finite() && (0.0..=180.0).contains(&t)) {
@@ -283,6 +307,18 @@ pub fn plan(
 ) -> Result<Plan, CamError> {
     settings.validate()?;
     validate_cutter(cutter)?;
+    // The band's outward width comes off the scallop the side steps are sized for.
+    let banded;
+    let settings = match settings.band {
+        Some(band) => {
+            banded = Settings {
+                scallop: settings.scallop - band.outward(settings.tolerance),
+                ..settings.clone()
+            };
+            &banded
+        }
+        None => settings,
+    };
     let ctx = Context::new(surface, cutter, settings)?;
     let paths = match settings.strategy {
         StrategyKind::ZigZag | StrategyKind::ZigZagOneWay => iso_parametric::passes(&ctx)?,
@@ -391,6 +427,8 @@ const LIMIT_NUDGE: f64 = 1e-8;
 
 /// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
 const MATCH_MARGIN: f64 = 0.05;
+/// Bisections of a side step against the true silhouette (the bracket shrinks by 2⁻³⁰).
+const SILHOUETTE_BISECTIONS: usize = 30;
 /// Lean added per correction trial, degrees.
 const CORRECTION_STEP_DEG: f64 = 1.0;
 
@@ -555,7 +593,40 @@ impl<'a> Context<'a> {
         let angles = self.nominal_angles(local)?;
         let r_e = self.shape().effective_radius(angles);
         let w = stepover_exact(r_e, local.curvature.tt, self.settings.scallop)?;
-        Some(w.min(self.shape().radius()))
+        Some(self.fit_silhouette(local, angles, w.min(self.shape().radius())))
+    }
+
+    /// `w`, shrunk (bisection) until the cusp on the cutter's true silhouette across the feed
+    /// is within the target (`silhouette`): a flat or bull-nose profile rises faster than its
+    /// osculating circle away from the contact. A ball's profile is its circle.
+    fn fit_silhouette(&self, local: &Local, angles: LeadTilt, w: f64) -> f64 {
+        if matches!(self.shape(), CutterShape::Ball { .. }) {
+            return w;
+        }
+        let a = self.axis_for(&local.frame, angles).into_inner();
+        let (n, t) = (
+            local.frame.normal.into_inner(),
+            local.frame.cross.into_inner(),
+        );
+        let (h, kappa, len) = (
+            self.settings.scallop,
+            local.curvature.tt,
+            self.cutter.flute_length,
+        );
+        let cusp = |w: f64| crate::silhouette::cusp(self.shape(), len, &a, &n, &t, kappa, w);
+        if cusp(w) <= h {
+            return w;
+        }
+        let (mut lo, mut hi) = (0.0, w);
+        for _ in 0..SILHOUETTE_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if cusp(mid) <= h {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
     }
 
     /// Places the cutter at the contact `(u, v)` on a path running along `tangent_uv`, leaning
@@ -656,22 +727,29 @@ impl<'a> Context<'a> {
             corrected: 0,
         };
         let sign = if reverse { -1.0 } else { 1.0 };
-        let contacts: Vec<Contact> = ts
+        let contact_at = |t: f64| {
+            let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
+            Contact {
+                uv: path.uv(t),
+                tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
+            }
+        };
+        let mut placed: Vec<Result<Placed, GougeReport>> = ts
             .iter()
             .map(|&t| {
-                let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
-                Contact {
-                    uv: path.uv(t),
-                    tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
-                }
+                let c = contact_at(t);
+                self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
-        let mut placed: Vec<Result<Placed, GougeReport>> = contacts
-            .iter()
-            .map(|c| self.place(c.uv.0, c.uv.1, c.tangent, 0.0))
-            .collect();
+        if self.settings.band.is_some() {
+            self.refine_chords(path, &mut ts, &mut placed, contact_at);
+        }
         if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
+            let contacts: Vec<Contact> = ts.iter().map(|&t| contact_at(t)).collect();
             self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
+        }
+        if let Some(band) = self.settings.band {
+            self.shift_outward(path, &ts, &mut placed, band);
         }
         let mut current = Pass::default();
         for item in placed {
@@ -682,18 +760,24 @@ impl<'a> Context<'a> {
                 }
                 Err(report) => {
                     out.refused.push(report);
-                    if current.points.len() >= 2 {
-                        out.passes.push(std::mem::take(&mut current));
-                    } else {
-                        current.points.clear();
-                    }
+                    self.close_pass(&mut out.passes, std::mem::take(&mut current));
                 }
             }
         }
-        if current.points.len() >= 2 {
-            out.passes.push(current);
-        }
+        self.close_pass(&mut out.passes, current);
         Ok(out)
+    }
+
+    /// Keeps a pass of two or more locations, with its run-out when the band is on.
+    fn close_pass(&self, passes: &mut Vec<Pass>, mut pass: Pass) {
+        if let [.., prev, last] = pass.points.as_slice() {
+            if self.settings.band.is_some() {
+                if let Some(extra) = self.run_out(prev, last) {
+                    pass.points.push(extra);
+                }
+            }
+            passes.push(pass);
+        }
     }
 
     /// Raises leads so consecutive placed locations differ by at most `rate` (radians): each

@@ -14,7 +14,9 @@
 //!   between two; the material left between two placements is at most the sagitta of the
 //!   cutter's section where the dexel meets it: at a scallop of height h that section of the
 //!   corner (radius ρ: the corner radius, the tool radius for a flat end) is a circle of radius
-//!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`.
+//!   ≥ ρ − h, so heights are over-estimated by at most `δ²/(8(ρ − h))`. A flat end's
+//!   section along the motion also has a corner at the rim, behind which its bottom rises at
+//!   the tool's lean θ from the normal: `δ·tan θ` more (θ the largest lean of the path).
 //! * grid: the highest scallop is sampled at a node at most `c/√2` from it (c the largest
 //!   node spacing); the scallop's flank rises with slope at most `tan φ`, `cos φ = 1 − h/ρ`
 //!   (the cutter's profile meeting the surface at the height h; on a convex surface ρ is
@@ -31,6 +33,7 @@ use tezgah_geom::{NurbsSurface, Vec3};
 
 pub use solid::{CutterPose, CutterSolid};
 
+use crate::arc_grid::{arc_nodes, spread};
 use crate::toolpath::ToolPath;
 
 /// How finely to simulate.
@@ -286,7 +289,12 @@ pub fn simulate(
     measure(&dexels, up, &mut out);
     let solid = sweeper.solid;
     let rho = if solid.corner > 0.0 { solid.corner } else { r };
-    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    let edge = if solid.corner > 0.0 {
+        0.0
+    } else {
+        rim_bound(spacing, &cls, r)
+    };
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm) + edge;
     let rho_flank = 1.0 / (1.0 / rho + convex);
     let coarse = grid_bound(&out, rho_flank, achieved);
 
@@ -332,7 +340,7 @@ pub fn simulate(
         sweeper.run(&mut fine, poses);
         measure(&fine, up, &mut out);
     }
-    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm);
+    out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm) + edge;
     out.grid_bound_mm = if complete {
         grid_bound(&out, rho_flank, achieved / REFINE as f64)
     } else {
@@ -341,76 +349,28 @@ pub fn simulate(
     Ok(out)
 }
 
-/// Samples along a parameter for [`arc_nodes`].
-const ARC_SAMPLES: usize = 256;
-
-/// The cumulative arc length along one parameter over `range` (at [`ARC_SAMPLES`] + 1 equally
-/// spaced values), the speed at each value being the largest `speed(t, s)` over
-/// [`SPEED_SAMPLES`] values of the other parameter `s` in `across`, with a 5 % margin for what
-/// falls between samples, and each interval taken at the larger of its ends' speeds. Returns
-/// the (parameter, length) samples and the total length.
-fn arc_nodes(
-    speed: impl Fn(f64, f64) -> f64,
-    range: (f64, f64),
-    across: (f64, f64),
-) -> (Vec<(f64, f64)>, f64) {
-    let at = |k: usize, n: usize, r: (f64, f64)| r.0 + (r.1 - r.0) * k as f64 / n as f64;
-    let fastest: Vec<f64> = (0..=ARC_SAMPLES)
-        .map(|k| {
-            let t = at(k, ARC_SAMPLES, range);
-            (0..SPEED_SAMPLES)
-                .map(|j| speed(t, at(j, SPEED_SAMPLES - 1, across)))
-                .filter(|x| x.is_finite())
-                .fold(0.0_f64, f64::max)
-                * 1.05
-        })
-        .collect();
-    let mut out = Vec::with_capacity(ARC_SAMPLES + 1);
-    let mut length = 0.0;
-    out.push((range.0, 0.0));
-    for k in 1..=ARC_SAMPLES {
-        let dt = (range.1 - range.0) / ARC_SAMPLES as f64;
-        length += fastest[k - 1].max(fastest[k]) * dt;
-        out.push((at(k, ARC_SAMPLES, range), length));
-    }
-    (out, length)
-}
-
-/// `n` parameter values (n ≥ 2) at equal steps of the length in `samples` (from
-/// [`arc_nodes`]), the first and last at the range's ends; n = 1 gives the start.
-fn spread(samples: &[(f64, f64)], n: usize) -> Vec<f64> {
-    let (Some(first), Some(last)) = (samples.first(), samples.last()) else {
-        return Vec::new();
-    };
-    if n < 2 || last.1 <= 0.0 {
-        return (0..n.max(1))
-            .map(|k| first.0 + (last.0 - first.0) * k as f64 / (n.max(2) - 1) as f64)
-            .collect();
-    }
-    let mut out = Vec::with_capacity(n);
-    let mut seg = 0;
-    for k in 0..n {
-        let target = last.1 * k as f64 / (n - 1) as f64;
-        while seg + 2 < samples.len() && samples[seg + 1].1 < target {
-            seg += 1;
-        }
-        let (a, b) = (samples[seg], samples[seg + 1]);
-        let t = if b.1 > a.1 {
-            ((target - a.1) / (b.1 - a.1)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        out.push(a.0 + (b.0 - a.0) * t);
-    }
-    out
-}
-
 /// Candidate nodes refined at most (each adds up to (2·REFINE + 1)² sub-dexels, fewer where
 /// neighbours share them).
 const REFINE_CAP: usize = 4096;
 
 /// The refinement lattice is this many times finer than the grid.
 const REFINE: usize = 2;
+
+/// A flat end's section along its motion has a corner at the rim: behind the front rim point
+/// the bottom face rises at the tool's lean θ from the surface normal, so between two
+/// placements δ apart it leaves up to `δ·tan θ` — θ the largest lean over the cutter
+/// locations (capped at the tool radius).
+fn rim_bound(spacing: f64, cls: &[&crate::toolpath::CutterLocation], radius: f64) -> f64 {
+    let lean = cls
+        .iter()
+        .map(|c| {
+            let cos = c.axis.dot(&c.normal) / (c.axis.norm() * c.normal.norm());
+            cos.clamp(-1.0, 1.0).acos()
+        })
+        .filter(|a| a.is_finite())
+        .fold(0.0, f64::max);
+    (spacing * lean.tan()).min(radius)
+}
 
 /// `δ²/(8(ρ − h))`: the sagitta between two placements δ apart of the cutter's section at
 /// the height h of the highest scallop, a circle of radius at least ρ − h (ρ when h ≥ ρ would
@@ -624,32 +584,6 @@ impl Buckets {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn grid_lines_at_equal_arc_length_keep_every_cell_within_the_spacing() {
-        // Speed 1 + 3t on [0, 1] (length 2.5), the same across: the nodes bunch where it is
-        // fast, and no step's true length ∫(1 + 3t) dt exceeds the cell.
-        let (samples, length) = arc_nodes(|t, _| 1.0 + 3.0 * t, (0.0, 1.0), (0.0, 1.0));
-        assert!(
-            (2.5 * 1.05..2.5 * 1.05 * 1.01).contains(&length),
-            "{length}"
-        );
-        let cell = 0.05;
-        let n = (length / cell).ceil() as usize + 1;
-        let nodes = spread(&samples, n);
-        assert_eq!(nodes.len(), n);
-        assert_eq!((nodes[0], nodes[n - 1]), (0.0, 1.0));
-        let true_length = |a: f64, b: f64| (b - a) + 1.5 * (b * b - a * a);
-        let steps: Vec<f64> = nodes.windows(2).map(|w| true_length(w[0], w[1])).collect();
-        assert!(steps.iter().all(|&d| d > 0.0 && d <= cell), "{steps:?}");
-        // Nearly equal: a uniform grid would need the fast end's spacing everywhere (4 × 1.05
-        // / 0.05 = 84 steps instead of 53).
-        let (lo, hi) = steps
-            .iter()
-            .fold((f64::INFINITY, 0.0_f64), |(a, b), &d| (a.min(d), b.max(d)));
-        assert!(lo > 0.9 * hi, "{lo} {hi}");
-        assert!(n - 1 < 60, "{n}");
-    }
 
     fn dexel(foot: Vec3) -> Dexel {
         Dexel {

@@ -1,0 +1,135 @@
+//! The cutter's true silhouette across the feed, to check the side steps the osculating-circle
+//! model (`scallop`, `effective_radius`) proposes: far from the contact a bull-nose's torus or a
+//! flat end's rim rises faster than its circle of curvature at the contact (a D8 r2 torus at 10°
+//! lead: 0.151 mm at 1.87 mm beside the contact against the circle's 0.130), so the cusp between
+//! two passes is higher than the model says. The strategies shrink a side step until the cusp
+//! on the true silhouette fits (`Context::side_step`).
+//!
+//! The cutting end is convex: the points within `r` of a core cylinder of radius `R − r` from
+//! height `r` to the flute length (as the verifying simulation models it). The lowest point of a
+//! convex body `K` along `n` on the slice `P·t = y` follows from its support function
+//! `h_K(d) = max_{P∈K} P·d` by Lagrange duality: `min {P·n : P·t = y} = max_μ (−h_K(−n − μt) −
+//! μy)`, a concave maximisation in one variable. For this body
+//! `h_K(d) = (R − r)|d − (d·a)a| + max(r d·a, L d·a) + r|d|` (Minkowski sum of the core with a
+//! ball of radius `r`; tip at the origin, axis `a`).
+
+use tezgah_geom::Vec3;
+
+use crate::cutter::CutterShape;
+
+/// Golden-section iterations on the multiplier (its bracket shrinks by 0.618⁸⁰).
+const ITERATIONS: usize = 80;
+
+/// The support function of the cutting end (tip at the origin, unit axis `a`, flutes up to
+/// `flute_length`) in direction `d`.
+fn support(shape: &CutterShape, flute_length: f64, a: &Vec3, d: &Vec3) -> f64 {
+    let (big_r, r) = (shape.radius(), shape.corner_radius());
+    let along = d.dot(a);
+    let across = (d - a * along).norm();
+    (big_r - r) * across + (r * along).max(flute_length.max(r) * along) + r * d.norm()
+}
+
+/// The lowest point along `n` of the cutter's slice `P·t = y` (`n`, `t` orthonormal).
+fn lowest(shape: &CutterShape, flute_length: f64, a: &Vec3, n: &Vec3, t: &Vec3, y: f64) -> f64 {
+    let f = |mu: f64| -support(shape, flute_length, a, &-(n + t * mu)) - mu * y;
+    // The optimal multiplier is the silhouette's slope, bounded well inside ±1e3 for any slice
+    // short of the cutter's side.
+    let (mut lo, mut hi) = (-1e3, 1e3);
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
+    let (mut f1, mut f2) = (f(x1), f(x2));
+    for _ in 0..ITERATIONS {
+        if f1 >= f2 {
+            hi = x2;
+            (x2, f2) = (x1, f1);
+            x1 = hi - g * (hi - lo);
+            f1 = f(x1);
+        } else {
+            lo = x1;
+            (x1, f1) = (x2, f2);
+            x2 = lo + g * (hi - lo);
+            f2 = f(x2);
+        }
+    }
+    f1.max(f2)
+}
+
+/// How far the cutter's silhouette across the feed has risen along `n` at `y` beside the
+/// contact (the lowest point): `n` the surface normal, `t` the cross-feed direction, `a` the
+/// tool axis, all unit.
+pub fn rise(shape: &CutterShape, flute_length: f64, a: &Vec3, n: &Vec3, t: &Vec3, y: f64) -> f64 {
+    let bottom = -support(shape, flute_length, a, &-n);
+    lowest(shape, flute_length, a, n, t, y) - bottom
+}
+
+/// The cusp between two passes `w` apart on a cross-feed section of normal curvature `kappa`
+/// (positive concave, as `scallop`): the silhouettes meet `w/2` beside each contact, where the
+/// surface has risen `ρ − √(ρ² − (w/2)²)` toward the tool (concave) or fallen as much (convex).
+pub fn cusp(
+    shape: &CutterShape,
+    flute_length: f64,
+    a: &Vec3,
+    n: &Vec3,
+    t: &Vec3,
+    kappa: f64,
+    w: f64,
+) -> f64 {
+    let y = 0.5 * w;
+    let tool = rise(shape, flute_length, a, n, t, y).max(rise(shape, flute_length, a, n, t, -y));
+    let surface = if kappa.abs() < 1e-12 {
+        0.0
+    } else {
+        let rho = 1.0 / kappa.abs();
+        let fall = rho - (rho * rho - y * y).max(0.0).sqrt();
+        fall * kappa.signum()
+    };
+    tool - surface
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ball_and_tilted_flat_match_their_closed_forms() {
+        let (n, t, f) = (Vec3::z(), Vec3::y(), Vec3::x());
+        // A ball's silhouette is its circle: R − √(R² − y²).
+        let ball = CutterShape::Ball { radius: 3.0 };
+        for y in [0.0_f64, 0.5, 1.5, 2.5] {
+            let want = 3.0 - (9.0 - y * y).sqrt();
+            let got = rise(&ball, 18.0, &n, &n, &t, y);
+            assert!((got - want).abs() < 1e-9, "{y}: {got} {want}");
+        }
+        // A flat end leaned λ toward the feed: its rim, (R − √(R² − y²))·sin λ.
+        let lam = 10f64.to_radians();
+        let a = (n * lam.cos() + f * lam.sin()).normalize();
+        let flat = CutterShape::Flat { radius: 4.0 };
+        for y in [0.5_f64, 1.33, 3.0] {
+            let want = (4.0 - (16.0 - y * y).sqrt()) * lam.sin();
+            let got = rise(&flat, 24.0, &a, &n, &t, y);
+            assert!((got - want).abs() < 1e-9, "{y}: {got} {want}");
+        }
+    }
+
+    #[test]
+    fn torus_rises_faster_than_its_osculating_circle() {
+        // D8 r2 at 10° lead (module comment): brute-force silhouette 0.1515 mm at 1.87 mm.
+        let (n, t, f) = (Vec3::z(), Vec3::y(), Vec3::x());
+        let lam = 10f64.to_radians();
+        let a = (n * lam.cos() + f * lam.sin()).normalize();
+        let bull = CutterShape::BullNose {
+            radius: 4.0,
+            corner_radius: 2.0,
+        };
+        let got = rise(&bull, 24.0, &a, &n, &t, 1.87);
+        assert!((got - 0.1515).abs() < 2e-3, "{got}");
+        // On a plane the cusp of passes w apart is the rise at w/2.
+        let c = cusp(&bull, 24.0, &a, &n, &t, 0.0, 3.74);
+        assert!((c - got).abs() < 1e-12);
+        // A concave section takes its rise off, a convex one adds it.
+        let rho: f64 = 40.0;
+        let fall = rho - (rho * rho - 1.87 * 1.87).sqrt();
+        assert!((cusp(&bull, 24.0, &a, &n, &t, 1.0 / rho, 3.74) - (got - fall)).abs() < 1e-12);
+        assert!((cusp(&bull, 24.0, &a, &n, &t, -1.0 / rho, 3.74) - (got + fall)).abs() < 1e-12);
+    }
+}

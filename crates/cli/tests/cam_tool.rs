@@ -1,0 +1,109 @@
+//! `tezgah cam --tool auto` end to end: the cutter is chosen for the face (the largest ball
+//! that fits its tightest concave curvature, reference 001 §2.10) from the tool table's ball
+//! end mills, or from the standard set without a table; the choice and its reason are
+//! printed, and the report and program name the chosen tool.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::{read_json, tezgah, tmp, TOOLS};
+
+fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../cam/tests/fixtures")
+        .join(name)
+}
+
+#[test]
+fn auto_picks_the_tables_ball_end_mill_and_says_why() {
+    // examples/tools.tbl: T1 a 6 mm flat end mill, T2 a 3 mm ball end mill. The free-form
+    // patch's tightest concave radius is ≈ 25.9 mm, so the 3 mm ball fits and is the only one.
+    let (ngc, json) = (tmp("auto-table.ngc"), tmp("auto-table.json"));
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture("freeform_patch.stp"))
+        .args(["--tool", "auto", "--tool-table", TOOLS])
+        .args(["--strategy", "iso-scallop", "--scallop", "0.3"])
+        .args(["--tolerance", "0.01", "--verify-cell", "1", "-o"])
+        .arg(&ngc)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("tool auto: ball:3"), "{stdout}");
+    assert!(stdout.contains("tightest concave radius 25.8"), "{stdout}");
+    assert!(stdout.contains("tools.tbl"), "{stdout}");
+    let report = read_json(&json);
+    assert_eq!(report["tool"], "ball:3", "{report}");
+    assert_eq!(report["tool_number"], 2, "{report}");
+    assert_eq!(report["verified"], true, "{report}");
+    let program = std::fs::read_to_string(&ngc).unwrap();
+    assert!(program.contains("T2 M6"), "{}", &program[..400]);
+}
+
+#[test]
+fn auto_without_a_table_picks_from_the_standard_set() {
+    // The sphere cap is convex everywhere (seen from outside): the largest ball of the
+    // standard set, 32 mm.
+    let (ngc, json) = (tmp("auto-std.ngc"), tmp("auto-std.json"));
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture("rational_sphere.stp"))
+        .args(["--tool", "auto", "--strategy", "zigzag", "--scallop", "0.3"])
+        .args([
+            "--tolerance",
+            "0.01",
+            "--max-tilt",
+            "30",
+            "--verify-cell",
+            "1.5",
+        ])
+        .arg("-o")
+        .arg(&ngc)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("tool auto: ball:32"), "{stdout}");
+    assert!(stdout.contains("nowhere concave"), "{stdout}");
+    assert!(stdout.contains("standard set"), "{stdout}");
+    let report = read_json(&json);
+    assert_eq!(report["tool"], "ball:32", "{report}");
+    assert_eq!(report["tool_number"], 1, "{report}");
+}
+
+#[test]
+fn auto_with_a_table_without_balls_is_refused() {
+    let table = tmp("flats.tbl");
+    std::fs::write(&table, "T1 P1 D6.0 Z35.0 ;6 mm flat end mill\n").unwrap();
+    let ngc = tmp("auto-none.ngc");
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture("freeform_patch.stp"))
+        .args(["--tool", "auto", "--tool-table"])
+        .arg(&table)
+        .args([
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.3",
+            "--tolerance",
+            "0.01",
+        ])
+        .arg("-o")
+        .arg(&ngc)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("has no ball end mill"), "{stderr}");
+    assert!(!ngc.exists());
+}
