@@ -150,8 +150,9 @@ impl ArcLengthMap {
         let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
         // Moments m_k = ½Σ w v xᵏ over the symmetric node pairs ±x.
         let mut moments = [0.0; 8];
-        for (&x, &w) in GL_X.iter().zip(GL_W.iter()) {
-            let (vm, vp) = (curve.speed(mid - half * x), curve.speed(mid + half * x));
+        let speeds = curve.gauss_speeds(ua, ub);
+        for ((&x, &w), v) in GL_X.iter().zip(GL_W.iter()).zip(speeds.chunks_exact(2)) {
+            let (vm, vp) = (v[0], v[1]);
             let (even, odd) = (0.5 * w * (vp + vm), 0.5 * w * (vp - vm));
             let mut xk = 1.0;
             for pair in moments.chunks_exact_mut(2) {
