@@ -75,7 +75,9 @@ impl ExecOptions {
 
 enum Current {
     Piece {
-        cursor: PieceCursor,
+        // Boxed: the cursor carries its arc-length panel's polynomial (`tezgah_geom`'s
+        // `ArcLengthCursor`), which made this variant much the larger.
+        cursor: Box<PieceCursor>,
         tau: f64,
         factor: f64,
     },
@@ -691,7 +693,7 @@ impl Executor {
             };
             match item {
                 Planned::Motion(piece) => {
-                    let cursor = PieceCursor::new(Arc::from(piece));
+                    let cursor = Box::new(PieceCursor::new(Arc::from(piece)));
                     self.current = Some(Current::Piece {
                         cursor,
                         tau: 0.0,
