@@ -408,7 +408,7 @@ mod tests {
 
     /// Runs the cursor forward in `steps` equal steps; every answer is checked against an
     /// independent fine map (within the map's tolerance of the true arc length) and `C(u)`.
-    /// Returns how many panels the cursor entered and how many of them took the Hermite path.
+    /// Returns how many panels the cursor entered and how many of them took the polynomial path.
     fn sweep(c: &Nurbs, tol: f64, steps: usize) -> (usize, usize) {
         let m = ArcLengthMap::new(c, tol).unwrap();
         let fine = ArcLengthMap::new(c, tol * 1e-3).unwrap();
@@ -441,7 +441,7 @@ mod tests {
     /// A smooth, uneven-speed cubic like a compressed surfacing pass (mm, map tolerance 1e-9
     /// per mm as the interpolator asks): nearly every panel takes the checked Legendre inverse.
     #[test]
-    fn smooth_spline_takes_the_hermite_inverse() {
+    fn smooth_spline_takes_the_polynomial_inverse() {
         let c = cubic(
             &[
                 [0.0, 0.0, 0.0],
