@@ -15,14 +15,16 @@
 //! Approximation Practice*, ch. 19; Davis & Rabinowitz, *Methods of Numerical Integration*,
 //! §2.7). Its integral `S(x) = s_k + h·Σ a_j ∫P_j`, with `∫_{-1}^x P_j = (P_{j+1} − P_{j−1})/(2j+1)`,
 //! is a polynomial `s(u)` on the panel that equals the table at both ends (`S(1)` is the
-//! panel's Gauss–Legendre value). It is checked once against the map: the leading
-//! interpolation error `∝ ∫P_8 = (P_9 − P_7)/17` is largest at the innermost Gauss nodes, so `s`
-//! is taken there by the map's quadrature; the panel is accepted when `S` is within the Newton
-//! tolerance of it (a hundredth of the map's tolerance: the margin for the terms the one check
-//! does not see). A sample on an accepted panel is then a Newton solve of `S(x) = s` on the
-//! polynomial (no curve evaluation) and one `C(u)`; other panels (a cusp, a fast-changing
-//! speed) keep the quadrature and Newton below. Like the map's own bound, the check is
-//! a-posteriori (module `arclen`).
+//! panel's Gauss–Legendre value). It is checked once against the map, twice over: the
+//! interpolant's leading speed error is ∝ `P_8`, largest at the panel's ends, where the table
+//! holds the true speeds — that error times the panel's width must be within half the Newton
+//! tolerance; and the leading arc-length error `∝ ∫P_8 = (P_9 − P_7)/17` is largest at the
+//! innermost Gauss nodes (it vanishes at the middle), so `s` is taken there by the map's
+//! quadrature and `S` must be within the Newton tolerance of it (a hundredth of the map's
+//! tolerance: the margin for the terms the checks do not see). A sample on an accepted panel is
+//! then a Newton solve of `S(x) = s` on the polynomial (no curve evaluation) and one `C(u)`;
+//! other panels (a heavy weight, a fast-changing speed) keep the quadrature and Newton below.
+//! Like the map's own bound, the checks are a-posteriori (module `arclen`).
 //!
 //! Sits between the map and the interpolator (`tezgah-motion`'s `interpolate::Param`).
 
@@ -143,8 +145,8 @@ impl ArcLengthMap {
         }
     }
 
-    /// The Legendre `s(u)` of panel `k`, if it is within the Newton tolerance of the map's
-    /// quadrature at the check node (module documentation).
+    /// The Legendre `s(u)` of panel `k`, if it passes both checks against the map (module
+    /// documentation).
     fn panel_inverse<C: Curve + ?Sized>(&self, curve: &C, k: usize) -> PanelInverse {
         let (ua, ub) = (self.u[k], self.u[k + 1]);
         let (mid, half) = (0.5 * (ua + ub), 0.5 * (ub - ua));
@@ -190,8 +192,8 @@ impl ArcLengthMap {
         }
     }
 
-    /// Solves `S(x) = s` on an accepted panel by Newton from the linear guess, inside the
-    /// bracket `[lo, hi]` of `u`; `None` when it does not settle (the caller falls back).
+    /// Solves `S(x) = s` on an accepted panel by Newton from the last answer, never behind
+    /// it: `u` and `dS/dx` there; `None` when it does not settle (the caller falls back).
     fn solve_panel(
         &self,
         k: usize,
@@ -234,8 +236,9 @@ impl ArcLengthMap {
 
     /// The point at arc length `s` (clamped to `[0, length]`), from the cursor's last place:
     /// `u` and `C(u)` for the same `u` as [`Self::u_at`] to within the map's bound (module
-    /// documentation), at about one quadrature and one derivative evaluation per call when
-    /// `s` moves forward by less than a panel. `C(u)` comes from the same evaluation as the
+    /// documentation): on a panel whose polynomial passed its checks, a Newton solve on it and
+    /// one `C(u)`; elsewhere about one quadrature and one derivative evaluation per call when
+    /// `s` moves forward by less than a panel. There `C(u)` comes from the same evaluation as the
     /// Newton step: the Taylor series to third order about the last iterate when the step δ is
     /// at most 1e-4 of the panel's width `w` — exact for curves of degree ≤ 3, off by
     /// `|C⁗|·δ⁴/24 ≤ 4e-18·|C⁗|·w⁴` otherwise (a fourth difference over the panel, below
