@@ -296,8 +296,15 @@ impl ArcLengthMap {
         if cursor.inverse == PanelInverse::Unchecked {
             cursor.inverse = self.panel_inverse(curve, k);
         }
-        if let PanelInverse::Legendre { mid, half, c } = cursor.inverse {
-            if let Some((u, slope)) = self.solve_panel(k, (mid, half, &c), cursor, s) {
+        // By reference: the polynomial is most of the cursor, and this runs per sample.
+        let solved = match &cursor.inverse {
+            PanelInverse::Legendre { mid, half, c } => {
+                Some(self.solve_panel(k, (*mid, *half, c), cursor, s))
+            }
+            _ => None,
+        };
+        match solved {
+            Some(Some((u, slope))) => {
                 cursor.u = u;
                 cursor.s = s;
                 cursor.speed_rate = slope;
@@ -306,10 +313,13 @@ impl ArcLengthMap {
                     point: curve.point(u),
                 };
             }
-            // Not settled: this panel keeps the quadrature from the table's start.
-            *cursor = self.anchor(k);
-            cursor.inverse = PanelInverse::Rejected;
-            return self.advance(curve, cursor, s);
+            Some(None) => {
+                // Not settled: this panel keeps the quadrature from the table's start.
+                *cursor = self.anchor(k);
+                cursor.inverse = PanelInverse::Rejected;
+                return self.advance(curve, cursor, s);
+            }
+            None => {}
         }
         // Second-order inverse series u(s) about the cursor: u' = 1/v, u'' = −v'/v³.
         let ds = s - sa;
