@@ -75,12 +75,11 @@ impl ExecOptions {
     }
 }
 
-/// What is being played now. One value lives in the executor, so the size difference between
-/// the variants costs nothing; boxing the cursor would allocate per piece instead.
-#[allow(clippy::large_enum_variant)]
 enum Current {
     Piece {
-        cursor: PieceCursor,
+        // Boxed: the cursor carries its arc-length panel's polynomial (`tezgah_geom`'s
+        // `ArcLengthCursor`), which made this variant much the larger.
+        cursor: Box<PieceCursor>,
         tau: f64,
         factor: f64,
         /// Its limits above the planned speed, if it may run faster (override > 100 %).
@@ -736,7 +735,7 @@ impl Executor {
             match item {
                 Planned::Motion(piece) => {
                     let fast = fast.or_else(|| self.fast_limits(&piece));
-                    let cursor = PieceCursor::new(Arc::from(piece));
+                    let cursor = Box::new(PieceCursor::new(Arc::from(piece)));
                     self.current = Some(Current::Piece {
                         cursor,
                         tau: 0.0,

@@ -82,6 +82,21 @@ pub fn gauss_legendre_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> f64 {
     sum * h
 }
 
+/// `f` at the eight nodes of [`gauss_legendre_8`] on `[a, b]`, in the order
+/// `m − h·x_i, m + h·x_i` for the positive nodes `x_i` (`m`, `h` the middle and half-width):
+/// what a caller needs to fit the integrand as well as integrate it (the cursor's panel
+/// polynomial, `arclen/cursor.rs`).
+#[inline]
+pub fn gauss_nodes_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> [f64; 8] {
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    let mut out = [0.0; 8];
+    for (pair, x) in out.chunks_exact_mut(2).zip(GL_X.iter()) {
+        pair[0] = f(m - h * x);
+        pair[1] = f(m + h * x);
+    }
+    out
+}
+
 /// Table of panels `u_k → s_k` with the speed at each boundary.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArcLengthMap {

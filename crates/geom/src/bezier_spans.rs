@@ -109,6 +109,21 @@ impl BezierSpans {
     /// `t` and `C'` are computed as [`Self::locate`] and [`d1`] compute them, so the result is
     /// the per-node quadrature's bit for bit.
     pub(crate) fn speed_integral(&self, a: f64, b: f64) -> Option<f64> {
+        let span = self.span_speed(a, b)?;
+        Some(crate::arclen::gauss_legendre_8(|u| span.at(u), a, b))
+    }
+
+    /// `|C'|` at the eight Gauss–Legendre nodes of `[a, b]` (`arclen::gauss_nodes_8`'s
+    /// order) with one span lookup, each as [`Self::speed_integral`] computes it; `None`
+    /// when `[a, b]` crosses a knot.
+    pub(crate) fn gauss_speeds(&self, a: f64, b: f64) -> Option<[f64; 8]> {
+        let span = self.span_speed(a, b)?;
+        Some(crate::arclen::gauss_nodes_8(|u| span.at(u), a, b))
+    }
+
+    /// The speed of the one span holding `[a, b]` (`None` when it crosses a knot).
+    #[inline]
+    fn span_speed(&self, a: f64, b: f64) -> Option<SpanSpeed> {
         let k = self.index(a);
         let (start, end) = (self.starts[k], self.starts[k + 1]);
         // Every node is strictly inside (a, b); with b at most the span end they all belong
@@ -118,14 +133,13 @@ impl BezierSpans {
         }
         let (b0, iw) = (&self.spans[k], self.inv[k]);
         // `d1`'s differences, once for the eight nodes; per node the same arithmetic as `d1`.
-        let (d0, d1, d2) = (b0[1] - b0[0], b0[2] - b0[1], b0[3] - b0[2]);
-        let scale = 3.0 * iw;
-        let speed = |u: f64| {
-            let t = if u >= end { 1.0 } else { (u - start) * iw };
-            let s = 1.0 - t;
-            ((d0 * (s * s) + d1 * (2.0 * s * t) + d2 * (t * t)) * scale).norm()
-        };
-        Some(crate::arclen::gauss_legendre_8(speed, a, b))
+        Some(SpanSpeed {
+            start,
+            end,
+            iw,
+            d: [b0[1] - b0[0], b0[2] - b0[1], b0[3] - b0[2]],
+            scale: 3.0 * iw,
+        })
     }
 
     /// An upper bound of `max |C'| / min |C'|` over `[u0, u1]` when it lies in one span: the
@@ -241,6 +255,29 @@ pub(crate) fn derivs(b: &Span, t: f64, inv_width: f64) -> [Vec3; 4] {
         (e0 * s + e1 * t) * (6.0 * iw2),
         (e1 - e0) * (6.0 * iw2 * inv_width),
     ]
+}
+
+/// `|C'|` on one cubic span, from its control-point differences (`d1`'s arithmetic).
+struct SpanSpeed {
+    start: f64,
+    end: f64,
+    iw: f64,
+    d: [Vec3; 3],
+    scale: f64,
+}
+
+impl SpanSpeed {
+    #[inline]
+    fn at(&self, u: f64) -> f64 {
+        let t = if u >= self.end {
+            1.0
+        } else {
+            (u - self.start) * self.iw
+        };
+        let s = 1.0 - t;
+        let [d0, d1, d2] = self.d;
+        ((d0 * (s * s) + d1 * (2.0 * s * t) + d2 * (t * t)) * self.scale).norm()
+    }
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! offers to the planner — parameter domain, point, derivatives up to the third, curvature,
 //! length and arc-length evaluation — so path building and feed planning never match on kinds.
 
-use crate::arclen::{gauss_legendre_8, ArcLengthMap};
+use crate::arclen::{gauss_legendre_8, gauss_nodes_8, ArcLengthMap};
 
 /// A point or vector in the workpiece frame, mm.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -41,6 +41,13 @@ pub trait Curve {
     /// span together (one span lookup) override it with the same values.
     fn speed_integral(&self, a: f64, b: f64) -> f64 {
         gauss_legendre_8(|u| self.speed(u), a, b)
+    }
+
+    /// `|C'|` at the eight nodes of [`Self::speed_integral`]'s rule on `[a, b]`
+    /// ([`crate::arclen::gauss_nodes_8`]'s order). Curves with a span cache override it as
+    /// they override `speed_integral`, with the same values.
+    fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+        gauss_nodes_8(|u| self.speed(u), a, b)
     }
 
     /// Curvature `|C' × C''| / |C'|³` (1/mm): infinite at a cusp, never NaN.
@@ -120,6 +127,9 @@ macro_rules! forward_curve {
             }
             fn speed_integral(&self, a: f64, b: f64) -> f64 {
                 (**self).speed_integral(a, b)
+            }
+            fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+                (**self).gauss_speeds(a, b)
             }
             fn curvature(&self, u: f64) -> f64 {
                 (**self).curvature(u)

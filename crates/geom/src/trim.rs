@@ -57,6 +57,13 @@ impl<C: Curve> Curve for Trimmed<C> {
             crate::arclen::gauss_legendre_8(|u| self.speed(u), a, b)
         }
     }
+    fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+        if a >= self.u0 && b <= self.u1 && a <= b {
+            self.curve.gauss_speeds(a, b)
+        } else {
+            crate::arclen::gauss_nodes_8(|u| self.speed(u), a, b)
+        }
+    }
     fn breakpoints(&self) -> Vec<f64> {
         let mut out = vec![self.u0];
         out.extend(

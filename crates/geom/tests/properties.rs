@@ -116,6 +116,34 @@ proptest! {
         prop_assert_eq!(c.speed_integral(da, db).to_bits(), whole.to_bits());
     }
 
+    /// A NURBS's eight node speeds (one span lookup) are the per-node speeds bit for bit,
+    /// inside a span and across knots (the fallback), and they sum to its panel quadrature.
+    #[test]
+    fn gauss_speeds_are_the_per_node_speeds(
+        c in nurbs(), pick in 0.0f64..1.0, f0 in 0.0f64..1.0, f1 in 0.0f64..1.0
+    ) {
+        let (lo, hi) = (f0.min(f1), f0.max(f1));
+        let (u, width) = inside_span(&c, pick, 0.5);
+        let (a, b) = (u - 0.5 * width + lo * width, u - 0.5 * width + hi * width);
+        let (da, db) = c.domain();
+        for (a, b) in [(a, b), (da, db)] {
+            let per_node = tezgah_geom::arclen::gauss_nodes_8(|x| c.speed(x), a, b);
+            let got = c.gauss_speeds(a, b);
+            prop_assert_eq!(got.map(f64::to_bits), per_node.map(f64::to_bits));
+            // m ∓ h·x_i pairs: the first pair is nearest the middle, straddling it.
+            let m = 0.5 * (a + b);
+            if b > a {
+                prop_assert!(got.iter().all(|v| v.is_finite()));
+            }
+            let weights = [0.362_683_783_378_362, 0.313_706_645_877_887_3,
+                0.222_381_034_453_374_5, 0.101_228_536_290_376_3];
+            let sum: f64 = got.chunks_exact(2).zip(weights).map(|(v, w)| w * (v[0] + v[1])).sum();
+            let integral = c.speed_integral(a, b);
+            prop_assert!((sum * 0.5 * (b - a) - integral).abs() <= 1e-12 * (1.0 + integral.abs()),
+                "{} vs {} at m = {}", sum * 0.5 * (b - a), integral, m);
+        }
+    }
+
     /// The forward cursor finds the same u as `u_at` (to the map's bound in arc length) on
     /// sampling runs like the interpolator's — many small forward steps, crossing panels — and
     /// after arbitrary jumps back and forth; its point is C(u).

@@ -46,6 +46,8 @@ pub struct Sample {
 pub(crate) struct Param {
     map: Option<(ArcLengthMap, ArcLengthCursor)>,
     scale: f64,
+    /// The curve's domain (a virtual call per sample otherwise).
+    domain: (f64, f64),
 }
 
 impl Param {
@@ -55,6 +57,7 @@ impl Param {
             return Param {
                 map: None,
                 scale: 1.0,
+                domain: (a, b),
             };
         }
         // Constant parametric speed (lines, circular arcs and helices): u is proportional
@@ -68,6 +71,7 @@ impl Param {
             return Param {
                 map: None,
                 scale: (b - a) / seg.length,
+                domain: (a, b),
             };
         }
         match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
@@ -77,12 +81,14 @@ impl Param {
                 Param {
                     map: Some((m, cursor)),
                     scale,
+                    domain: (a, b),
                 }
             }
             // Fall back to a parameter proportional to length (exact for constant-speed arcs).
             Err(_) => Param {
                 map: None,
                 scale: (b - a) / seg.length,
+                domain: (a, b),
             },
         }
     }
@@ -95,7 +101,7 @@ impl Param {
                 (at.u, at.point)
             }
             None => {
-                let u = seg.curve.domain().0 + s * self.scale;
+                let u = self.domain.0 + s * self.scale;
                 (u, seg.curve.point(u))
             }
         }
@@ -116,8 +122,10 @@ pub(crate) fn segment_pose(
     let len = seg.path_length();
     let s = s.clamp(0.0, len);
     let f = if len > 0.0 { s / len } else { 1.0 };
-    let (_, b) = seg.curve.domain();
     let (tip, u) = if s >= len {
+        // From the segment, not `param`: the piece's end is asked with the last segment's
+        // param possibly not built yet.
+        let (_, b) = seg.curve.domain();
         (seg.curve.point(b), b)
     } else {
         let (u, tip) = param.at(seg, s);

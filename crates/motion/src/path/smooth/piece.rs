@@ -87,6 +87,14 @@ impl Curve for Geo {
             _ => None,
         }
     }
+    // Forwarded for the interpolator's panel polynomial (the same span lookup).
+    fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+        match self {
+            Geo::Line(c) => c.gauss_speeds(a, b),
+            Geo::Arc(c) => c.gauss_speeds(a, b),
+            Geo::Spline(c) => c.gauss_speeds(a, b),
+        }
+    }
     fn curvature(&self, u: f64) -> f64 {
         match self {
             Geo::Line(c) => c.curvature(u),
