@@ -773,6 +773,40 @@ fn override_above_100_speeds_up_the_planned_window() {
     assert!(top <= 200.0 * (1.0 + 1e-9) && top > 199.0, "{top}");
 }
 
+/// The same on an arc (curved: its limits are derived again for the highest override's feed,
+/// with room for the centripetal acceleration at that speed): a half circle of R 30 at F600,
+/// 200 % set 0.2 s after the start, runs at twice the feed within every joint limit and takes
+/// about half the time.
+#[test]
+fn override_above_100_speeds_up_a_planned_arc() {
+    let run = |percent: f64| {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::Load {
+            program: "G21 G90 F600\nG2 X60 Y0 I30 J0\nM2\n".into(),
+        })
+        .unwrap();
+        exec.command(Command::CycleStart).unwrap();
+        drive(&mut exec, &mut trace, 100_000, |k, e| {
+            if k == 200 {
+                e.command(Command::FeedOverride { percent }).unwrap();
+            }
+        });
+        assert_eq!(exec.state(), RunState::Idle);
+        let (out, report) = trace.report();
+        assert_within_limits(&report);
+        assert_continuous(&out);
+        assert!((out.last().unwrap().tip - Vec3::new(60.0, 0.0, 0.0)).norm() < 1e-9);
+        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+    };
+    let (v100, n100) = run(100.0);
+    let (v200, n200) = run(200.0);
+    assert!((v100 - 10.0).abs() < 1e-9, "{v100}");
+    assert!((v200 / 20.0 - 1.0).abs() < 1e-3, "{v200}");
+    let want = 200.0 + (n100 as f64 - 200.0) / 2.0;
+    assert!((n200 as f64 / want - 1.0).abs() < 0.01, "{n200} vs {want}");
+}
+
 /// Worst joint speed, acceleration and jerk over their limits in a verifier's report.
 fn worst_ratios(report: &tezgah_motion::verify::Report) -> [f64; 3] {
     let mut w = [0.0f64; 3];

@@ -449,6 +449,20 @@ pub fn segment_limits(
     options: &PlanOptions,
     reserve: bool,
 ) -> Result<SegmentLimits, PlanError> {
+    segment_limits_at_feed(seg, geom, machine, options, reserve, 1.0)
+}
+
+/// [`segment_limits`] with the programmed feed scaled by `feed_scale` (a feed override above
+/// 100 %): the V, A and J returned hold for every speed up to that V, so a re-timing that runs
+/// the planned profile faster stays within every joint's limits under them.
+pub fn segment_limits_at_feed(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+    feed_scale: f64,
+) -> Result<SegmentLimits, PlanError> {
     let n = machine.joint_count().min(MAX_JOINTS);
     let budget = if reserve {
         1.0 - options.junction_reserve
@@ -495,12 +509,13 @@ pub fn segment_limits(
             }
         }
     }
-    let feed = match seg.feed {
-        SegmentFeed::Rapid => f64::INFINITY,
-        SegmentFeed::Feed(f) => f,
-        SegmentFeed::InverseTime(t) if t > 0.0 => geom.length / t,
-        SegmentFeed::InverseTime(_) => f64::INFINITY,
-    };
+    let feed = feed_scale
+        * match seg.feed {
+            SegmentFeed::Rapid => f64::INFINITY,
+            SegmentFeed::Feed(f) => f,
+            SegmentFeed::InverseTime(t) if t > 0.0 => geom.length / t,
+            SegmentFeed::InverseTime(_) => f64::INFINITY,
+        };
     if feed < v {
         v = feed;
         by = LimitedBy::Feed;
