@@ -224,6 +224,10 @@ impl<'a> Reader<'a> {
     pub fn number(&mut self) -> ReadResult<f64> {
         let start = self.pos;
         let t = self.text;
+        if let Some(quick) = quick_number(t, start) {
+            self.pos = quick.end;
+            return Ok(quick.value);
+        }
         let mut i = start;
         while i < t.len() && matches!(t[i], b'+' | b'-') {
             i += 1;
@@ -457,26 +461,74 @@ const POW10: [f64; 23] = [
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 
+/// A number read by [`quick_number`]: its value and the index just past it.
+struct QuickNumber {
+    value: f64,
+    end: usize,
+}
+
+/// The common number, `[sign]digits[.digits]` with at most 19 digits whose integer is at most
+/// 2⁵³ and at most 22 decimals, read in one tight pass; `None` for anything else (more signs or
+/// dots, no digit, too many digits), which [`Reader::number`] then reads the general way. The
+/// value is the same correctly rounded one (see [`Digits::exact_value`]); 19 digits always
+/// fit a `u64`, so the wrapping arithmetic never wraps on a number this path accepts.
+#[inline]
+fn quick_number(t: &[u8], start: usize) -> Option<QuickNumber> {
+    let sign = t.get(start).filter(|&&b| matches!(b, b'+' | b'-'));
+    let negative = sign == Some(&b'-');
+    let mut i = start + usize::from(sign.is_some());
+    let digit = |i: usize| t.get(i).map(|b| b.wrapping_sub(b'0')).filter(|&d| d <= 9);
+    let mut mantissa: u64 = 0;
+    let int_start = i;
+    while let Some(d) = digit(i) {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    let mut count = i - int_start;
+    let mut decimals = 0;
+    if t.get(i) == Some(&b'.') {
+        i += 1;
+        let frac_start = i;
+        while let Some(d) = digit(i) {
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        decimals = i - frac_start;
+        count += decimals;
+    }
+    if count == 0 || count > 19 || mantissa > EXACT_MANTISSA {
+        return None;
+    }
+    if matches!(t.get(i), Some(b'.' | b'+' | b'-')) {
+        return None;
+    }
+    let magnitude = mantissa as f64 / *POW10.get(decimals)?;
+    Some(QuickNumber {
+        value: if negative { -magnitude } else { magnitude },
+        end: i,
+    })
+}
+
 /// The digits of a decimal number read so far, as one integer while it fits.
 #[derive(Default)]
 struct Digits {
     count: usize,
-    /// All digits as an integer, `None` once it overflowed.
-    mantissa: Option<u64>,
+    /// All digits as an integer while it is at most 2⁵³; once above, it stops growing and so
+    /// stays above (nothing larger is exact, and 2⁵³·10 + 9 cannot overflow a `u64`).
+    mantissa: u64,
     /// Digits after the decimal point.
     decimals: usize,
 }
 
+/// Largest integer of digits the quick path takes (every integer up to it is an exact `f64`).
+const EXACT_MANTISSA: u64 = 1 << 53;
+
 impl Digits {
+    #[inline]
     fn push(&mut self, digit: u8, after_point: bool) {
-        let m = if self.count == 0 {
-            Some(0)
-        } else {
-            self.mantissa
-        };
-        self.mantissa = m
-            .and_then(|m| m.checked_mul(10))
-            .and_then(|m| m.checked_add(u64::from(digit)));
+        if self.mantissa <= EXACT_MANTISSA {
+            self.mantissa = self.mantissa * 10 + u64::from(digit);
+        }
         self.count += 1;
         self.decimals += usize::from(after_point);
     }
@@ -487,8 +539,10 @@ impl Digits {
     /// value (Clinger, "How to read floating point numbers accurately", 1990). `None` sends the
     /// number to the general parser.
     fn exact_value(&self) -> Option<f64> {
-        let m = self.mantissa.filter(|&m| m <= 1 << 53)?;
-        Some(m as f64 / *POW10.get(self.decimals)?)
+        if self.mantissa > EXACT_MANTISSA {
+            return None;
+        }
+        Some(self.mantissa as f64 / *POW10.get(self.decimals)?)
     }
 }
 
