@@ -220,7 +220,7 @@ impl Block {
     /// `/` and holds nothing to execute. On error, the index into `line.text` is returned.
     pub fn read(&mut self, line: &NormLine, params: &Params) -> ReadResult<bool> {
         self.clear();
-        let text = &line.text[..];
+        let text = line.text();
         let mut r = Reader::new(text, 0, params);
         if text.first() == Some(&b'/') {
             return Ok(false);
@@ -234,7 +234,7 @@ impl Block {
             self.n = Some(v.trunc() as i64);
         }
         if text.get(r.pos) == Some(&b'o') {
-            let at = line.at[r.pos];
+            let at = line.at()[r.pos];
             self.o = Some(read_o_word(&mut r, at, true)?);
             // Only comments may follow (they are not executed on control lines).
             if let Some(i) = text[r.pos..].iter().position(|&c| c != COMMENT_MARK) {
@@ -245,7 +245,7 @@ impl Block {
         let mut comment_index = 0;
         while r.pos < text.len() {
             let c = text[r.pos];
-            let at = line.at[r.pos];
+            let at = line.at()[r.pos];
             match c {
                 COMMENT_MARK => {
                     self.comment = Some(comment_index);

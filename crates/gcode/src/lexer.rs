@@ -33,10 +33,14 @@ pub struct Comment {
 /// in the steady state.
 #[derive(Debug, Default, Clone)]
 pub struct NormLine {
-    /// Lower-cased text without blanks; each comment replaced by [`COMMENT_MARK`].
-    pub text: Vec<u8>,
-    /// For each byte of `text`, its byte offset in the source line.
-    pub at: Vec<u32>,
+    /// Buffer of the lower-cased text without blanks (each comment replaced by
+    /// [`COMMENT_MARK`]) in its first `len` bytes; see [`NormLine::text`].
+    text: Vec<u8>,
+    /// Buffer of the source offsets in its first `len` entries; see [`NormLine::at`].
+    at: Vec<u32>,
+    /// Length of the normalised line. The buffers keep the longest line's length so that
+    /// lexing neither fills nor cuts them per line.
+    len: usize,
     /// The comments, in order; the i-th [`COMMENT_MARK`] stands for the i-th comment.
     pub comments: Vec<Comment>,
     /// Byte offset in the source line of a `%` that no comment precedes. Lexing stops there:
@@ -55,24 +59,33 @@ impl NormLine {
         self.percent = None;
         let bytes = raw.as_bytes();
         self.mentions_parameters = memchr::memchr(b'#', bytes).is_some();
-        // The normalised line is never longer than the source line: size both buffers to it
-        // and write by index with a local length (a `push` per byte stores the length and
-        // checks the capacity every time, and was most of the lexer's cost), then cut them
-        // to the length written, also on error.
-        self.text.clear();
-        self.text.resize(bytes.len(), 0);
-        self.at.clear();
-        self.at.resize(bytes.len(), 0);
+        // The normalised line is never longer than the source line: with buffers at least
+        // that long, write by index with a local length (a `push` per byte stores the length
+        // and checks the capacity every time, and was most of the lexer's cost).
+        if self.text.len() < bytes.len() {
+            self.text.resize(bytes.len(), 0);
+            self.at.resize(bytes.len(), 0);
+        }
         let mut out = Out {
             text: &mut self.text,
             at: &mut self.at,
             len: 0,
         };
         let result = lex_into(raw, &mut out, &mut self.comments, &mut self.percent);
-        let len = out.len;
-        self.text.truncate(len);
-        self.at.truncate(len);
+        self.len = out.len;
         result
+    }
+
+    /// Lower-cased text without blanks; each comment replaced by [`COMMENT_MARK`].
+    #[inline]
+    pub fn text(&self) -> &[u8] {
+        &self.text[..self.len]
+    }
+
+    /// For each byte of [`NormLine::text`], its byte offset in the source line.
+    #[inline]
+    pub fn at(&self) -> &[u32] {
+        &self.at[..self.len]
     }
 }
 
@@ -171,14 +184,14 @@ mod tests {
     #[test]
     fn blanks_removed_and_case_folded() {
         let l = lex("G 0 1 X 1 . 5\tY-2");
-        assert_eq!(l.text, b"g01x1.5y-2");
-        assert_eq!(l.at[3], 6); // the 'x'
+        assert_eq!(l.text(), b"g01x1.5y-2");
+        assert_eq!(l.at()[3], 6); // the 'x'
     }
 
     #[test]
     fn comments_keep_case_and_leave_a_mark() {
         let l = lex("g0 x1 (  Hello World) y2 ; rest");
-        assert_eq!(l.text, b"g0x1\x01y2");
+        assert_eq!(l.text(), b"g0x1\x01y2");
         assert_eq!(l.comments[0].text, "Hello World");
         assert_eq!(l.comments[0].at, 6);
     }

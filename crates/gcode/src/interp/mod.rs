@@ -424,7 +424,7 @@ impl Interpreter {
         }
         let Self { norm, params, .. } = self;
         let to_span = |norm: &NormLine, idx: usize| {
-            let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
+            let byte = norm.at().get(idx).map_or(line.text.len(), |&b| b as usize);
             line.span(byte)
         };
         let live = block
