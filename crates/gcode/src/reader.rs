@@ -213,6 +213,20 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// [`Reader::real_value`], with the plain number (most words of most programs) read
+    /// inline first: [`quick_number`] accepts only text that `real_value` would hand to
+    /// [`Reader::number`], which reads it the same way, so the value is the same.
+    #[inline]
+    pub fn word_value(&mut self) -> ReadResult<f64> {
+        match quick_number(self.text, self.pos) {
+            Some(quick) => {
+                self.pos = quick.end;
+                Ok(quick.value)
+            }
+            None => self.real_value(),
+        }
+    }
+
     /// A value that must be an integer (within 1e-4), rounded to it.
     pub fn integer_value(&mut self) -> ReadResult<i64> {
         let start = self.pos;
