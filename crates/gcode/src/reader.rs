@@ -587,6 +587,60 @@ mod tests {
         );
     }
 
+    /// The quick path's edges: where it hands over to the general reader (20 digits, an integer
+    /// of digits above 2⁵³, 23 decimals, a second sign or dot) the value and the end are still
+    /// the general reader's, and `word_value` agrees with `real_value` everywhere.
+    #[test]
+    fn quick_path_edges_read_as_the_general_reader() {
+        let cases = [
+            "9007199254740992",     // 2⁵³: quick
+            "9007199254740993",     // 2⁵³ + 1: general (rounds to even)
+            "9007199254740992.5",   // integer of digits above 2⁵³
+            "1234567890123456789",  // 19 digits
+            "12345678901234567890", // 20 digits
+            "00000000000000000000001.5",
+            "0.0000000000000000000001",  // 22 decimals
+            "0.00000000000000000000001", // 23 decimals
+            "-0",
+            "+.5",
+            "5.",
+            "-7.25",
+            "18446744073709551616", // 2⁶⁴: would wrap a u64
+            "99999999999999999999999.9",
+        ];
+        for text in cases {
+            let general: f64 = text.parse().unwrap();
+            assert_eq!(
+                eval(text).map(f64::to_bits),
+                Ok(general.to_bits()),
+                "{text}"
+            );
+            let p = Params::default();
+            let mut quick = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(
+                quick.word_value().map(f64::to_bits),
+                Ok(general.to_bits()),
+                "{text}"
+            );
+            assert_eq!(quick.pos, text.len(), "{text}");
+        }
+        // What follows a number is left for the block: a sign, a letter, a second number.
+        for (text, value, end) in [("1.5-2", 1.5, 3), ("12x", 12.0, 2), ("-3+", -3.0, 2)] {
+            let p = Params::default();
+            let mut r = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(r.word_value(), Ok(value), "{text}");
+            assert_eq!(r.pos, end, "{text}");
+        }
+        // Not numbers for the quick path; the general reader's verdicts stand.
+        for text in ["1.2.3", "--1", "-.", ".", "+-1", "-[1]", "#1", "sin[0]"] {
+            let p = Params::default();
+            let mut quick = Reader::new(text.as_bytes(), 0, &p);
+            let mut general = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(quick.word_value(), general.real_value(), "{text}");
+            assert_eq!(quick.pos, general.pos, "{text}");
+        }
+    }
+
     /// Numbers read bit for bit as the general (correctly rounded) parser reads them, on the
     /// quick path and off it.
     #[test]
