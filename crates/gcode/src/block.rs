@@ -13,7 +13,7 @@ use crate::params::Params;
 use crate::reader::{integer_of, ParamRef, ReadResult, Reader};
 
 /// A word's value and where its letter stands in the source line (byte offset).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Word {
     pub value: f64,
     pub at: u32,
@@ -116,7 +116,11 @@ pub struct OWord {
 pub struct Block {
     /// The N word's number (its integer part), if any.
     pub n: Option<i64>,
-    pub words: [Option<Word>; 26],
+    /// The words of the letters other than G, M, N and O by position in the alphabet; only
+    /// those whose bit is set in `present` are in the block (a bit mask to clear per line
+    /// instead of 26 options: clearing the block was a tenth of reading it).
+    words: [Word; 26],
+    present: u32,
     pub g: [Option<Code>; ggroup::COUNT],
     pub m: [Option<Code>; mgroup::COUNT],
     pub m_count: usize,
@@ -159,7 +163,14 @@ impl Block {
     /// The word of letter `c` (lower case), if the block has one.
     #[inline]
     pub fn word(&self, c: u8) -> Option<Word> {
-        self.words[(c - b'a') as usize]
+        let slot = (c - b'a') as usize;
+        (self.present >> slot & 1 == 1).then(|| self.words[slot])
+    }
+
+    /// Whether the block holds no word of a letter other than G, M, N and O.
+    #[inline]
+    pub fn has_no_letter_words(&self) -> bool {
+        self.present == 0
     }
 
     /// The value of letter `c`, if present.
@@ -207,7 +218,7 @@ impl Block {
 
     fn clear(&mut self) {
         self.n = None;
-        self.words = [None; 26];
+        self.present = 0;
         self.g = [None; ggroup::COUNT];
         self.m = [None; mgroup::COUNT];
         self.m_count = 0;
@@ -220,7 +231,7 @@ impl Block {
     /// `/` and holds nothing to execute. On error, the index into `line.text` is returned.
     pub fn read(&mut self, line: &NormLine, params: &Params) -> ReadResult<bool> {
         self.clear();
-        let text = &line.text[..];
+        let text = line.text();
         let mut r = Reader::new(text, 0, params);
         if text.first() == Some(&b'/') {
             return Ok(false);
@@ -234,7 +245,7 @@ impl Block {
             self.n = Some(v.trunc() as i64);
         }
         if text.get(r.pos) == Some(&b'o') {
-            let at = line.at[r.pos];
+            let at = line.at()[r.pos];
             self.o = Some(read_o_word(&mut r, at, true)?);
             // Only comments may follow (they are not executed on control lines).
             if let Some(i) = text[r.pos..].iter().position(|&c| c != COMMENT_MARK) {
@@ -245,7 +256,7 @@ impl Block {
         let mut comment_index = 0;
         while r.pos < text.len() {
             let c = text[r.pos];
-            let at = line.at[r.pos];
+            let at = line.at()[r.pos];
             match c {
                 COMMENT_MARK => {
                     self.comment = Some(comment_index);
@@ -276,7 +287,7 @@ impl Block {
     fn read_g(&mut self, r: &mut Reader, at: u32) -> ReadResult<()> {
         let start = r.pos;
         r.pos += 1;
-        let value = r.real_value()?;
+        let value = r.word_value()?;
         // LinuxCNC keeps G codes as ten times their number and allows 0.001 of slack.
         let tenfold = 10.0 * value;
         let mut code = tenfold.floor();
@@ -325,14 +336,14 @@ impl Block {
     fn read_letter(&mut self, r: &mut Reader, c: u8, at: u32) -> ReadResult<()> {
         let start = r.pos;
         let slot = (c - b'a') as usize;
-        if self.words[slot].is_some() {
+        if self.present >> slot & 1 == 1 {
             return Err((ErrorKind::MultipleWords(c as char), start));
         }
         r.pos += 1;
         let value = match c {
             // Words whose value must be an integer.
             b'h' | b'l' | b't' => r.integer_value()? as f64,
-            _ => r.real_value()?,
+            _ => r.word_value()?,
         };
         let negative = value < 0.0;
         let kind = match c {
@@ -345,7 +356,8 @@ impl Block {
         if let Some(kind) = kind {
             return Err((kind, start));
         }
-        self.words[slot] = Some(Word { value, at });
+        self.words[slot] = Word { value, at };
+        self.present |= 1 << slot;
         Ok(())
     }
 }

@@ -213,6 +213,20 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// [`Reader::real_value`], with the plain number (most words of most programs) read
+    /// inline first: [`quick_number`] accepts only text that `real_value` would hand to
+    /// [`Reader::number`], which reads it the same way, so the value is the same.
+    #[inline]
+    pub fn word_value(&mut self) -> ReadResult<f64> {
+        match quick_number(self.text, self.pos) {
+            Some(quick) => {
+                self.pos = quick.end;
+                Ok(quick.value)
+            }
+            None => self.real_value(),
+        }
+    }
+
     /// A value that must be an integer (within 1e-4), rounded to it.
     pub fn integer_value(&mut self) -> ReadResult<i64> {
         let start = self.pos;
@@ -224,6 +238,10 @@ impl<'a> Reader<'a> {
     pub fn number(&mut self) -> ReadResult<f64> {
         let start = self.pos;
         let t = self.text;
+        if let Some(quick) = quick_number(t, start) {
+            self.pos = quick.end;
+            return Ok(quick.value);
+        }
         let mut i = start;
         while i < t.len() && matches!(t[i], b'+' | b'-') {
             i += 1;
@@ -457,26 +475,74 @@ const POW10: [f64; 23] = [
     1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
 ];
 
+/// A number read by [`quick_number`]: its value and the index just past it.
+struct QuickNumber {
+    value: f64,
+    end: usize,
+}
+
+/// The common number, `[sign]digits[.digits]` with at most 19 digits whose integer is at most
+/// 2⁵³ and at most 22 decimals, read in one tight pass; `None` for anything else (more signs or
+/// dots, no digit, too many digits), which [`Reader::number`] then reads the general way. The
+/// value is the same correctly rounded one (see [`Digits::exact_value`]); 19 digits always
+/// fit a `u64`, so the wrapping arithmetic never wraps on a number this path accepts.
+#[inline]
+fn quick_number(t: &[u8], start: usize) -> Option<QuickNumber> {
+    let sign = t.get(start).filter(|&&b| matches!(b, b'+' | b'-'));
+    let negative = sign == Some(&b'-');
+    let mut i = start + usize::from(sign.is_some());
+    let digit = |i: usize| t.get(i).map(|b| b.wrapping_sub(b'0')).filter(|&d| d <= 9);
+    let mut mantissa: u64 = 0;
+    let int_start = i;
+    while let Some(d) = digit(i) {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        i += 1;
+    }
+    let mut count = i - int_start;
+    let mut decimals = 0;
+    if t.get(i) == Some(&b'.') {
+        i += 1;
+        let frac_start = i;
+        while let Some(d) = digit(i) {
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+            i += 1;
+        }
+        decimals = i - frac_start;
+        count += decimals;
+    }
+    if count == 0 || count > 19 || mantissa > EXACT_MANTISSA {
+        return None;
+    }
+    if matches!(t.get(i), Some(b'.' | b'+' | b'-')) {
+        return None;
+    }
+    let magnitude = mantissa as f64 / *POW10.get(decimals)?;
+    Some(QuickNumber {
+        value: if negative { -magnitude } else { magnitude },
+        end: i,
+    })
+}
+
 /// The digits of a decimal number read so far, as one integer while it fits.
 #[derive(Default)]
 struct Digits {
     count: usize,
-    /// All digits as an integer, `None` once it overflowed.
-    mantissa: Option<u64>,
+    /// All digits as an integer while it is at most 2⁵³; once above, it stops growing and so
+    /// stays above (nothing larger is exact, and 2⁵³·10 + 9 cannot overflow a `u64`).
+    mantissa: u64,
     /// Digits after the decimal point.
     decimals: usize,
 }
 
+/// Largest integer of digits the quick path takes (every integer up to it is an exact `f64`).
+const EXACT_MANTISSA: u64 = 1 << 53;
+
 impl Digits {
+    #[inline]
     fn push(&mut self, digit: u8, after_point: bool) {
-        let m = if self.count == 0 {
-            Some(0)
-        } else {
-            self.mantissa
-        };
-        self.mantissa = m
-            .and_then(|m| m.checked_mul(10))
-            .and_then(|m| m.checked_add(u64::from(digit)));
+        if self.mantissa <= EXACT_MANTISSA {
+            self.mantissa = self.mantissa * 10 + u64::from(digit);
+        }
         self.count += 1;
         self.decimals += usize::from(after_point);
     }
@@ -487,8 +553,10 @@ impl Digits {
     /// value (Clinger, "How to read floating point numbers accurately", 1990). `None` sends the
     /// number to the general parser.
     fn exact_value(&self) -> Option<f64> {
-        let m = self.mantissa.filter(|&m| m <= 1 << 53)?;
-        Some(m as f64 / *POW10.get(self.decimals)?)
+        if self.mantissa > EXACT_MANTISSA {
+            return None;
+        }
+        Some(self.mantissa as f64 / *POW10.get(self.decimals)?)
     }
 }
 
@@ -517,6 +585,60 @@ mod tests {
             eval("-."),
             Err((ErrorKind::BadNumberFormat("-.".into()), 0))
         );
+    }
+
+    /// The quick path's edges: where it hands over to the general reader (20 digits, an integer
+    /// of digits above 2⁵³, 23 decimals, a second sign or dot) the value and the end are still
+    /// the general reader's, and `word_value` agrees with `real_value` everywhere.
+    #[test]
+    fn quick_path_edges_read_as_the_general_reader() {
+        let cases = [
+            "9007199254740992",     // 2⁵³: quick
+            "9007199254740993",     // 2⁵³ + 1: general (rounds to even)
+            "9007199254740992.5",   // integer of digits above 2⁵³
+            "1234567890123456789",  // 19 digits
+            "12345678901234567890", // 20 digits
+            "00000000000000000000001.5",
+            "0.0000000000000000000001",  // 22 decimals
+            "0.00000000000000000000001", // 23 decimals
+            "-0",
+            "+.5",
+            "5.",
+            "-7.25",
+            "18446744073709551616", // 2⁶⁴: would wrap a u64
+            "99999999999999999999999.9",
+        ];
+        for text in cases {
+            let general: f64 = text.parse().unwrap();
+            assert_eq!(
+                eval(text).map(f64::to_bits),
+                Ok(general.to_bits()),
+                "{text}"
+            );
+            let p = Params::default();
+            let mut quick = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(
+                quick.word_value().map(f64::to_bits),
+                Ok(general.to_bits()),
+                "{text}"
+            );
+            assert_eq!(quick.pos, text.len(), "{text}");
+        }
+        // What follows a number is left for the block: a sign, a letter, a second number.
+        for (text, value, end) in [("1.5-2", 1.5, 3), ("12x", 12.0, 2), ("-3+", -3.0, 2)] {
+            let p = Params::default();
+            let mut r = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(r.word_value(), Ok(value), "{text}");
+            assert_eq!(r.pos, end, "{text}");
+        }
+        // Not numbers for the quick path; the general reader's verdicts stand.
+        for text in ["1.2.3", "--1", "-.", ".", "+-1", "-[1]", "#1", "sin[0]"] {
+            let p = Params::default();
+            let mut quick = Reader::new(text.as_bytes(), 0, &p);
+            let mut general = Reader::new(text.as_bytes(), 0, &p);
+            assert_eq!(quick.word_value(), general.real_value(), "{text}");
+            assert_eq!(quick.pos, general.pos, "{text}");
+        }
     }
 
     /// Numbers read bit for bit as the general (correctly rounded) parser reads them, on the

@@ -182,7 +182,7 @@ impl Interpreter {
         line: LineRef,
         sink: &mut impl CanonSink,
     ) -> Result<Flow, GcodeError> {
-        let text = &self.norm.text;
+        let text = self.norm.text();
         // An N word may stand before the O-word.
         let mut i = 0;
         if text.first() == Some(&b'n') {
@@ -194,7 +194,7 @@ impl Interpreter {
         if text.get(i) != Some(&b'o') {
             return Ok(Flow::Continue);
         }
-        let at = self.norm.at.get(i).copied().unwrap_or(0);
+        let at = self.norm.at().get(i).copied().unwrap_or(0);
         let mut r = Reader::new(text, i, &self.params);
         let Ok(o) = read_o_word(&mut r, at, false) else {
             // Malformed control lines are reported when they execute, not when skipped.
@@ -286,7 +286,7 @@ impl Interpreter {
         let at = |idx: usize| {
             let byte = self
                 .norm
-                .at
+                .at()
                 .get(idx)
                 .map_or(line.text.len(), |&b| b as usize);
             line.span(byte)

@@ -424,7 +424,7 @@ impl Interpreter {
         }
         let Self { norm, params, .. } = self;
         let to_span = |norm: &NormLine, idx: usize| {
-            let byte = norm.at.get(idx).map_or(line.text.len(), |&b| b as usize);
+            let byte = norm.at().get(idx).map_or(line.text.len(), |&b| b as usize);
             line.span(byte)
         };
         let live = block
@@ -451,7 +451,17 @@ impl Interpreter {
 
     /// Handle `%` lines (after lexing, which finds the `%`). `Some(flow)` when the line was
     /// a percent line.
+    #[inline]
     fn percent_line(&mut self, line: LineRef) -> Result<Option<Flow>, GcodeError> {
+        // Almost every line: no `%` in it, and the program's first line already seen.
+        if self.norm.percent.is_none() && self.percent != Percent::Unknown {
+            return Ok(None);
+        }
+        self.percent_line_slow(line)
+    }
+
+    /// [`Interpreter::percent_line`] for a line with a `%` or the program's first line.
+    fn percent_line_slow(&mut self, line: LineRef) -> Result<Option<Flow>, GcodeError> {
         let percent_at = self.norm.percent;
         let is_percent = percent_at.is_some() && line.text.trim() == "%";
         if self.percent == Percent::Unknown {
@@ -475,7 +485,16 @@ impl Interpreter {
     }
 
     /// Apply a block's parameter assignments (after the whole line was read, as LinuxCNC).
+    #[inline]
     fn assign_parameters(&mut self, block: &Block) -> Result<(), (ErrorKind, u32)> {
+        if block.assignments.is_empty() {
+            return Ok(());
+        }
+        self.assign_parameters_slow(block)
+    }
+
+    /// [`Interpreter::assign_parameters`] for a block that has assignments.
+    fn assign_parameters_slow(&mut self, block: &Block) -> Result<(), (ErrorKind, u32)> {
         for a in &block.assignments {
             match &a.target {
                 crate::reader::ParamRef::Numbered(n) => self.params.set(*n, a.value),

@@ -259,7 +259,7 @@ impl Interpreter {
             return Ok(());
         };
         let continues = motion == Some(G6_2) && block.g(ggroup::MOTION).is_none();
-        let wordless = block.words.iter().all(Option::is_none)
+        let wordless = block.has_no_letter_words()
             && block.g.iter().all(Option::is_none)
             && block.m_count == 0;
         if continues || wordless {
