@@ -62,9 +62,32 @@ pub fn rise(shape: &CutterShape, flute_length: f64, a: &Vec3, n: &Vec3, t: &Vec3
     lowest(shape, flute_length, a, n, t, y) - bottom
 }
 
+/// Where the contact (the cutter's lowest point along `n`) lies across the feed, `P·t`: the
+/// support point of the body in direction `−n` — on the core, the corner circle's point
+/// farthest along `−n`'s part across the axis, at height `r`; plus `r` along `−n`. A cutter
+/// leaned across the feed touches off its axis (a flat end at its rim, `R·cos λ` aside).
+fn contact_across(shape: &CutterShape, a: &Vec3, n: &Vec3, t: &Vec3) -> f64 {
+    let (big_r, r) = (shape.radius(), shape.corner_radius());
+    let d = -n;
+    let across = d - a * d.dot(a);
+    let len = across.norm();
+    if len < 1e-12 {
+        return 0.0;
+    }
+    (a * r + across * ((big_r - r) / len) + d * r).dot(t)
+}
+
+/// Bisections for where two neighbouring silhouettes cross (the bracket shrinks by 2⁻⁴⁰).
+const CROSSING_BISECTIONS: usize = 40;
+
 /// The cusp between two passes `w` apart on a cross-feed section of normal curvature `kappa`
-/// (positive concave, as `scallop`): the silhouettes meet `w/2` beside each contact, where the
-/// surface has risen `ρ − √(ρ² − (w/2)²)` toward the tool (concave) or fallen as much (convex).
+/// (positive concave, as `scallop`). What the two passes leave at `x` from the first contact is
+/// the lower of their silhouettes there, `min(rise(x), rise(x − w))`; its highest point is where
+/// they cross (`rise` grows away from the contact on either side). A silhouette symmetric about
+/// its contact crosses at `w/2`; a leaned flat end's is not (its rim is a corner, the wall
+/// beyond it vertical), so the crossing is found by bisection. There the surface has risen
+/// `ρ − √(ρ² − (w/2)²)` toward the tool (concave) or fallen as much (convex), taken at the
+/// midpoint of the two contacts.
 pub fn cusp(
     shape: &CutterShape,
     flute_length: f64,
@@ -74,8 +97,20 @@ pub fn cusp(
     kappa: f64,
     w: f64,
 ) -> f64 {
+    let y0 = contact_across(shape, a, n, t);
+    let rise_at = |x: f64| rise(shape, flute_length, a, n, t, y0 + x);
+    let (mut lo, mut hi) = (0.0, w);
+    for _ in 0..CROSSING_BISECTIONS {
+        let x = 0.5 * (lo + hi);
+        if rise_at(x) < rise_at(x - w) {
+            lo = x;
+        } else {
+            hi = x;
+        }
+    }
+    let x = 0.5 * (lo + hi);
+    let tool = rise_at(x).max(rise_at(x - w));
     let y = 0.5 * w;
-    let tool = rise(shape, flute_length, a, n, t, y).max(rise(shape, flute_length, a, n, t, -y));
     let surface = if kappa.abs() < 1e-12 {
         0.0
     } else {
@@ -108,6 +143,25 @@ mod tests {
             let want = (4.0 - (16.0 - y * y).sqrt()) * lam.sin();
             let got = rise(&flat, 24.0, &a, &n, &t, y);
             assert!((got - want).abs() < 1e-9, "{y}: {got} {want}");
+        }
+    }
+
+    #[test]
+    fn a_flat_leaned_across_the_feed_leaves_the_cusp_of_its_face_and_wall() {
+        // Axis leaned λ toward the cross-feed t: the contact is the rim; toward the disk the
+        // face rises as d·tan λ, beyond the rim the wall as d·cot λ. Passes w apart cross at
+        // x = w·sin²λ, so the cusp is w·sin λ·cos λ on a plane (the midpoint rule said
+        // (w/2)·cot λ, five times more at 11°, which shrank such steps to nothing).
+        let (n, t) = (Vec3::z(), Vec3::y());
+        let flat = CutterShape::Flat { radius: 3.0 };
+        for deg in [5.0_f64, 11.0, 30.0] {
+            let lam = deg.to_radians();
+            let a = (n * lam.cos() + t * lam.sin()).normalize();
+            for w in [0.2_f64, 1.0, 2.0] {
+                let want = w * lam.sin() * lam.cos();
+                let got = cusp(&flat, 20.0, &a, &n, &t, 0.0, w);
+                assert!((got - want).abs() < 1e-9, "{deg}° w {w}: {got} {want}");
+            }
         }
     }
 
