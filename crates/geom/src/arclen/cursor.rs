@@ -134,6 +134,18 @@ impl ArcLengthMap {
         self.anchor(0)
     }
 
+    /// A cursor at the start of the panel holding arc length `s` (clamped): for a caller that
+    /// starts part-way along the curve (a trimmed piece of it), found by bisection of the
+    /// table, where [`Self::advance`] from [`Self::cursor`] would walk every panel before it.
+    pub fn cursor_at(&self, s: f64) -> ArcLengthCursor {
+        let n = self.panels();
+        if n == 0 {
+            return self.anchor(0);
+        }
+        let k = self.s.partition_point(|&x| x <= s).clamp(1, n) - 1;
+        self.anchor(k)
+    }
+
     fn anchor(&self, k: usize) -> ArcLengthCursor {
         ArcLengthCursor {
             panel: k,

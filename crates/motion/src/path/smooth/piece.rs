@@ -4,7 +4,7 @@
 
 use std::sync::Arc as Shared;
 
-use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, Trimmed, Vec3};
+use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, PrebuiltArcLength, Trimmed, Vec3};
 
 use crate::path::orient::{AxisPath, GreatCircle};
 use crate::path::{Junction, Segment, SegmentFeed};
@@ -337,13 +337,19 @@ impl Piece {
             }
             f => f,
         };
+        // The piece's arc-length map travels with the curve: the interpolator reuses it
+        // instead of building one per segment (`Curve::prebuilt_arc_length`).
+        let map = self.map.map(|m| {
+            let start = m.s_at(&self.geo, self.u0);
+            (m, start)
+        });
         let curve: Box<dyn Curve + Send + Sync> = if whole {
-            Box::new(self.geo)
+            Mapped::boxed(self.geo, map)
         } else {
             match Trimmed::new(self.geo.clone(), self.u0, self.u1) {
-                Ok(t) => Box::new(t),
+                Ok(t) => Mapped::boxed(t, map),
                 // u0 <= u1 always holds (blends never overlap); keep the curve if not.
-                Err(_) => Box::new(self.geo),
+                Err(_) => Mapped::boxed(self.geo, map),
             }
         };
         Segment {
@@ -359,6 +365,85 @@ impl Piece {
             tool_axis_travel: None,
             axis,
         }
+    }
+}
+
+/// The whole curve a segment's curve is (a part of): where the piece's map is built.
+trait Whole: Curve + Send + Sync + 'static {
+    fn whole(&self) -> &Geo;
+}
+
+impl Whole for Geo {
+    fn whole(&self) -> &Geo {
+        self
+    }
+}
+
+impl Whole for Trimmed<Geo> {
+    fn whole(&self) -> &Geo {
+        self.inner()
+    }
+}
+
+/// A segment's curve with the piece's arc-length map (over the whole curve) and the arc
+/// length at the segment's start: every `Curve` method is the curve's own, bit for bit, and
+/// `prebuilt_arc_length` hands the map on.
+struct Mapped<C> {
+    curve: C,
+    map: Shared<ArcLengthMap>,
+    start: f64,
+}
+
+impl<C: Whole> Mapped<C> {
+    /// The curve boxed, with the map where the piece has one.
+    fn boxed(curve: C, map: Option<(Shared<ArcLengthMap>, f64)>) -> Box<dyn Curve + Send + Sync> {
+        match map {
+            Some((map, start)) => Box::new(Mapped { curve, map, start }),
+            None => Box::new(curve),
+        }
+    }
+}
+
+impl<C: Whole> Curve for Mapped<C> {
+    fn domain(&self) -> (f64, f64) {
+        self.curve.domain()
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        self.curve.derivs(u)
+    }
+    fn point(&self, u: f64) -> Vec3 {
+        self.curve.point(u)
+    }
+    fn d1(&self, u: f64) -> Vec3 {
+        self.curve.d1(u)
+    }
+    fn speed(&self, u: f64) -> f64 {
+        self.curve.speed(u)
+    }
+    fn speed_integral(&self, a: f64, b: f64) -> f64 {
+        self.curve.speed_integral(a, b)
+    }
+    fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+        self.curve.gauss_speeds(a, b)
+    }
+    fn curvature(&self, u: f64) -> f64 {
+        self.curve.curvature(u)
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.curve.breakpoints()
+    }
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        self.curve.speed_ratio(a, b)
+    }
+    fn length(&self) -> f64 {
+        self.curve.length()
+    }
+    fn prebuilt_arc_length(&self) -> Option<PrebuiltArcLength<'_>> {
+        Some(PrebuiltArcLength {
+            map: &self.map,
+            curve: self.curve.whole(),
+            start: self.start,
+        })
     }
 }
 
