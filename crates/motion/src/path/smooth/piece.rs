@@ -458,3 +458,65 @@ pub(crate) fn frame<C: Curve + ?Sized>(c: &C, u: f64) -> Option<(Vec3, Vec3)> {
     let k = (d2 - t * d2.dot(&t)) / (speed * speed);
     Some((t, k))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interpolate::Param;
+
+    /// A cubic spline piece of uneven parametric speed, trimmed at both ends as blends leave
+    /// it: its segment hands on the piece's map (start = arc length at the trim), the curve
+    /// is unchanged, and the interpolator's `s → point` on it is the segment's own arc length
+    /// to within the map tolerance (checked against a map built on the segment at 1e-12).
+    #[test]
+    fn trimmed_spline_segment_carries_the_piece_map() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [3.0, 0.5, 0.1],
+            [5.0, 4.0, 0.0],
+            [12.0, 5.0, -0.2],
+            [13.0, 11.0, 0.0],
+            [20.0, 10.0, 0.3],
+        ]
+        .map(|p| Vec3::new(p[0], p[1], p[2]));
+        let knots = vec![0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 3.0, 3.0, 3.0];
+        let nurbs = Nurbs::new(3, &pts, &[1.0; 6], knots).unwrap();
+        let mut piece = Piece::new(
+            Geo::Spline(Shared::new(nurbs)),
+            [[0.0; 3]; 2],
+            1,
+            SegmentFeed::Feed(600.0),
+            0.01,
+            Mode::Continuous,
+        );
+        let map = piece.map.clone().expect("a spline piece has a map");
+        piece.u0 = 0.2;
+        piece.u1 = 2.7;
+        let start = map.s_at(&piece.geo, 0.2);
+        let seg = piece.clone().into_segment(Junction::Smooth);
+        let pre = seg
+            .curve
+            .prebuilt_arc_length()
+            .expect("the map is handed on");
+        assert!(
+            std::ptr::eq(pre.map, &*map),
+            "the piece's own map, not a copy"
+        );
+        assert_eq!(pre.start, start);
+        assert_eq!(seg.curve.domain(), (0.2, 2.7));
+        for k in 0..=20 {
+            let u = 0.2 + 2.5 * k as f64 / 20.0;
+            assert_eq!(seg.curve.point(u), pre.curve.point(u));
+            assert_eq!(seg.curve.point(u), piece.geo.point(u));
+        }
+        let fine = ArcLengthMap::new(&*seg.curve, 1e-12).unwrap();
+        assert!((fine.length() - seg.length).abs() <= 2e-9);
+        let mut param = Param::new(&seg);
+        for k in 0..400 {
+            let s = seg.length * k as f64 / 400.0;
+            let (u, point) = param.at(&seg, s);
+            assert!((fine.s_at(&*seg.curve, u) - s).abs() <= 2e-9, "s = {s}");
+            assert_eq!(point, piece.geo.point(u));
+        }
+    }
+}
