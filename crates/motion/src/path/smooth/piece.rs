@@ -467,7 +467,8 @@ mod tests {
     /// A cubic spline piece of uneven parametric speed, trimmed at both ends as blends leave
     /// it: its segment hands on the piece's map (start = arc length at the trim), the curve
     /// is unchanged, and the interpolator's `s → point` on it is the segment's own arc length
-    /// to within the map tolerance (checked against a map built on the segment at 1e-12).
+    /// to within the map tolerance (checked against a map built on the segment at 1e-12), with
+    /// the point `C(u)`.
     #[test]
     fn trimmed_spline_segment_carries_the_piece_map() {
         let pts = [
@@ -516,7 +517,8 @@ mod tests {
             let s = seg.length * k as f64 / 400.0;
             let (u, point) = param.at(&seg, s);
             assert!((fine.s_at(&*seg.curve, u) - s).abs() <= 2e-9, "s = {s}");
-            assert_eq!(point, piece.geo.point(u));
+            // The cursor may take C(u) from its Newton step's Taylor series: rounding apart.
+            assert!((point - piece.geo.point(u)).norm() <= 1e-12 * (1.0 + point.norm()));
         }
     }
 }
