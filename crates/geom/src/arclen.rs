@@ -97,6 +97,20 @@ pub fn gauss_nodes_8(f: impl Fn(f64) -> f64, a: f64, b: f64) -> [f64; 8] {
     out
 }
 
+/// A map built once for a whole curve, handed on with a part of that curve (a trimmed piece):
+/// `Curve::prebuilt_arc_length`. The part's parameters are the whole curve's, and its arc
+/// length `s` is `map`'s arc length less `start`.
+#[derive(Clone, Copy)]
+pub struct PrebuiltArcLength<'a> {
+    /// The map, over `curve`.
+    pub map: &'a ArcLengthMap,
+    /// The whole curve the map was built on (evaluate points on it: the same values, with
+    /// fewer layers than through the part).
+    pub curve: &'a dyn Curve,
+    /// Arc length along `curve` at the part's start.
+    pub start: f64,
+}
+
 /// Table of panels `u_k → s_k` with the speed at each boundary.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArcLengthMap {

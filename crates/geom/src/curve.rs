@@ -2,7 +2,7 @@
 //! offers to the planner — parameter domain, point, derivatives up to the third, curvature,
 //! length and arc-length evaluation — so path building and feed planning never match on kinds.
 
-use crate::arclen::{gauss_legendre_8, gauss_nodes_8, ArcLengthMap};
+use crate::arclen::{gauss_legendre_8, gauss_nodes_8, ArcLengthMap, PrebuiltArcLength};
 
 /// A point or vector in the workpiece frame, mm.
 pub type Vec3 = nalgebra::Vector3<f64>;
@@ -78,6 +78,13 @@ pub trait Curve {
             .map(|m| m.length())
             .unwrap_or(f64::NAN)
     }
+
+    /// An arc-length map its producer already built, over the curve this one is a part of:
+    /// a consumer that needs `s → u` (the interpolator) reuses it instead of building its own.
+    /// `None` (the default) when there is none.
+    fn prebuilt_arc_length(&self) -> Option<PrebuiltArcLength<'_>> {
+        None
+    }
 }
 
 /// Curvature from the first two derivatives; a zero first derivative is a cusp (infinite
@@ -142,6 +149,9 @@ macro_rules! forward_curve {
             }
             fn length(&self) -> f64 {
                 (**self).length()
+            }
+            fn prebuilt_arc_length(&self) -> Option<PrebuiltArcLength<'_>> {
+                (**self).prebuilt_arc_length()
             }
         }
     )*};

@@ -26,7 +26,7 @@ pub mod surface;
 pub mod trim;
 
 pub use arc::{Arc, Helix};
-pub use arclen::{ArcLengthCursor, ArcLengthMap, ArcPosition};
+pub use arclen::{ArcLengthCursor, ArcLengthMap, ArcPosition, PrebuiltArcLength};
 pub use bezier::Bezier;
 pub use curve::{Curve, Vec3};
 pub use error::CurveError;

@@ -48,6 +48,7 @@ impl Joints {
     }
 
     /// `n` joints at zero (`n` is clamped to [`MAX_JOINTS`]).
+    #[inline]
     pub fn zeros(n: usize) -> Self {
         Self {
             len: n.min(MAX_JOINTS) as u8,

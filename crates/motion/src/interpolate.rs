@@ -44,10 +44,21 @@ pub struct Sample {
 /// arc-length map built once per segment with a forward cursor on it (samples move forward, so
 /// each one starts from the last: [`ArcLengthMap::advance`]).
 pub(crate) struct Param {
-    map: Option<(ArcLengthMap, ArcLengthCursor)>,
+    map: Option<(Inverse, ArcLengthCursor)>,
     scale: f64,
     /// The curve's domain (a virtual call per sample otherwise).
     domain: (f64, f64),
+}
+
+/// Where a segment's `s → u` map is.
+enum Inverse {
+    /// Built here, over the segment's curve.
+    Own(ArcLengthMap),
+    /// The one the path builder built over the whole curve the segment is a part of
+    /// (`Curve::prebuilt_arc_length`), at this arc length of the segment's start: the
+    /// smoother's map at its tolerance (1e-9 mm, at least as tight as the one built here),
+    /// with points taken on the whole curve, a layer less per sample.
+    Prebuilt { start: f64 },
 }
 
 impl Param {
@@ -74,12 +85,22 @@ impl Param {
                 domain: (a, b),
             };
         }
+        if let Some(pre) = seg.curve.prebuilt_arc_length() {
+            return Param {
+                map: Some((
+                    Inverse::Prebuilt { start: pre.start },
+                    pre.map.cursor_at(pre.start),
+                )),
+                scale: 1.0,
+                domain: (a, b),
+            };
+        }
         match ArcLengthMap::new(&*seg.curve, 1e-9 * seg.length.max(1.0)) {
             Ok(m) => {
                 let scale = m.length() / seg.length;
                 let cursor = m.cursor();
                 Param {
-                    map: Some((m, cursor)),
+                    map: Some((Inverse::Own(m), cursor)),
                     scale,
                     domain: (a, b),
                 }
@@ -96,9 +117,22 @@ impl Param {
     /// The parameter and point at distance `s` along `seg`.
     pub(crate) fn at(&mut self, seg: &Segment, s: f64) -> (f64, Vec3) {
         match &mut self.map {
-            Some((m, cursor)) => {
+            Some((Inverse::Own(m), cursor)) => {
                 let at = m.advance(&*seg.curve, cursor, s * self.scale);
                 (at.u, at.point)
+            }
+            Some((Inverse::Prebuilt { start }, cursor)) => {
+                match seg.curve.prebuilt_arc_length() {
+                    Some(pre) => {
+                        let at = pre.map.advance(pre.curve, cursor, *start + s);
+                        (at.u, at.point)
+                    }
+                    // Not reached: the map came from this segment's curve.
+                    None => {
+                        let u = self.domain.0 + s * (self.domain.1 - self.domain.0) / seg.length;
+                        (u, seg.curve.point(u))
+                    }
+                }
             }
             None => {
                 let u = self.domain.0 + s * self.scale;

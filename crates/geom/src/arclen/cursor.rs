@@ -134,6 +134,18 @@ impl ArcLengthMap {
         self.anchor(0)
     }
 
+    /// A cursor at the start of the panel holding arc length `s` (clamped): for a caller that
+    /// starts part-way along the curve (a trimmed piece of it), found by bisection of the
+    /// table, where [`Self::advance`] from [`Self::cursor`] would walk every panel before it.
+    pub fn cursor_at(&self, s: f64) -> ArcLengthCursor {
+        let n = self.panels();
+        if n == 0 {
+            return self.anchor(0);
+        }
+        let k = self.s.partition_point(|&x| x <= s).clamp(1, n) - 1;
+        self.anchor(k)
+    }
+
     fn anchor(&self, k: usize) -> ArcLengthCursor {
         ArcLengthCursor {
             panel: k,
@@ -449,6 +461,42 @@ mod tests {
         knots.extend((1..n - 3).map(|i| i as f64));
         knots.extend([(n - 3) as f64; 4]);
         Nurbs::new(3, &pts, weights, knots).unwrap()
+    }
+
+    /// A cursor started part-way (`cursor_at`, as the interpolator does on a trimmed part of a
+    /// curve whose map was built over the whole) lands on the panel holding `s`, and gives the
+    /// same answers as one run from the start, within the map's bound of the true arc length.
+    #[test]
+    fn cursor_at_starts_part_way() {
+        let c = cubic(
+            &[
+                [0.0, 0.0, 0.0],
+                [0.3, 0.05, 0.01],
+                [0.5, 0.4, 0.0],
+                [1.2, 0.5, -0.02],
+                [1.3, 1.1, 0.0],
+                [2.0, 1.0, 0.03],
+            ],
+            &[1.0; 6],
+        );
+        let tol = 1e-9;
+        let m = ArcLengthMap::new(&c, tol).unwrap();
+        let fine = ArcLengthMap::new(&c, tol * 1e-3).unwrap();
+        let len = m.length();
+        for start in [0.0, 0.1, 0.37, 0.5, 0.91].map(|f| f * len) {
+            let mut cur = m.cursor_at(start);
+            assert!(m.s[cur.panel] <= start && start < m.s[cur.panel + 1]);
+            let mut from_start = m.cursor();
+            for i in 0..=200 {
+                let s = start + (len - start) * i as f64 / 200.0;
+                let at = m.advance(&c, &mut cur, s);
+                let reference = m.advance(&c, &mut from_start, s);
+                assert!((fine.s_at(&c, at.u) - s).abs() <= tol, "s = {s}");
+                assert!((fine.s_at(&c, reference.u) - fine.s_at(&c, at.u)).abs() <= 2.0 * tol);
+            }
+        }
+        // Past the end: the last panel.
+        assert_eq!(m.cursor_at(2.0 * len).panel, m.panels() - 1);
     }
 
     /// A smooth, uneven-speed cubic like a compressed surfacing pass (mm, map tolerance 1e-9

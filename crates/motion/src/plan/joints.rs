@@ -270,28 +270,39 @@ impl PlanMachine {
             return None;
         };
         let limits = self.model.joint_limits();
-        // The model's own input checks (`check_input`), inlined: a call per sample showed.
-        let previous_ok = previous.as_slice().iter().all(|v| v.is_finite());
-        if limits.len() != map.len() || previous.len() != map.len() || !previous_ok {
+        // The model refuses a non-finite tip (a NaN in a coordinate no joint carries).
+        if limits.len() != map.len()
+            || previous.len() != map.len()
+            || !(tip.x.is_finite() && tip.y.is_finite() && tip.z.is_finite())
+        {
             return None;
         }
         let length = match control {
             ToolControl::CentrePoint { tool_length } => tool_length,
             ToolControl::Joints => Tool::default().length,
         };
+        // One pass over the joints, with the model's own input checks (`check_input`: every
+        // previous joint finite) fused in: this runs once per sample.
         let mut q = Joints::zeros(map.len());
-        for ((v, m), l) in q.as_mut_slice().iter_mut().zip(map).zip(limits) {
+        for (((v, m), l), p) in q
+            .as_mut_slice()
+            .iter_mut()
+            .zip(map)
+            .zip(limits)
+            .zip(previous.as_slice())
+        {
             *v = match *m {
                 JointMap::Tip(2) => tip.z + length,
                 JointMap::Tip(i) => tip[i],
                 JointMap::Rotary(k) => rotary[k].to_radians(),
             };
-            if !(v.is_finite() && l.contains(*v)) {
+            // `contains` is false for a NaN, and an infinite value is inside no finite limit
+            // but inside an endless one: hence the explicit finiteness test.
+            if !(v.is_finite() && l.contains(*v) && p.is_finite()) {
                 return None;
             }
         }
-        // The model also refuses a non-finite tip (a NaN in a coordinate no joint carries).
-        tip.iter().all(|x| x.is_finite()).then_some(q)
+        Some(q)
     }
 
     /// [`Self::joints`] through the model: the program pose and the model's TCP inverse.

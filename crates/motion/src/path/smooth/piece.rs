@@ -4,7 +4,7 @@
 
 use std::sync::Arc as Shared;
 
-use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, Trimmed, Vec3};
+use tezgah_geom::{Arc, ArcLengthMap, Curve, Line, Nurbs, PrebuiltArcLength, Trimmed, Vec3};
 
 use crate::path::orient::{AxisPath, GreatCircle};
 use crate::path::{Junction, Segment, SegmentFeed};
@@ -337,13 +337,19 @@ impl Piece {
             }
             f => f,
         };
+        // The piece's arc-length map travels with the curve: the interpolator reuses it
+        // instead of building one per segment (`Curve::prebuilt_arc_length`).
+        let map = self.map.map(|m| {
+            let start = m.s_at(&self.geo, self.u0);
+            (m, start)
+        });
         let curve: Box<dyn Curve + Send + Sync> = if whole {
-            Box::new(self.geo)
+            Mapped::boxed(self.geo, map)
         } else {
             match Trimmed::new(self.geo.clone(), self.u0, self.u1) {
-                Ok(t) => Box::new(t),
+                Ok(t) => Mapped::boxed(t, map),
                 // u0 <= u1 always holds (blends never overlap); keep the curve if not.
-                Err(_) => Box::new(self.geo),
+                Err(_) => Mapped::boxed(self.geo, map),
             }
         };
         Segment {
@@ -362,6 +368,85 @@ impl Piece {
     }
 }
 
+/// The whole curve a segment's curve is (a part of): where the piece's map is built.
+trait Whole: Curve + Send + Sync + 'static {
+    fn whole(&self) -> &Geo;
+}
+
+impl Whole for Geo {
+    fn whole(&self) -> &Geo {
+        self
+    }
+}
+
+impl Whole for Trimmed<Geo> {
+    fn whole(&self) -> &Geo {
+        self.inner()
+    }
+}
+
+/// A segment's curve with the piece's arc-length map (over the whole curve) and the arc
+/// length at the segment's start: every `Curve` method is the curve's own, bit for bit, and
+/// `prebuilt_arc_length` hands the map on.
+struct Mapped<C> {
+    curve: C,
+    map: Shared<ArcLengthMap>,
+    start: f64,
+}
+
+impl<C: Whole> Mapped<C> {
+    /// The curve boxed, with the map where the piece has one.
+    fn boxed(curve: C, map: Option<(Shared<ArcLengthMap>, f64)>) -> Box<dyn Curve + Send + Sync> {
+        match map {
+            Some((map, start)) => Box::new(Mapped { curve, map, start }),
+            None => Box::new(curve),
+        }
+    }
+}
+
+impl<C: Whole> Curve for Mapped<C> {
+    fn domain(&self) -> (f64, f64) {
+        self.curve.domain()
+    }
+    fn derivs(&self, u: f64) -> [Vec3; 4] {
+        self.curve.derivs(u)
+    }
+    fn point(&self, u: f64) -> Vec3 {
+        self.curve.point(u)
+    }
+    fn d1(&self, u: f64) -> Vec3 {
+        self.curve.d1(u)
+    }
+    fn speed(&self, u: f64) -> f64 {
+        self.curve.speed(u)
+    }
+    fn speed_integral(&self, a: f64, b: f64) -> f64 {
+        self.curve.speed_integral(a, b)
+    }
+    fn gauss_speeds(&self, a: f64, b: f64) -> [f64; 8] {
+        self.curve.gauss_speeds(a, b)
+    }
+    fn curvature(&self, u: f64) -> f64 {
+        self.curve.curvature(u)
+    }
+    fn breakpoints(&self) -> Vec<f64> {
+        self.curve.breakpoints()
+    }
+    fn speed_ratio(&self, a: f64, b: f64) -> Option<f64> {
+        self.curve.speed_ratio(a, b)
+    }
+    fn length(&self) -> f64 {
+        self.curve.length()
+    }
+    fn prebuilt_arc_length(&self) -> Option<PrebuiltArcLength<'_>> {
+        Some(PrebuiltArcLength {
+            map: &self.map,
+            curve: self.curve.whole(),
+            start: self.start,
+        })
+    }
+}
+
 /// Unit tangent `t = C'/|C'|` and curvature vector `κn = (C'' − (C''·t)t)/|C'|²` at `u`.
 pub(crate) fn frame<C: Curve + ?Sized>(c: &C, u: f64) -> Option<(Vec3, Vec3)> {
     let [_, d1, d2, _] = c.derivs(u);
@@ -372,4 +457,68 @@ pub(crate) fn frame<C: Curve + ?Sized>(c: &C, u: f64) -> Option<(Vec3, Vec3)> {
     let t = d1 / speed;
     let k = (d2 - t * d2.dot(&t)) / (speed * speed);
     Some((t, k))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interpolate::Param;
+
+    /// A cubic spline piece of uneven parametric speed, trimmed at both ends as blends leave
+    /// it: its segment hands on the piece's map (start = arc length at the trim), the curve
+    /// is unchanged, and the interpolator's `s → point` on it is the segment's own arc length
+    /// to within the map tolerance (checked against a map built on the segment at 1e-12), with
+    /// the point `C(u)`.
+    #[test]
+    fn trimmed_spline_segment_carries_the_piece_map() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [3.0, 0.5, 0.1],
+            [5.0, 4.0, 0.0],
+            [12.0, 5.0, -0.2],
+            [13.0, 11.0, 0.0],
+            [20.0, 10.0, 0.3],
+        ]
+        .map(|p| Vec3::new(p[0], p[1], p[2]));
+        let knots = vec![0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 3.0, 3.0, 3.0];
+        let nurbs = Nurbs::new(3, &pts, &[1.0; 6], knots).unwrap();
+        let mut piece = Piece::new(
+            Geo::Spline(Shared::new(nurbs)),
+            [[0.0; 3]; 2],
+            1,
+            SegmentFeed::Feed(600.0),
+            0.01,
+            Mode::Continuous,
+        );
+        let map = piece.map.clone().expect("a spline piece has a map");
+        piece.u0 = 0.2;
+        piece.u1 = 2.7;
+        let start = map.s_at(&piece.geo, 0.2);
+        let seg = piece.clone().into_segment(Junction::Smooth);
+        let pre = seg
+            .curve
+            .prebuilt_arc_length()
+            .expect("the map is handed on");
+        assert!(
+            std::ptr::eq(pre.map, &*map),
+            "the piece's own map, not a copy"
+        );
+        assert_eq!(pre.start, start);
+        assert_eq!(seg.curve.domain(), (0.2, 2.7));
+        for k in 0..=20 {
+            let u = 0.2 + 2.5 * k as f64 / 20.0;
+            assert_eq!(seg.curve.point(u), pre.curve.point(u));
+            assert_eq!(seg.curve.point(u), piece.geo.point(u));
+        }
+        let fine = ArcLengthMap::new(&*seg.curve, 1e-12).unwrap();
+        assert!((fine.length() - seg.length).abs() <= 2e-9);
+        let mut param = Param::new(&seg);
+        for k in 0..400 {
+            let s = seg.length * k as f64 / 400.0;
+            let (u, point) = param.at(&seg, s);
+            assert!((fine.s_at(&*seg.curve, u) - s).abs() <= 2e-9, "s = {s}");
+            // The cursor may take C(u) from its Newton step's Taylor series: rounding apart.
+            assert!((point - piece.geo.point(u)).norm() <= 1e-12 * (1.0 + point.norm()));
+        }
+    }
 }
