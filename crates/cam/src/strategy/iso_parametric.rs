@@ -13,8 +13,6 @@ use crate::forward_step::IsoLine;
 
 /// Lattice size (per direction) over which the constant side step is minimised.
 const LATTICE: usize = 48;
-/// Newton steps placing the neighbouring pass's point abreast of a contact.
-const ABREAST_STEPS: usize = 4;
 /// Most passes a plan may have.
 pub(super) const MAX_PASSES: usize = 200_000;
 
@@ -72,9 +70,7 @@ fn true_surface_step(ctx: &Context, step: f64) -> f64 {
             if s2 > side.1 {
                 return true;
             }
-            let from = ctx.axes.uv(s, f);
-            let f2 = abreast(ctx, from, s2, f);
-            ctx.cusp_fits(from, ctx.axes.uv(s2, f2), tangent)
+            ctx.cusp_fits(ctx.axes.uv(s, f), ctx.axes.uv(s2, f), tangent)
         };
         if fits(step) {
             return step;
@@ -99,31 +95,6 @@ fn true_surface_step(ctx: &Context, step: f64) -> f64 {
                 .fold(step, f64::min)
         })
         .reduce(|| step, f64::min)
-}
-
-/// The feed parameter on the iso line `side = s2` whose point lies in the cross-feed plane
-/// of the contact at `from` (normal to the pass there): where the neighbouring pass crosses
-/// that contact's section. A few Newton steps on `(S(s2, f) − S(from))·S_f = 0`.
-fn abreast(ctx: &Context, from: (f64, f64), s2: f64, f0: f64) -> f64 {
-    let feed = ctx.axes.feed;
-    let d0 = ctx.surface.derivs(from.0, from.1);
-    let sf = |d: &tezgah_geom::SurfaceDerivs| if ctx.axes.along_v { d.sv } else { d.su };
-    let along = sf(&d0);
-    let mut f = f0;
-    for _ in 0..ABREAST_STEPS {
-        let (u, v) = ctx.axes.uv(s2, f);
-        let d = ctx.surface.derivs(u, v);
-        let slope = sf(&d).dot(&along);
-        if !(slope.abs() > 0.0) {
-            break;
-        }
-        let next = (f - (d.point - d0.point).dot(&along) / slope).clamp(feed.0, feed.1);
-        if !next.is_finite() {
-            break;
-        }
-        f = next;
-    }
-    f
 }
 
 /// The passes: iso lines at `side.0 + k·Δ`, `k = 0..=n`, `n = ⌈range / Δs⌉`, in order.

@@ -17,6 +17,11 @@ use crate::silhouette::envelope;
 const CUSP_BISECTIONS: usize = 60;
 /// Samples of the parameter segment between the contacts seeding the point inversion.
 const SEED_SAMPLES: usize = 16;
+/// Newton steps sliding the second contact abreast of the first.
+const ABREAST_STEPS: usize = 6;
+/// The most the second contact may stay ahead or behind the first's section (relative to the
+/// step) for the check to count: more only at the domain's feed ends, where the pass ends.
+const ABREAST_LAG: f64 = 0.02;
 /// Gauss–Newton steps of the local point inversion (it converges quadratically near a foot).
 const INVERSION_STEPS: usize = 8;
 /// Bisections of a side step against the true cusp (the bracket shrinks by 2⁻¹⁴ of the step).
@@ -54,6 +59,7 @@ impl Context<'_> {
         tangent_uv: (f64, f64),
     ) -> Option<f64> {
         let first = self.local(from.0, from.1, tangent_uv)?;
+        let to = self.abreast(&first, to, tangent_uv)?;
         let second = self.local(to.0, to.1, tangent_uv)?;
         let (c1, c2) = (self.standing(&first)?, self.standing(&second)?);
         let p = first.d.point;
@@ -92,6 +98,33 @@ impl Context<'_> {
         let cusp = p + t * y + n * z;
         let foot = self.foot(&cusp, from, to)?;
         Some((cusp - foot).norm() * (cusp - foot).dot(&n).signum())
+    }
+
+    /// `to` slid along its pass (`tangent_uv`) into the cross-feed plane of the first contact:
+    /// the section sees the second pass where it runs abreast of the first contact, not the
+    /// cutter a little ahead or behind (on a surface curved along the feed that one stands
+    /// lower or higher by the curvature times the square of the lag). Newton on
+    /// `(S(to + λ·tangent) − p)·f = 0`; `None` where the domain's edge stops it short.
+    fn abreast(&self, first: &Local, to: (f64, f64), tangent_uv: (f64, f64)) -> Option<(f64, f64)> {
+        let (p, f) = (first.d.point, first.frame.feed.into_inner());
+        let (du, dv) = (self.surface.domain_u(), self.surface.domain_v());
+        let (mut u, mut v) = to;
+        let mut across = 0.0;
+        for _ in 0..ABREAST_STEPS {
+            let d = self.surface.derivs(u, v);
+            let lag = (d.point - p).dot(&f);
+            across = (d.point - p - f * lag).norm();
+            let slope = (d.su * tangent_uv.0 + d.sv * tangent_uv.1).dot(&f);
+            if !(slope.abs() > 0.0) {
+                break;
+            }
+            let lam = -lag / slope;
+            u = (u + lam * tangent_uv.0).clamp(du.0, du.1);
+            v = (v + lam * tangent_uv.1).clamp(dv.0, dv.1);
+        }
+        let lag = (self.surface.point(u, v) - p).dot(&f);
+        (lag.abs() <= ABREAST_LAG * across.max(f64::MIN_POSITIVE) && u.is_finite() && v.is_finite())
+            .then_some((u, v))
     }
 
     /// The surface point nearest `q` near the parameter segment `from`–`to`: the nearest of
@@ -133,5 +166,33 @@ impl Context<'_> {
     ) -> bool {
         self.true_cusp(from, to, tangent_uv)
             .is_none_or(|c| c <= self.settings.scallop * (1.0 + CUSP_SLACK))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cutter::{Cutter, CutterShape};
+    use crate::scallop::stepover_exact;
+    use crate::strategy::{Settings, StrategyKind};
+
+    #[test]
+    fn sphere_cusp_is_the_closed_form() {
+        let s = crate::testing::sphere(30.0);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+        let h = 0.02;
+        let settings = Settings::new(StrategyKind::IsoScallop, h, 0.005);
+        let ctx = Context::new(&s, &cutter, &settings).unwrap();
+        let w = stepover_exact(3.0, -1.0 / 30.0, h).unwrap();
+        let (du, dv) = (s.domain_u(), s.domain_v());
+        for (x, y) in [(0.3, 0.5), (0.1, 0.1), (0.8, 0.9), (0.5, 0.2)] {
+            let u = du.0 + (du.1 - du.0) * x;
+            let v = dv.0 + (dv.1 - dv.0) * y;
+            let d = s.derivs(u, v);
+            let u2 = u + w / d.su.norm();
+            let c = ctx.true_cusp((u, v), (u2, v), (0.0, 1.0));
+            let chord = (s.point(u2, v) - d.point).norm();
+            println!("{x} {y}: {c:?} chord {chord} w {w}");
+        }
     }
 }
