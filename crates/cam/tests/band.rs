@@ -329,7 +329,7 @@ fn step_free_form_large_balls_hold_the_scallop_on_the_true_surface() {
             &face.surface,
             &ball(d),
             &settings,
-            0.5,
+            0.8,
         );
     }
     // Zig-zag's constant step, at its worst place.
@@ -339,6 +339,6 @@ fn step_free_form_large_balls_hold_the_scallop_on_the_true_surface() {
         &face.surface,
         &ball(32.0),
         &settings,
-        0.5,
+        0.8,
     );
 }

@@ -177,22 +177,39 @@ mod tests {
     use crate::strategy::{Settings, StrategyKind};
 
     #[test]
-    fn sphere_cusp_is_the_closed_form() {
-        let s = crate::testing::sphere(30.0);
+    fn cusp_on_a_sphere_and_a_trough_is_the_closed_form() {
+        // Where the cross-section is a circle everywhere the true cusp of passes the exact
+        // model's chord apart is h: convex sphere R 30 (chord along u, the neighbour slid
+        // abreast) and concave trough R 40 (across its arc), ball D6, h 0.02.
         let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
         let h = 0.02;
         let settings = Settings::new(StrategyKind::IsoScallop, h, 0.005);
-        let ctx = Context::new(&s, &cutter, &settings).unwrap();
-        let w = stepover_exact(3.0, -1.0 / 30.0, h).unwrap();
-        let (du, dv) = (s.domain_u(), s.domain_v());
-        for (x, y) in [(0.3, 0.5), (0.1, 0.1), (0.8, 0.9), (0.5, 0.2)] {
-            let u = du.0 + (du.1 - du.0) * x;
-            let v = dv.0 + (dv.1 - dv.0) * y;
-            let d = s.derivs(u, v);
-            let u2 = u + w / d.su.norm();
-            let c = ctx.true_cusp((u, v), (u2, v), (0.0, 1.0));
-            let chord = (s.point(u2, v) - d.point).norm();
-            println!("{x} {y}: {c:?} chord {chord} w {w}");
+        for (name, s, kappa) in [
+            ("sphere", crate::testing::sphere(30.0), -1.0 / 30.0),
+            ("trough", crate::testing::trough(40.0, 50.0), 1.0 / 40.0),
+        ] {
+            let ctx = Context::new(&s, &cutter, &settings).unwrap();
+            let w = stepover_exact(3.0, kappa, h).unwrap();
+            let (du, dv) = (s.domain_u(), s.domain_v());
+            for (x, y) in [(0.3, 0.5), (0.1, 0.1), (0.7, 0.9), (0.5, 0.2)] {
+                let (u, v) = (du.0 + (du.1 - du.0) * x, dv.0 + (dv.1 - dv.0) * y);
+                let p = s.point(u, v);
+                // The point along u at chord w (bisection on the parameter).
+                let (mut lo, mut hi) = (u, du.1);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    if (s.point(mid, v) - p).norm() < w {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let c = ctx.true_cusp((u, v), (lo, v), (0.0, 1.0)).unwrap();
+                assert!((c - h).abs() < 2e-3 * h, "{name} {x} {y}: {c}");
+                // A wider step leaves more, a narrower less.
+                let wide = ctx.true_cusp((u, v), (u + 1.2 * (lo - u), v), (0.0, 1.0));
+                assert!(wide.unwrap() > 1.3 * h, "{name}: {wide:?}");
+            }
         }
     }
 }
