@@ -70,7 +70,7 @@ impl Context<'_> {
             t = -t;
             yq = -yq;
         }
-        if !(yq > 0.0) {
+        if yq.is_nan() || yq <= 0.0 {
             return None;
         }
         let (shape, len) = (self.shape(), self.cutter.flute_length);
@@ -115,7 +115,7 @@ impl Context<'_> {
             let lag = (d.point - p).dot(&f);
             across = (d.point - p - f * lag).norm();
             let slope = (d.su * tangent_uv.0 + d.sv * tangent_uv.1).dot(&f);
-            if !(slope.abs() > 0.0) {
+            if slope.is_nan() || slope == 0.0 {
                 break;
             }
             let lam = -lag / slope;
@@ -145,7 +145,7 @@ impl Context<'_> {
             let r = q - d.point;
             let (e, f, g) = (d.su.dot(&d.su), d.su.dot(&d.sv), d.sv.dot(&d.sv));
             let det = e * g - f * f;
-            if !(det > 0.0) {
+            if det.is_nan() || det <= 0.0 {
                 break;
             }
             let (a, b) = (d.su.dot(&r), d.sv.dot(&r));
