@@ -51,9 +51,9 @@ fn auto_picks_the_tables_ball_end_mill_and_says_why() {
 #[test]
 fn auto_from_the_standard_set_on_the_free_form_is_verified() {
     // The free-form patch's tightest concave radius (≈ 25.9 mm) admits the standard set's
-    // 32 mm ball; its 4–5 mm side steps span regions of varying concave curvature, where the
-    // osculating circle alone left 0.278 mm at h = 0.2 (session 5). Checked on the true
-    // surface, the posted program's simulated scallop is within h.
+    // 32 mm ball; its 4–5 mm side steps span regions of varying concave curvature, which the
+    // osculating-circle models do not see (session 5 reported 0.278 mm at h = 0.2). With the
+    // steps checked on the true surface the posted program's simulated scallop is within h.
     let (ngc, json) = (tmp("auto-free-std.ngc"), tmp("auto-free-std.json"));
     let out = tezgah()
         .arg("cam")
