@@ -80,6 +80,36 @@ fn contact_across(shape: &CutterShape, a: &Vec3, n: &Vec3, t: &Vec3) -> f64 {
 /// Bisections for where two neighbouring silhouettes cross (the bracket shrinks by 2⁻⁴⁰).
 const CROSSING_BISECTIONS: usize = 40;
 
+/// The lower envelope of a cutter standing anywhere, seen along the feed: the lowest `P·n` over
+/// the cutting end on the slice `P·t = y`, for the cutter with its tip at `tip` and unit axis
+/// `a` (`n`, `t` orthonormal, coordinates in any common origin). This is the cross-section of
+/// the swept pass (the feed is normal to `n` and `t`), so two passes' envelopes meet at their
+/// cusp. A ball's is its sphere's circle (closed form; the flutes above it only matter at
+/// its side), `f64::INFINITY` beside it; the dual search returns a large value there for the
+/// others.
+#[allow(clippy::too_many_arguments)]
+pub fn envelope(
+    shape: &CutterShape,
+    flute_length: f64,
+    tip: &Vec3,
+    a: &Vec3,
+    n: &Vec3,
+    t: &Vec3,
+    y: f64,
+) -> f64 {
+    if let CutterShape::Ball { radius } = *shape {
+        let centre = tip + a * radius;
+        let dy = y - centre.dot(t);
+        let d2 = radius * radius - dy * dy;
+        return if d2 >= 0.0 {
+            centre.dot(n) - d2.sqrt()
+        } else {
+            f64::INFINITY
+        };
+    }
+    tip.dot(n) + lowest(shape, flute_length, a, n, t, y - tip.dot(t))
+}
+
 /// The cusp between two passes `w` apart on a cross-feed section of normal curvature `kappa`
 /// (positive concave, as `scallop`). What the two passes leave at `x` from the first contact is
 /// the lower of their silhouettes there, `min(rise(x), rise(x − w))`; its highest point is where
@@ -163,6 +193,27 @@ mod tests {
                 assert!((got - want).abs() < 1e-9, "{deg}° w {w}: {got} {want}");
             }
         }
+    }
+
+    #[test]
+    fn ball_envelope_is_the_dual_search_of_its_body() {
+        // The ball's closed-form circle against the generic search on a bull-nose of corner
+        // radius = radius (the same body), with the axis leaned along the feed and an offset
+        // tip (leaned sideways, the flutes above the ball would reach below its circle's ends).
+        let (n, t) = (Vec3::z(), Vec3::y());
+        let a = Vec3::new(0.3, 0.0, 1.0).normalize();
+        let tip = Vec3::new(0.7, -1.1, 0.4);
+        let ball = CutterShape::Ball { radius: 3.0 };
+        let torus = CutterShape::BullNose {
+            radius: 3.0,
+            corner_radius: 3.0,
+        };
+        for y in [-3.5_f64, -2.0, -0.5, 0.3, 1.5] {
+            let got = envelope(&ball, 18.0, &tip, &a, &n, &t, y);
+            let want = envelope(&torus, 18.0, &tip, &a, &n, &t, y);
+            assert!((got - want).abs() < 1e-7, "{y}: {got} {want}");
+        }
+        assert_eq!(envelope(&ball, 18.0, &tip, &a, &n, &t, 5.0), f64::INFINITY);
     }
 
     #[test]

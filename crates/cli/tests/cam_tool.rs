@@ -49,6 +49,42 @@ fn auto_picks_the_tables_ball_end_mill_and_says_why() {
 }
 
 #[test]
+fn auto_from_the_standard_set_on_the_free_form_is_verified() {
+    // The free-form patch's tightest concave radius (≈ 25.9 mm) admits the standard set's
+    // 32 mm ball; its 4–5 mm side steps span regions of varying concave curvature, which the
+    // osculating-circle models do not see (session 5 reported 0.278 mm at h = 0.2). With the
+    // steps checked on the true surface the posted program's simulated scallop is within h.
+    let (ngc, json) = (tmp("auto-free-std.ngc"), tmp("auto-free-std.json"));
+    let out = tezgah()
+        .arg("cam")
+        .arg(fixture("freeform_patch.stp"))
+        .args([
+            "--tool",
+            "auto",
+            "--strategy",
+            "iso-scallop",
+            "--scallop",
+            "0.2",
+        ])
+        .args(["--tolerance", "0.01", "--verify-cell", "0.5", "-o"])
+        .arg(&ngc)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("tool auto: ball:32"), "{stdout}");
+    let report = read_json(&json);
+    assert_eq!(report["tool"], "ball:32", "{report}");
+    assert_eq!(report["verified"], true, "{report}");
+}
+
+#[test]
 fn auto_without_a_table_picks_from_the_standard_set() {
     // The sphere cap is convex everywhere (seen from outside): the largest ball of the
     // standard set, 32 mm.

@@ -4,6 +4,9 @@
 //! recommends, the step is the minimum over a lattice of the whole surface of the local
 //! allowed step `ω / |S_s · t|` (the side step's component across the feed per unit parameter).
 
+use rayon::prelude::*;
+
+use super::true_cusp::STEP_BISECTIONS;
 use super::{Axes, Context, PassPath};
 use crate::error::CamError;
 use crate::forward_step::IsoLine;
@@ -52,7 +55,46 @@ fn side_step(ctx: &Context) -> Result<f64, CamError> {
             }
         }
     }
-    Ok(best)
+    Ok(true_surface_step(ctx, best))
+}
+
+/// `step`, shrunk until the cusp between passes `step` apart, measured on the true surface
+/// (`true_cusp`), fits the target at every lattice point: the worst place of a constant step
+/// is where the model's osculating circle departs most from the surface across it.
+fn true_surface_step(ctx: &Context, step: f64) -> f64 {
+    let Axes { side, feed, .. } = ctx.axes;
+    let tangent = ctx.axes.uv(0.0, 1.0);
+    let allowed = |s: f64, f: f64| -> f64 {
+        let fits = |d: f64| {
+            let s2 = s + d;
+            if s2 > side.1 {
+                return true;
+            }
+            ctx.cusp_fits(ctx.axes.uv(s, f), ctx.axes.uv(s2, f), tangent)
+        };
+        if fits(step) {
+            return step;
+        }
+        let (mut lo, mut hi) = (0.0, step);
+        for _ in 0..STEP_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    (0..=LATTICE)
+        .into_par_iter()
+        .map(|i| {
+            let s = side.0 + (side.1 - side.0) * i as f64 / LATTICE as f64;
+            (0..=LATTICE)
+                .map(|j| allowed(s, feed.0 + (feed.1 - feed.0) * j as f64 / LATTICE as f64))
+                .fold(step, f64::min)
+        })
+        .reduce(|| step, f64::min)
 }
 
 /// The passes: iso lines at `side.0 + k·Δ`, `k = 0..=n`, `n = ⌈range / Δs⌉`, in order.

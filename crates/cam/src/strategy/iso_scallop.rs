@@ -10,6 +10,7 @@
 use tezgah_geom::Vec3;
 
 use super::iso_parametric::MAX_PASSES;
+use super::true_cusp::STEP_BISECTIONS;
 use super::{Context, PassPath};
 use crate::error::CamError;
 use crate::forward_step::UvPolyline;
@@ -146,6 +147,23 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
             }
             w = narrowest;
             moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
+        }
+        // The models see the surface across the step as its osculating circle at one point;
+        // the cusp is checked on the true surface and the step shrunk until it fits.
+        if !ctx.cusp_fits((u, v), axes.uv(moved.s, moved.f), tangent) {
+            let (mut lo, mut hi) = (0.0, w);
+            let mut fitted = None;
+            for _ in 0..STEP_BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                let m = offset(ctx, p, (dir_s, dir_f), &local.d.point, mid);
+                if ctx.cusp_fits((u, v), axes.uv(m.s, m.f), tangent) {
+                    (lo, fitted) = (mid, Some(m));
+                } else {
+                    hi = mid;
+                }
+            }
+            w = lo;
+            moved = fitted.unwrap_or_else(|| offset(ctx, p, (dir_s, dir_f), &local.d.point, lo));
         }
         next.push(moved);
         steps.push(w);

@@ -10,6 +10,7 @@
 mod band;
 mod iso_parametric;
 mod iso_scallop;
+mod true_cusp;
 
 use std::fmt;
 use std::str::FromStr;
