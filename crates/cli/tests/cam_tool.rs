@@ -15,36 +15,57 @@ fn fixture(name: &str) -> PathBuf {
         .join(name)
 }
 
-#[test]
-fn auto_picks_the_tables_ball_end_mill_and_says_why() {
-    // examples/tools.tbl: T1 a 6 mm flat end mill, T2 a 3 mm ball end mill. The free-form
-    // patch's tightest concave radius is ≈ 25.9 mm, so the 3 mm ball fits and is the only one.
-    let (ngc, json) = (tmp("auto-table.ngc"), tmp("auto-table.json"));
+/// Runs `tezgah cam SURFACE --tool auto ARGS -o NAME.ngc --report NAME.json`, which must
+/// succeed: its stdout, report and program.
+fn cam_auto(name: &str, surface: &str, args: &[&str]) -> (String, serde_json::Value, String) {
+    let (ngc, json) = (tmp(&format!("{name}.ngc")), tmp(&format!("{name}.json")));
     let out = tezgah()
         .arg("cam")
-        .arg(fixture("freeform_patch.stp"))
-        .args(["--tool", "auto", "--tool-table", TOOLS])
-        .args(["--strategy", "iso-scallop", "--scallop", "0.3"])
-        .args(["--tolerance", "0.01", "--verify-cell", "1", "-o"])
+        .arg(fixture(surface))
+        .args(["--tool", "auto"])
+        .args(args)
+        .arg("-o")
         .arg(&ngc)
         .arg("--report")
         .arg(&json)
         .output()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
         out.status.success(),
         "{stdout}{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    let program = std::fs::read_to_string(&ngc).unwrap();
+    (stdout, read_json(&json), program)
+}
+
+#[test]
+fn auto_picks_the_tables_ball_end_mill_and_says_why() {
+    // examples/tools.tbl: T1 a 6 mm flat end mill, T2 a 3 mm ball end mill. The free-form
+    // patch's tightest concave radius is ≈ 25.9 mm, so the 3 mm ball fits and is the only one.
+    let (stdout, report, program) = cam_auto(
+        "auto-table",
+        "freeform_patch.stp",
+        &[
+            "--tool-table",
+            TOOLS,
+            "--strategy",
+            "iso-scallop",
+            "--scallop",
+            "0.3",
+            "--tolerance",
+            "0.01",
+            "--verify-cell",
+            "1",
+        ],
+    );
     assert!(stdout.contains("tool auto: ball:3"), "{stdout}");
     assert!(stdout.contains("tightest concave radius 25.8"), "{stdout}");
     assert!(stdout.contains("tools.tbl"), "{stdout}");
-    let report = read_json(&json);
     assert_eq!(report["tool"], "ball:3", "{report}");
     assert_eq!(report["tool_number"], 2, "{report}");
     assert_eq!(report["verified"], true, "{report}");
-    let program = std::fs::read_to_string(&ngc).unwrap();
     assert!(program.contains("T2 M6"), "{}", &program[..400]);
 }
 
@@ -54,32 +75,21 @@ fn auto_from_the_standard_set_on_the_free_form_is_verified() {
     // 32 mm ball; its 4–5 mm side steps span regions of varying concave curvature, which the
     // osculating-circle models do not see (session 5 reported 0.278 mm at h = 0.2). With the
     // steps checked on the true surface the posted program's simulated scallop is within h.
-    let (ngc, json) = (tmp("auto-free-std.ngc"), tmp("auto-free-std.json"));
-    let out = tezgah()
-        .arg("cam")
-        .arg(fixture("freeform_patch.stp"))
-        .args([
-            "--tool",
-            "auto",
+    let (stdout, report, _) = cam_auto(
+        "auto-free-std",
+        "freeform_patch.stp",
+        &[
             "--strategy",
             "iso-scallop",
             "--scallop",
             "0.2",
-        ])
-        .args(["--tolerance", "0.01", "--verify-cell", "0.5", "-o"])
-        .arg(&ngc)
-        .arg("--report")
-        .arg(&json)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+            "--tolerance",
+            "0.01",
+            "--verify-cell",
+            "0.5",
+        ],
     );
     assert!(stdout.contains("tool auto: ball:32"), "{stdout}");
-    let report = read_json(&json);
     assert_eq!(report["tool"], "ball:32", "{report}");
     assert_eq!(report["verified"], true, "{report}");
 }

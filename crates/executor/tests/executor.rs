@@ -718,6 +718,30 @@ fn hold_distance_distribution() {
     );
 }
 
+/// Runs `program` with the feed override set to `percent` 0.2 s after the start, checking
+/// every joint limit, continuity and the end at `end`: the fastest path speed and the number
+/// of periods.
+fn run_with_override(program: &str, percent: f64, end: Vec3) -> (f64, usize) {
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::Load {
+        program: program.into(),
+    })
+    .unwrap();
+    exec.command(Command::CycleStart).unwrap();
+    drive(&mut exec, &mut trace, 100_000, |k, e| {
+        if k == 200 {
+            e.command(Command::FeedOverride { percent }).unwrap();
+        }
+    });
+    assert_eq!(exec.state(), RunState::Idle);
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
+    assert!((out.last().unwrap().tip - end).norm() < 1e-9);
+    (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+}
+
 /// Override above 100 % reaches the moves already planned: on a long line whose feed (not
 /// the machine) caps the speed, 150 % and 200 % set after the start speed up the piece in
 /// hand to 1.5× and 2× the feed and shorten the cycle in proportion; on a line planned near
@@ -726,24 +750,7 @@ fn hold_distance_distribution() {
 #[test]
 fn override_above_100_speeds_up_the_planned_window() {
     let run = |program: &str, percent: f64| {
-        let mut exec = executor();
-        let mut trace = Trace::new(&exec);
-        exec.command(Command::Load {
-            program: program.into(),
-        })
-        .unwrap();
-        exec.command(Command::CycleStart).unwrap();
-        drive(&mut exec, &mut trace, 100_000, |k, e| {
-            if k == 200 {
-                e.command(Command::FeedOverride { percent }).unwrap();
-            }
-        });
-        assert_eq!(exec.state(), RunState::Idle);
-        let (out, report) = trace.report();
-        assert_within_limits(&report);
-        assert_continuous(&out);
-        assert!((out.last().unwrap().tip - Vec3::new(150.0, 0.0, 0.0)).norm() < 1e-9);
-        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+        run_with_override(program, percent, Vec3::new(150.0, 0.0, 0.0))
     };
     // One piece, planned at 10 mm/s before the override changes.
     let slow = "G21 G90 F600\nG1 X150\nM2\n";
@@ -780,24 +787,11 @@ fn override_above_100_speeds_up_the_planned_window() {
 #[test]
 fn override_above_100_speeds_up_a_planned_arc() {
     let run = |percent: f64| {
-        let mut exec = executor();
-        let mut trace = Trace::new(&exec);
-        exec.command(Command::Load {
-            program: "G21 G90 F600\nG2 X60 Y0 I30 J0\nM2\n".into(),
-        })
-        .unwrap();
-        exec.command(Command::CycleStart).unwrap();
-        drive(&mut exec, &mut trace, 100_000, |k, e| {
-            if k == 200 {
-                e.command(Command::FeedOverride { percent }).unwrap();
-            }
-        });
-        assert_eq!(exec.state(), RunState::Idle);
-        let (out, report) = trace.report();
-        assert_within_limits(&report);
-        assert_continuous(&out);
-        assert!((out.last().unwrap().tip - Vec3::new(60.0, 0.0, 0.0)).norm() < 1e-9);
-        (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
+        run_with_override(
+            "G21 G90 F600\nG2 X60 Y0 I30 J0\nM2\n",
+            percent,
+            Vec3::new(60.0, 0.0, 0.0),
+        )
     };
     let (v100, n100) = run(100.0);
     let (v200, n200) = run(200.0);
