@@ -726,7 +726,8 @@ impl Executor {
                 return Ok(Some(Event::Done));
             };
             let (next, fast) = match self.peeked.take() {
-                Some(p) => (Some(p), self.peeked_fast.take()),
+                // Its limits above the plan were worked out when it was peeked.
+                Some(p) => (Some(p), Some(self.peeked_fast.take())),
                 None => (job.next(factor)?, None),
             };
             let Some(PlannedItem { item, factor }) = next else {
@@ -734,7 +735,7 @@ impl Executor {
             };
             match item {
                 Planned::Motion(piece) => {
-                    let fast = fast.or_else(|| self.fast_limits(&piece));
+                    let fast = fast.unwrap_or_else(|| self.fast_limits(&piece));
                     let cursor = Box::new(PieceCursor::new(Arc::from(piece)));
                     self.current = Some(Current::Piece {
                         cursor,
@@ -807,8 +808,8 @@ impl Executor {
         }
     }
 
-    /// A piece's limits above its planned speed ([`crate::overspeed`]); worked out only while
-    /// the override asks for more than the piece was planned for.
+    /// A piece's limits above its planned speed ([`crate::overspeed`]); worked out once per
+    /// piece, when it is peeked or taken, so an override raised later reaches it too.
     fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
         overspeed_limits(piece, &self.machine, &self.options.plan)
     }
