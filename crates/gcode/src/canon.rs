@@ -79,6 +79,13 @@ pub enum Canon {
     SelectPlane(Option<Plane>),
     SetMotionControlMode(ControlMode),
     SetNaivecamTolerance(f64),
+    /// LinuxCNC's `G64 P… R…` (newer than 2.9): the trajectory planner's kind and its peak
+    /// scale. `R` > 0 selects kind 1 with the scale clamped to 0.1–1; `R0` kind 0 (scale −1).
+    /// tezgah's planner takes its limits from the machine file; the call is carried for `canon`.
+    SetPlannerMode {
+        kind: u8,
+        peak_scale: f64,
+    },
     /// Fanuc's `G05.1 Q1`/`Q0` (tezgah's own call; LinuxCNC has none): compression of short
     /// moves into splines on or off.
     SetSmoothing(bool),
@@ -200,6 +207,9 @@ impl fmt::Display for Canon {
                 }
             },
             SetNaivecamTolerance(t) => write!(f, "SET_NAIVECAM_TOLERANCE({t:.4})"),
+            SetPlannerMode { kind, peak_scale } => {
+                write!(f, "SET_PLANNER_MODE(type={kind}, peak_scale={peak_scale:.6})")
+            }
             SetFeedMode(m) => write!(f, "SET_FEED_MODE(0, {m})"),
             SetFeedRate(v) => write!(f, "SET_FEED_RATE({v:.4})"),
             SetSpindleSpeed(s) => write!(f, "SET_SPINDLE_SPEED(0, {s:.4})"),

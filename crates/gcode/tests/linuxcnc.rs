@@ -176,6 +176,7 @@ const RUNS: &[Run] = &[
         ..run("sequence-number", "test.ngc")
     },
     run("inside-corners", "test.ngc"),
+    run("g64-r-planner", "test.ngc"),
     run("crazy-paths", "test.ngc"),
     Run {
         table: Some("test.tbl"),
@@ -200,7 +201,6 @@ const RUNS: &[Run] = &[
 #[allow(dead_code)]
 const FOLDERS_NOT_YET: &[(&str, &str)] = &[
     ("g33.1", "spindle-synchronised motion, out of scope"),
-    ("g64-r-planner", "G64 R of LinuxCNC master, not in 2.9"),
     ("g71-*, g72-*, g76", "lathe cycles, out of scope"),
     (
         "g84/g18/*, g84/g19/*",

@@ -236,7 +236,11 @@ fn check_other_words(
     rule(b'q', q_user, ErrorKind::QWordUnused)?;
     rule(
         b'r',
-        arc || g10 || cycle || motion == Some(62) || matches!(m(mgroup::SPINDLE), Some(19)),
+        arc || g10
+            || cycle
+            || motion == Some(62)
+            || block.g(ggroup::PATH_CONTROL) == Some(640)
+            || matches!(m(mgroup::SPINDLE), Some(19)),
         ErrorKind::RWordUnused,
     )?;
     Ok(())

@@ -375,6 +375,10 @@ impl Interpreter {
             _ => ControlMode::Continuous(block.get(b'p').unwrap_or(0.0).max(0.0)),
         };
         self.state.control = mode;
+        // LinuxCNC announces the planner of `G64 … R` before the blending mode itself.
+        if let (ControlMode::Continuous(_), Some(r)) = (mode, block.get(b'r')) {
+            self.emit(sink, planner_mode(r));
+        }
         self.emit(sink, Canon::SetMotionControlMode(mode));
         if let ControlMode::Continuous(p) = mode {
             let q = block.get(b'q').unwrap_or(p);
@@ -578,4 +582,20 @@ pub(super) fn unsupported(g10: u32, at: u32) -> ExecError {
 fn unsupported_m(block: &Block, group: usize) -> ExecError {
     let c = block.m[group].expect("group present");
     (ErrorKind::Unsupported(format!("M{}", c.code)), c.at)
+}
+
+/// `G64 … R<r>`, as LinuxCNC's newer interpreters read it: a positive R picks the planner of
+/// kind 1 with its peak scale clamped to 0.1–1; zero (or less) goes back to kind 0.
+fn planner_mode(r: f64) -> Canon {
+    if r > 0.0 {
+        Canon::SetPlannerMode {
+            kind: 1,
+            peak_scale: r.clamp(0.1, 1.0),
+        }
+    } else {
+        Canon::SetPlannerMode {
+            kind: 0,
+            peak_scale: -1.0,
+        }
+    }
 }
