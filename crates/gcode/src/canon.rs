@@ -146,6 +146,12 @@ pub enum Canon {
     DisableFeedOverride,
     EnableSpeedOverride,
     DisableSpeedOverride,
+    /// M52 (P1): the feed follows the adaptive-feed input.
+    EnableAdaptiveFeed,
+    DisableAdaptiveFeed,
+    /// M53 (P1): the feed-hold input is honoured; `M53 P0` ignores it.
+    EnableFeedHold,
+    DisableFeedHold,
     ProgramStop,
     OptionalProgramStop,
     PalletShuttle,
@@ -289,6 +295,10 @@ impl fmt::Display for Canon {
             DisableFeedOverride => f.write_str("DISABLE_FEED_OVERRIDE()"),
             EnableSpeedOverride => f.write_str("ENABLE_SPEED_OVERRIDE(0)"),
             DisableSpeedOverride => f.write_str("DISABLE_SPEED_OVERRIDE(0)"),
+            EnableAdaptiveFeed => f.write_str("ENABLE_ADAPTIVE_FEED()"),
+            DisableAdaptiveFeed => f.write_str("DISABLE_ADAPTIVE_FEED()"),
+            EnableFeedHold => f.write_str("ENABLE_FEED_HOLD()"),
+            DisableFeedHold => f.write_str("DISABLE_FEED_HOLD()"),
             ProgramStop => f.write_str("PROGRAM_STOP()"),
             OptionalProgramStop => f.write_str("OPTIONAL_PROGRAM_STOP()"),
             PalletShuttle => f.write_str("PALLET_SHUTTLE()"),

@@ -134,6 +134,21 @@ pub struct SystemValues {
     pub mist: f64,
     pub flood: f64,
     pub selected_tool: f64,
+    /// Pocket (tool-table P) of the selected tool, −1 before any T.
+    pub selected_pocket: f64,
+    /// Tool in the spindle (#5400) and its pocket.
+    pub current_tool: f64,
+    pub current_pocket: f64,
+    /// 400 (G40), 410 (G41, G41.1) or 420 (G42, G42.1).
+    pub ccomp: f64,
+    /// G99 in force (else G98).
+    pub retract_r_plane: f64,
+    /// G7 in force (else G8).
+    pub lathe_diameter: f64,
+    pub feed_override: f64,
+    pub speed_override: f64,
+    pub adaptive_feed: f64,
+    pub feed_hold: f64,
     pub call_level: f64,
     pub value: f64,
     pub value_returned: f64,
@@ -176,6 +191,25 @@ impl SystemValues {
             "_mist" => self.mist,
             "_flood" => self.flood,
             "_selected_tool" => self.selected_tool,
+            "_selected_pocket" => self.selected_pocket,
+            "_current_tool" => self.current_tool,
+            "_current_pocket" => self.current_pocket,
+            "_ccomp" => self.ccomp,
+            "_retract_r_plane" => self.retract_r_plane,
+            "_retract_old_z" => 1.0 - self.retract_r_plane,
+            // tezgah has no constant surface speed (G96): always G97.
+            "_spindle_rpm_mode" => 1.0,
+            "_spindle_css_mode" => 0.0,
+            "_lathe_diameter_mode" => self.lathe_diameter,
+            "_lathe_radius_mode" => 1.0 - self.lathe_diameter,
+            "_speed_override" => self.speed_override,
+            "_feed_override" => self.feed_override,
+            "_adaptive_feed" => self.adaptive_feed,
+            "_feed_hold" => self.feed_hold,
+            // U V W are not driven: they never leave 0.
+            "_u" | "_v" | "_w" => 0.0,
+            // No plug-in layer: never inside a remap, and one interpreter (rs274's reading).
+            "_remap_level" | "_task" => 0.0,
             "_call_level" => self.call_level,
             "_value" => self.value,
             "_value_returned" => self.value_returned,

@@ -420,8 +420,10 @@ impl<'a> Reader<'a> {
                 Ok(y.atan2(x).to_degrees())
             }
             _ => {
+                // A function's value is refused at once when not finite (`0 * EXP[1000]` is
+                // 'infinity', not 'not a number'), unlike an operator's.
                 let x = self.expression()?;
-                op.apply(x).map_err(|k| (k, at))
+                op.apply(x).and_then(finite).map_err(|k| (k, at))
             }
         }
     }
@@ -694,6 +696,18 @@ mod tests {
         assert_eq!(eval("-sqrt[4]"), Ok(-2.0));
         assert_eq!(eval("sqrt[-1]").unwrap_err().0, ErrorKind::SqrtOfNegative);
         assert_eq!(eval("[1/0]").unwrap_err().0, ErrorKind::DivisionByZero);
+    }
+
+    /// Where rs274 says 'infinity' and where 'not a number': a function's value is checked at
+    /// once, an operator's only when its bracket closes (the verdicts are rs274's, 2.9).
+    #[test]
+    fn non_finite_values_are_refused_as_rs274_refuses_them() {
+        let kind = |s: &str| eval(s).unwrap_err().0;
+        assert_eq!(kind("[0*exp[1000]]"), ErrorKind::Infinity);
+        assert_eq!(kind("[0eqexp[1000]]"), ErrorKind::Infinity);
+        assert_eq!(kind("[exp[1000]-exp[1000]]"), ErrorKind::Infinity);
+        assert_eq!(kind("[0*[10**1000]]"), ErrorKind::Infinity);
+        assert_eq!(kind("[0eq[10**400*0]]"), ErrorKind::NotANumber);
     }
 
     #[test]

@@ -74,7 +74,10 @@ const FAULTY: [&str; 14] = [
 ];
 
 /// Words that may ride along on a motion block.
-const EXTRAS: [&str; 8] = ["S1000", "M3", "M4", "M5", "M7", "M8", "M9", "S2500 M3"];
+const EXTRAS: [&str; 16] = [
+    "S1000", "M3", "M4", "M5", "M7", "M8", "M9", "S2500 M3", "M48", "M49", "M50 P0", "M50",
+    "M51 P0", "M52 P1", "M53 P0", "M53",
+];
 
 // ---------------------------------------------------------------------------------------------
 // Program model

@@ -225,6 +225,15 @@ fn check_other_words(
         || matches!(m(mgroup::IO), Some(62..=66))
         || m(mgroup::USER).is_some();
     rule(b'p', p_user, ErrorKind::PWordUnused)?;
+    // The turn count of a G2/G3 is checked here, before the block does anything (F, S, M48…).
+    if let (true, Some(w)) = (arc, block.word(b'p')) {
+        if (w.value - w.value.round()).abs() > 0.001 {
+            return Err((ErrorKind::ArcTurnsNotInteger, w.at));
+        }
+        if w.value.round() < 1.0 {
+            return Err((ErrorKind::ArcTurnsBelowOne, w.at));
+        }
+    }
     let q_user = g10
         || smoothing
         || block.g(ggroup::PATH_CONTROL) == Some(640)

@@ -108,7 +108,10 @@ impl Interpreter {
             }
             None => {}
         }
-        for group in [mgroup::IO, mgroup::OVERRIDE, mgroup::USER] {
+        if let Some(m) = block.m(mgroup::OVERRIDE) {
+            self.set_switches(m, block.get(b'p'), sink);
+        }
+        for group in [mgroup::IO, mgroup::USER] {
             if block.m[group].is_some() {
                 return Err(unsupported_m(block, group));
             }
@@ -234,6 +237,58 @@ impl Interpreter {
         if mode != FeedMode::InverseTime {
             self.state.feed_rate = 0.0;
             self.emit(sink, Canon::SetFeedRate(0.0));
+        }
+    }
+
+    /// M48–M53: which operator inputs act on the motion. `P0` turns one off, a missing or other
+    /// P on (LinuxCNC's reading); M48/M49 switch both overrides together.
+    fn set_switches(&mut self, m: u32, p: Option<f64>, sink: &mut impl CanonSink) {
+        let on = p != Some(0.0);
+        let s = &mut self.state.switches;
+        let calls: &[Canon] = match m {
+            48 | 49 => {
+                (s.feed_override, s.speed_override) = (m == 48, m == 48);
+                if m == 48 {
+                    &[Canon::EnableFeedOverride, Canon::EnableSpeedOverride]
+                } else {
+                    &[Canon::DisableFeedOverride, Canon::DisableSpeedOverride]
+                }
+            }
+            50 => {
+                s.feed_override = on;
+                if on {
+                    &[Canon::EnableFeedOverride]
+                } else {
+                    &[Canon::DisableFeedOverride]
+                }
+            }
+            51 => {
+                s.speed_override = on;
+                if on {
+                    &[Canon::EnableSpeedOverride]
+                } else {
+                    &[Canon::DisableSpeedOverride]
+                }
+            }
+            52 => {
+                s.adaptive_feed = on;
+                if on {
+                    &[Canon::EnableAdaptiveFeed]
+                } else {
+                    &[Canon::DisableAdaptiveFeed]
+                }
+            }
+            _ => {
+                s.feed_hold = on;
+                if on {
+                    &[Canon::EnableFeedHold]
+                } else {
+                    &[Canon::DisableFeedHold]
+                }
+            }
+        };
+        for call in calls {
+            self.emit(sink, call.clone());
         }
     }
 

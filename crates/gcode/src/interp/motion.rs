@@ -5,7 +5,7 @@
 
 use tezgah_geom::{FeedMode, Plane, Pose};
 
-use crate::block::{is_integer, Block, AXIS_LETTERS};
+use crate::block::{Block, AXIS_LETTERS};
 use crate::canon::{Canon, CanonSink};
 use crate::codes::ggroup;
 use crate::error::ErrorKind;
@@ -202,12 +202,8 @@ impl Interpreter {
                 at,
             ));
         }
-        let turns = match block.get(b'p') {
-            None => 1,
-            Some(p) if !is_integer(p) => return Err((ErrorKind::ArcTurnsNotInteger, at)),
-            Some(p) if p.round() < 1.0 => return Err((ErrorKind::ArcTurnsBelowOne, at)),
-            Some(p) => p.round() as i32,
-        };
+        // `checks` has made sure P is a whole number of at least 1.
+        let turns = block.get(b'p').map_or(1, |p| p.round() as i32);
         let start = self.comp_start();
         let end = self.find_ends(block);
         let s2 = [start.0[first], start.0[second]];

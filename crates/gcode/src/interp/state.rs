@@ -44,6 +44,9 @@ pub struct State {
     pub spindle_slot: crate::tooltable::Tool,
     pub mist: bool,
     pub flood: bool,
+    /// The operator's switches the program may lock (M48–M53): feed and spindle-speed
+    /// override, adaptive feed, feed hold.
+    pub switches: Switches,
     pub lathe_diameter: bool,
     /// G99 (retract to the R plane, LinuxCNC's default) or G98 (to the height before).
     pub retract_r_plane: bool,
@@ -80,11 +83,33 @@ impl Default for State {
             spindle_slot: Default::default(),
             mist: false,
             flood: false,
+            switches: Switches::default(),
             lathe_diameter: false,
             retract_r_plane: true,
             cycle: Default::default(),
             cycle_initial_level: None,
             naivecam_tolerance: 0.0,
+        }
+    }
+}
+
+/// Which operator inputs the program lets act on the motion (M48–M53). At start, as in
+/// LinuxCNC: both overrides and feed hold on, adaptive feed off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Switches {
+    pub feed_override: bool,
+    pub speed_override: bool,
+    pub adaptive_feed: bool,
+    pub feed_hold: bool,
+}
+
+impl Default for Switches {
+    fn default() -> Self {
+        Switches {
+            feed_override: true,
+            speed_override: true,
+            adaptive_feed: false,
+            feed_hold: true,
         }
     }
 }

@@ -49,7 +49,41 @@ impl Interpreter {
         v.spindle_cw = flag(s.spindle == Some(SpindleDir::Clockwise));
         v.mist = flag(s.mist);
         v.flood = flag(s.flood);
-        v.selected_tool = s.selected_tool.map_or(-1.0, |t| t as f64);
+        // rs274 2.9 reads 0 before any T (its documentation says −1).
+        v.selected_tool = s.selected_tool.map_or(0.0, |t| t as f64);
+        let pocket_of_row = |row: usize| {
+            if row == 0 {
+                s.spindle_slot.pocket
+            } else {
+                self.cfg
+                    .tool_table
+                    .iter()
+                    .find(|t| t.row == row)
+                    .map_or(0, |t| t.pocket)
+            }
+        };
+        v.selected_pocket = s.selected_tool.map_or(-1.0, |t| {
+            let row = self
+                .cfg
+                .tool_table
+                .get(t)
+                .filter(|_| t != 0)
+                .map_or(0, |t| t.row);
+            pocket_of_row(row) as f64
+        });
+        v.current_tool = s.spindle_slot.number.max(0) as f64;
+        v.current_pocket = pocket_of_row(s.current_pocket) as f64;
+        v.ccomp = match self.comp.side {
+            None => 400.0,
+            Some(super::comp::Side::Left) => 410.0,
+            Some(super::comp::Side::Right) => 420.0,
+        };
+        v.retract_r_plane = flag(s.retract_r_plane);
+        v.lathe_diameter = flag(s.lathe_diameter);
+        v.feed_override = flag(s.switches.feed_override);
+        v.speed_override = flag(s.switches.speed_override);
+        v.adaptive_feed = flag(s.switches.adaptive_feed);
+        v.feed_hold = flag(s.switches.feed_hold);
         let (pos, machine) = (v.position, v.machine_position);
         self.params.set6(params::CURRENT_POSITION, pos);
         self.params.set6(params::MACHINE_POSITION, machine);
