@@ -563,10 +563,14 @@ impl Executor {
         self.history = History::at_rest(drive);
     }
 
-    fn target(&self, factor: f64) -> f64 {
+    /// The time scale wanted: the override's, or the plan's own where the program locked the
+    /// override (M49, `M50 P0`, tapping).
+    fn target(&self, factor: f64, overridable: bool) -> f64 {
         match self.state {
             // Above 1 only as far as the pieces' overspeed limits allow (the time scale caps it).
-            RunState::Running => self.override_pct / 100.0 / factor,
+            RunState::Running if overridable => self.override_pct / 100.0 / factor,
+            // Its feeds were planned as programmed (`Job` applies no factor to them).
+            RunState::Running => 1.0,
             _ => 0.0,
         }
     }
@@ -615,11 +619,11 @@ impl Executor {
             return self.step_hold();
         }
         // The time scale moves with the plan's state where the tool is.
-        let factor = match &self.current {
-            Some(Current::Piece { factor, .. }) => *factor,
-            _ => 1.0,
+        let (factor, overridable) = match &self.current {
+            Some(Current::Piece { factor, cursor, .. }) => (*factor, overridable(cursor.piece())),
+            _ => (1.0, true),
         };
-        let target = self.target(factor);
+        let target = self.target(factor, overridable);
         if matches!(self.current, Some(Current::Piece { .. })) && self.peeked.is_none() {
             // The scale looks into the next piece (its limits may be lower).
             let factor = (self.override_pct / 100.0).max(1.0);
@@ -811,7 +815,9 @@ impl Executor {
     /// A piece's limits above its planned speed ([`crate::overspeed`]); worked out once per
     /// piece, when it is peeked or taken, so an override raised later reaches it too.
     fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
-        overspeed_limits(piece, &self.machine, &self.options.plan)
+        overridable(piece)
+            .then(|| overspeed_limits(piece, &self.machine, &self.options.plan))
+            .flatten()
     }
 
     /// Leaves the piece in hand at its exact end (every segment passed on the way counted);
@@ -924,6 +930,12 @@ pub fn restart_moves(program: &[Move], line: u32) -> Result<Vec<Move>, ExecError
     Ok(out)
 }
 
+/// Whether the feed override acts on a piece (the path builders stop where the program
+/// switches it, so a piece is wholly one or the other).
+fn overridable(piece: &tezgah_motion::plan::Piece) -> bool {
+    piece.segments.iter().all(|s| s.feed_override)
+}
+
 fn is_motion(kind: &MoveKind) -> bool {
     matches!(
         kind,
@@ -940,6 +952,7 @@ fn is_modal(kind: &MoveKind) -> bool {
             | MoveKind::SpindleSpeed { .. }
             | MoveKind::PathMode(_)
             | MoveKind::Smoothing(_)
+            | MoveKind::FeedOverride(_)
             | MoveKind::ToolControl { .. }
     )
 }

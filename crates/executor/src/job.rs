@@ -146,6 +146,8 @@ impl Job {
     fn push(&mut self, item: PathItem, factor: f64) -> Result<(), ExecError> {
         let item = match item {
             PathItem::Segment(mut seg) => {
+                // A segment under M49 / `M50 P0` runs at its programmed feed.
+                let factor = if seg.feed_override { factor } else { 1.0 };
                 seg.feed = match seg.feed {
                     SegmentFeed::Feed(f) => SegmentFeed::Feed(f * factor),
                     SegmentFeed::InverseTime(t) => SegmentFeed::InverseTime(t / factor),

@@ -571,6 +571,56 @@ fn override_scales_the_programmed_feed() {
     assert!(top <= 200.0 * (1.0 + 1e-9) && top > 150.0, "{top}");
 }
 
+/// The program may lock the override (M49, `M50 P0`; LinuxCNC's G84 does around the tap):
+/// there the feed is the programmed one at 50 % and at 150 %, and the dial acts again after
+/// `M50` / M48. The machine stops where the switch is (a planned piece is wholly one or the
+/// other); every joint stays within its limits.
+#[test]
+fn program_can_lock_the_feed_override() {
+    let peaks = |program: &str, percent: f64, bands: &[(f64, f64)]| -> Vec<f64> {
+        let mut exec = executor();
+        let mut trace = Trace::new(&exec);
+        exec.command(Command::FeedOverride { percent }).unwrap();
+        run_program(&mut exec, &mut trace, program);
+        let (out, report) = trace.report();
+        assert_within(&report, RETIME_JERK);
+        assert_continuous(&out);
+        bands
+            .iter()
+            .map(|&(lo, hi)| {
+                out.iter()
+                    .filter(|p| p.tip.x > lo && p.tip.x < hi && p.tip.z.abs() < 1e-9)
+                    .map(|p| p.feed)
+                    .fold(0.0, f64::max)
+            })
+            .collect()
+    };
+    let bands = [(10.0, 40.0), (60.0, 90.0), (110.0, 140.0), (160.0, 190.0)];
+    for (percent, scaled) in [(50.0, 5.0), (150.0, 15.0)] {
+        let program = "G21 G90 F600\nG1 X50\nM50 P0\nG1 X100\nM50\nG1 X150\nM49\nG1 X200\nM2\n";
+        let v = peaks(program, percent, &bands);
+        let want = [scaled, 10.0, scaled, 10.0];
+        for (got, want) in v.iter().zip(want) {
+            assert!((got - want).abs() < 1e-3 * want, "{percent} %: {v:?}");
+        }
+    }
+    // A right-hand tap: its feed down and out is the programmed one at 50 %.
+    let tap = "G21 G90 S500 M3 F300\nG0 X10 Z5\nG84 X10 Z-10 R2\nG80\nM2\n";
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::FeedOverride { percent: 50.0 })
+        .unwrap();
+    run_program(&mut exec, &mut trace, tap);
+    let (out, report) = trace.report();
+    assert_within(&report, RETIME_JERK);
+    let top = out
+        .iter()
+        .filter(|p| p.tip.z < -1.0 && p.tip.z > -9.0)
+        .map(|p| p.feed)
+        .fold(0.0, f64::max);
+    assert!((top - 5.0).abs() < 5e-3, "{top}");
+}
+
 /// At cruise a hold acts in the next period and stops in the time-optimal jerk-limited time
 /// (from 10 mm/s under mill3's path limits), rounded up to whole periods.
 #[test]

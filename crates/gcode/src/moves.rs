@@ -200,6 +200,8 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 self.push(line, MoveKind::FeedMode(mode));
             }
             Canon::SetSmoothing(on) => self.push(line, MoveKind::Smoothing(on)),
+            Canon::EnableFeedOverride => self.push(line, MoveKind::FeedOverride(true)),
+            Canon::DisableFeedOverride => self.push(line, MoveKind::FeedOverride(false)),
             Canon::SetMotionControlMode(m) => {
                 let mode = match m {
                     ControlMode::ExactStop => PathMode::ExactStop,

@@ -84,6 +84,10 @@ pub enum MoveKind {
     PathMode(PathMode),
     /// Fanuc's `G05.1 Q1` (true) / `Q0`: runs of short moves may be compressed into splines.
     Smoothing(bool),
+    /// Whether the operator's feed override acts on the moves from here on: M48 and M50 turn
+    /// it on, M49 and `M50 P0` off (the feed is then the programmed one, whatever the dial
+    /// says), as do the tapping cycles G74/G84 around their feed in and out.
+    FeedOverride(bool),
     /// Tool-centre-point control switched (G43.4 on, G49 off) or, under it, a new tool length.
     /// `at` is the current point in the coordinates of the new control (nothing moves here: the
     /// next move starts from `at`; a machine whose joints differ between the two readings of

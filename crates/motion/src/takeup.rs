@@ -113,6 +113,7 @@ fn joint_line(
         end: Junction::Stop,
         tolerance: next.tolerance,
         control: ToolControl::Joints,
+        feed_override: next.feed_override,
         tool_axis_travel: None,
         axis: None,
     })

@@ -44,6 +44,7 @@ fn segment(curve: Bezier, feed: f64) -> Segment {
         end: Junction::Smooth,
         tolerance: 0.01,
         control: Default::default(),
+        feed_override: true,
         tool_axis_travel: None,
         axis: None,
     }

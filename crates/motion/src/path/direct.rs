@@ -63,6 +63,8 @@ pub struct Direct {
     path_mode: PathMode,
     pending: Option<Segment>,
     control: ToolControl,
+    /// M48/M50 on, M49/`M50 P0` off.
+    feed_override: bool,
 }
 
 fn end_tangent(seg: &Segment) -> Option<Vec3> {
@@ -97,6 +99,7 @@ impl Direct {
             path_mode: PathMode::default(),
             pending: None,
             control: options.control,
+            feed_override: true,
         }
     }
 
@@ -162,6 +165,14 @@ impl Direct {
             }
             // The direct builder never compresses: G05.1 changes nothing here.
             MoveKind::Smoothing(_) => return Ok(()),
+            // The planner never groups across the switch: the machine stops there.
+            &MoveKind::FeedOverride(on) => {
+                if on != self.feed_override {
+                    self.flush(Junction::Stop, out);
+                    self.feed_override = on;
+                }
+                return Ok(());
+            }
             // TCP switched: stop; the next move starts from the same point read the new way.
             &MoveKind::ToolControl { control, at } => {
                 if !at.0.iter().all(|v| v.is_finite()) {
@@ -223,6 +234,7 @@ impl Direct {
             end: Junction::Stop,
             tolerance: self.tolerance(),
             control: self.control,
+            feed_override: self.feed_override,
             tool_axis_travel: None,
             axis: None,
         };

@@ -74,6 +74,9 @@ pub struct Segment {
     pub tolerance: f64,
     /// How the program axes reach the joints along this segment (TCP on or off).
     pub control: ToolControl,
+    /// Whether the operator's feed override may re-time this segment (M48/M50); `false` runs
+    /// it at the planned speed whatever the override (M49, `M50 P0`, tapping).
+    pub feed_override: bool,
     /// Under tool-centre-point control, the angle (degrees) the tool axis turns through on a
     /// segment that only turns it, which times the segment (DESIGN.md: F is then degrees per
     /// minute of that rotation). Set by the planner, which knows the machine; `None` times a

@@ -203,6 +203,9 @@ pub(crate) enum Tok {
     /// TCP switched (or its tool length changed): the machine stops before it, and nothing
     /// is compressed or blended across it.
     Control(ToolControl),
+    /// Feed override allowed or locked (M48–M50): a stop, as `Control`, so that a planned
+    /// piece is wholly one or the other.
+    FeedOverride(bool),
 }
 
 /// The modal state the moves run under.
@@ -216,6 +219,7 @@ struct Modal {
     mode: Mode,
     tolerance: f64,
     control: ToolControl,
+    feed_override: bool,
 }
 
 /// The streaming smoothing builder: an iterator of `Result<PathItem, PathError>`; after an
@@ -231,6 +235,8 @@ pub struct Smoother<I> {
     stats: Stats,
     /// The tool control of the segments being emitted (the tokens run ahead of it).
     control: ToolControl,
+    /// Whether feed override acts on the segments being emitted.
+    feed_override: bool,
 }
 
 /// Counts for reports and the compression ratio.
@@ -269,8 +275,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 mode: Mode::Continuous,
                 tolerance: opts.tolerance,
                 control: opts.control,
+                feed_override: true,
             },
             control: opts.control,
+            feed_override: true,
             opts,
             pending: None,
             out: VecDeque::new(),
@@ -335,6 +343,13 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 m.control = control;
                 m.pos = at;
                 return Ok(Some(Tok::Control(control)));
+            }
+            &MoveKind::FeedOverride(on) => {
+                if on == m.feed_override {
+                    return Ok(None);
+                }
+                m.feed_override = on;
+                return Ok(Some(Tok::FeedOverride(on)));
             }
             &MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
             &MoveKind::Stop(StopKind::Pause)
@@ -479,6 +494,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     self.flush(Junction::Stop);
                     self.control = control;
                 }
+                Tok::FeedOverride(on) => {
+                    self.flush(Junction::Stop);
+                    self.feed_override = on;
+                }
             }
         }
         if !more {
@@ -516,10 +535,10 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         }
     }
 
-    /// Queues a segment under the tool control in force.
-    /// Out with a segment, under the tool control in force.
+    /// Out with a segment, under the tool control and feed override switch in force.
     fn push_segment(&mut self, mut seg: Segment) {
         seg.control = self.control;
+        seg.feed_override = self.feed_override;
         self.out.push_back(PathItem::Segment(seg));
     }
 
@@ -581,6 +600,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                     end: Junction::Smooth,
                     tolerance: a.tolerance.min(b.tolerance),
                     control: self.control,
+                    feed_override: self.feed_override,
                     tool_axis_travel: None,
                     axis,
                 };

@@ -360,8 +360,9 @@ impl Piece {
             feed,
             end,
             tolerance: self.tolerance,
-            // The builder stamps the control in force when it emits the segment.
+            // The builder stamps the control and override switch in force when it emits it.
             control: tezgah_geom::ToolControl::Joints,
+            feed_override: true,
             tool_axis_travel: None,
             axis,
         }
