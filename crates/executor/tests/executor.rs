@@ -534,19 +534,26 @@ fn holds_found_by_random_search() {
     }
 }
 
+/// `program` run whole with the feed override at `percent` from the start; every joint within
+/// its limits (re-timing's jerk allowance) and the set-points continuous.
+fn run_at_override(program: &str, percent: f64) -> Vec<Produced> {
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    exec.command(Command::FeedOverride { percent }).unwrap();
+    run_program(&mut exec, &mut trace, program);
+    let (out, report) = trace.report();
+    assert_within(&report, RETIME_JERK);
+    assert_continuous(&out);
+    out
+}
+
 /// Override scales the feed both ways: 50 % halves the cruise speed at once, 200 % doubles it
 /// for moves planned after the change; the limits still cap it.
 #[test]
 fn override_scales_the_programmed_feed() {
     let program = "G21 G90 F600\nG1 X50\nG1 X100\nG1 X150\nM2\n";
     let peak = |percent: f64| {
-        let mut exec = executor();
-        let mut trace = Trace::new(&exec);
-        exec.command(Command::FeedOverride { percent }).unwrap();
-        run_program(&mut exec, &mut trace, program);
-        let (out, report) = trace.report();
-        assert_within(&report, RETIME_JERK);
-        assert_continuous(&out);
+        let out = run_at_override(program, percent);
         (out.iter().map(|p| p.feed).fold(0.0, f64::max), out.len())
     };
     let (v100, n100) = peak(100.0);
@@ -578,13 +585,7 @@ fn override_scales_the_programmed_feed() {
 #[test]
 fn program_can_lock_the_feed_override() {
     let peaks = |program: &str, percent: f64, bands: &[(f64, f64)]| -> Vec<f64> {
-        let mut exec = executor();
-        let mut trace = Trace::new(&exec);
-        exec.command(Command::FeedOverride { percent }).unwrap();
-        run_program(&mut exec, &mut trace, program);
-        let (out, report) = trace.report();
-        assert_within(&report, RETIME_JERK);
-        assert_continuous(&out);
+        let out = run_at_override(program, percent);
         bands
             .iter()
             .map(|&(lo, hi)| {
@@ -606,14 +607,7 @@ fn program_can_lock_the_feed_override() {
     }
     // A right-hand tap: its feed down and out is the programmed one at 50 %.
     let tap = "G21 G90 S500 M3 F300\nG0 X10 Z5\nG84 X10 Z-10 R2\nG80\nM2\n";
-    let mut exec = executor();
-    let mut trace = Trace::new(&exec);
-    exec.command(Command::FeedOverride { percent: 50.0 })
-        .unwrap();
-    run_program(&mut exec, &mut trace, tap);
-    let (out, report) = trace.report();
-    assert_within(&report, RETIME_JERK);
-    let top = out
+    let top = run_at_override(tap, 50.0)
         .iter()
         .filter(|p| p.tip.z < -1.0 && p.tip.z > -9.0)
         .map(|p| p.feed)

@@ -243,52 +243,43 @@ impl Interpreter {
     /// M48–M53: which operator inputs act on the motion. `P0` turns one off, a missing or other
     /// P on (LinuxCNC's reading); M48/M49 switch both overrides together.
     fn set_switches(&mut self, m: u32, p: Option<f64>, sink: &mut impl CanonSink) {
-        let on = p != Some(0.0);
-        let s = &mut self.state.switches;
-        let calls: &[Canon] = match m {
-            48 | 49 => {
-                (s.feed_override, s.speed_override) = (m == 48, m == 48);
-                if m == 48 {
-                    &[Canon::EnableFeedOverride, Canon::EnableSpeedOverride]
-                } else {
-                    &[Canon::DisableFeedOverride, Canon::DisableSpeedOverride]
-                }
-            }
-            50 => {
-                s.feed_override = on;
-                if on {
-                    &[Canon::EnableFeedOverride]
-                } else {
-                    &[Canon::DisableFeedOverride]
-                }
-            }
-            51 => {
-                s.speed_override = on;
-                if on {
-                    &[Canon::EnableSpeedOverride]
-                } else {
-                    &[Canon::DisableSpeedOverride]
-                }
-            }
-            52 => {
-                s.adaptive_feed = on;
-                if on {
-                    &[Canon::EnableAdaptiveFeed]
-                } else {
-                    &[Canon::DisableAdaptiveFeed]
-                }
-            }
-            _ => {
-                s.feed_hold = on;
-                if on {
-                    &[Canon::EnableFeedHold]
-                } else {
-                    &[Canon::DisableFeedHold]
-                }
-            }
+        let on = match m {
+            48 => true,
+            49 => false,
+            _ => p != Some(0.0),
         };
+        let s = &mut self.state.switches;
+        let mut calls = Vec::with_capacity(2);
+        let mut set = |flag: &mut bool, enable: Canon, disable: Canon| {
+            *flag = on;
+            calls.push(if on { enable } else { disable });
+        };
+        use Canon::*;
+        if matches!(m, 48..=50) {
+            set(
+                &mut s.feed_override,
+                EnableFeedOverride,
+                DisableFeedOverride,
+            );
+        }
+        if matches!(m, 48 | 49 | 51) {
+            set(
+                &mut s.speed_override,
+                EnableSpeedOverride,
+                DisableSpeedOverride,
+            );
+        }
+        match m {
+            52 => set(
+                &mut s.adaptive_feed,
+                EnableAdaptiveFeed,
+                DisableAdaptiveFeed,
+            ),
+            53 => set(&mut s.feed_hold, EnableFeedHold, DisableFeedHold),
+            _ => {}
+        }
         for call in calls {
-            self.emit(sink, call.clone());
+            self.emit(sink, call);
         }
     }
 
