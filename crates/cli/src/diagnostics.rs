@@ -3,41 +3,25 @@
 //! The library's errors carry a `Span`; here they become `miette` reports with the source.
 
 use miette::{miette, LabeledSpan, NamedSource, Report};
+use tezgah_gcode::sources::{Source, SourceLine, Sources};
 use tezgah_gcode::{Canon, CanonSink, GcodeError, Origin, Span};
-
-use crate::source::{Source, SourceLine, Sources};
 
 /// A report naming `file:line:col` and underlining the place in the file the error is in (the
 /// program, or a subroutine file it called).
 pub fn report(sources: &Sources, e: &GcodeError) -> Report {
-    let Some(file) = &e.file else {
-        return located(&sources.program, e.span, 0, &e.kind.to_string());
-    };
-    let message = format!(
-        "{} (in a subroutine called from {})",
-        e.kind, sources.program.name
-    );
-    match sources.named(file) {
-        Some(source) => located(source, e.span, 0, &message),
+    let error = sources.error_at(e);
+    match error.source {
+        Some(source) => located(source, e.span, 0, &error.message),
         // Not loaded (cannot happen for an error inside it): name it without its text.
-        None => miette!("{file}:{}: {message}", e.span),
+        None => miette!("{}: {}", error.at, error.message),
     }
 }
 
 /// A report for an error known only by its line (the path and the kinematics keep lines, not
 /// columns): `file:line:col` of the line's first word, the line's words underlined.
 pub fn report_line(sources: &Sources, at: SourceLine, message: &str) -> Report {
-    let source = sources.file(at.file);
-    let text = &source.text;
-    let start: usize = text
-        .split_inclusive('\n')
-        .take((at.line as usize).saturating_sub(1))
-        .map(str::len)
-        .sum();
-    let body = text[start.min(text.len())..].lines().next().unwrap_or("");
-    let indent = body.len() - body.trim_start().len();
-    let span = Span::in_line(at.line, body, start, indent);
-    located(source, span, body.trim().len().max(1), message)
+    let line = sources.line_at(at);
+    located(line.source, line.span, line.width, message)
 }
 
 /// `file:line:col: message`, with `width` bytes from the span underlined (a point for 0).

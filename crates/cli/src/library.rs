@@ -29,6 +29,10 @@ impl SubroutineLibrary for Folders {
         let bytes = std::fs::read(self.locate(name)?).ok()?;
         Some(String::from_utf8_lossy(&bytes).into_owned())
     }
+
+    fn path(&self, name: &str) -> Option<PathBuf> {
+        self.locate(name)
+    }
 }
 
 /// The subroutine library, INI file and parameter file of a program.

@@ -9,7 +9,6 @@ mod library;
 mod plot;
 mod run;
 mod serve;
-mod source;
 mod tracking;
 
 use std::path::{Path, PathBuf};
@@ -18,7 +17,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use library::Inputs;
 use miette::{IntoDiagnostic, Result};
-use source::{Pass, Sources};
+use tezgah_gcode::sources::{self, Pass, Sources};
 use tezgah_gcode::{Canon, CanonSink, Config, Interpreter, Origin};
 
 #[derive(Parser)]
@@ -115,8 +114,8 @@ fn canon(program: &Path, inputs: &Inputs) -> Result<ExitCode> {
     match result {
         Ok(()) => Ok(ExitCode::SUCCESS),
         Err(e) => {
-            let sources =
-                Sources::new(program, text).with_subroutines(&interp, |name| extra.locate(name));
+            let sources = Sources::new(program.display().to_string(), text)
+                .with_subroutines(&interp, |name| extra.locate(name));
             eprintln!("{:?}", diagnostics::report(&sources, &e));
             Ok(ExitCode::FAILURE)
         }
@@ -156,8 +155,8 @@ fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitC
         Some(_) => Pass::CheckMoves,
         None => Pass::Check,
     };
-    let done = source::interpret(
-        Sources::new(program, text),
+    let done = sources::interpret(
+        Sources::new(program.display().to_string(), text),
         config,
         pass,
         |name| extra.locate(name),

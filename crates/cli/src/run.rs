@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
+use tezgah_gcode::sources::{interpret, LineKeys, Pass, Sources};
 use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
 use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
@@ -15,7 +16,6 @@ use tezgah_motion::verify::{Report, Verifier};
 
 use crate::diagnostics::report_line;
 use crate::plot::Trace;
-use crate::source::{interpret, LineKeys, Pass, Sources};
 use crate::tracking::{DriveKind, Tracker, Tracking};
 
 /// The path a machine will follow, checked whole before anything moves.
@@ -31,8 +31,8 @@ pub struct BuiltPath {
 /// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
 /// the tolerance, G61 keeps corners, G61.1 stops at every block end), then the pre-flight:
 /// every segment within the machine's reach and joint limits, else a report naming the file,
-/// line and column. `moves` carry `keys` numbers ([`crate::source`]); the path returned carries
-/// plain line numbers.
+/// line and column. `moves` carry `keys` numbers ([`tezgah_gcode::sources`]); the path
+/// returned carries plain line numbers.
 pub fn build_path(
     sources: &Sources,
     keys: &LineKeys,
@@ -63,7 +63,12 @@ pub fn build_path(
         .map_err(|e| miette!("the start pose: {e}"))?;
     tezgah_motion::preflight::check_path(&items, &pm, start_joints)
         .map_err(|e| report_line(sources, keys.source(e.line), &e.source.to_string()))?;
-    keys.unkey(&mut items);
+    if !keys.is_plain() {
+        for item in &mut items {
+            let line = item.line_mut();
+            *line = keys.plain(*line);
+        }
+    }
     Ok(BuiltPath {
         items,
         pm,
@@ -75,19 +80,10 @@ pub fn build_path(
 /// A path builder's error at the file, line and column of its move (the message without its
 /// own `line N:`, which would give the key).
 fn path_error(sources: &Sources, keys: &LineKeys, e: &smooth::PathError) -> miette::Report {
-    use smooth::PathError as P;
-    let line = match e {
-        P::Curve { line, .. }
-        | P::Feed { line, .. }
-        | P::FeedPerRevolution { line }
-        | P::Tolerance { line, .. } => *line,
-        P::Option { .. } => return miette!("{e}"),
-    };
-    let text = e.to_string();
-    let message = text
-        .strip_prefix(&format!("line {line}: "))
-        .unwrap_or(&text);
-    report_line(sources, keys.source(line), message)
+    match e.line() {
+        Some(line) => report_line(sources, keys.source(line), &e.detail()),
+        None => miette!("{e}"),
+    }
 }
 
 pub const DEMO: &str = include_str!("../../../examples/demo.ngc");
@@ -184,7 +180,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
     let done = interpret(
-        Sources::new(&path_name, text),
+        Sources::new(path_name.display().to_string(), text),
         config,
         Pass::Run,
         |name| extra.locate(name),

@@ -5,6 +5,7 @@
 
 use std::io::ErrorKind;
 use std::net::{TcpListener, TcpStream};
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -38,6 +39,10 @@ pub struct ServeArgs {
     /// both are asked for, best effort, with a warning when the system refuses).
     #[arg(long)]
     pub no_realtime: bool,
+    /// A folder of subroutine files `<name>.ngc` for loaded programs and MDI (repeatable;
+    /// a loaded program arrives as text, so it has no folder of its own).
+    #[arg(long = "subroutine-path")]
+    pub subroutine_path: Vec<PathBuf>,
 }
 
 /// A message from a client: a command with an optional id that its reply echoes.
@@ -73,7 +78,11 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
         return Err(miette!("--lead-ms must be > 0, got {}", args.lead_ms));
     }
     let ring = ((args.lead_ms / 1000.0 / period).ceil() as usize).max(2);
-    let executor = Executor::new(&machine, options, Pose::ZERO).map_err(|e| miette!("{e}"))?;
+    let mut executor = Executor::new(&machine, options, Pose::ZERO).map_err(|e| miette!("{e}"))?;
+    let inputs = crate::library::program_inputs(None, None, None, &args.subroutine_path)?;
+    if let Some(library) = inputs.subroutines {
+        executor = executor.with_subroutines(library);
+    }
     // Shared by the connections: each request waits for its own answer only.
     let realtime = if args.no_realtime {
         RealtimeSettings::OFF

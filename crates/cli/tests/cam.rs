@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{assert_joints_within_limits, assert_success, read_json, tezgah, tmp, TOOLS};
+use common::{tezgah, tmp};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PostOptions};
 use tezgah_cam::{Cutter, CutterLocation, CutterShape, Pass, ToolPath};
 use tezgah_geom::{NurbsSurface, Vec3};
@@ -67,34 +67,12 @@ fn cylinder_job() -> ToolPath {
     }
 }
 
+/// `check` and `run` on table-ac ([`common::check_and_run`]), and the run ends where the
+/// program's last block says.
 fn check_and_run(program: &str, name: &str) -> serde_json::Value {
-    let ngc = tmp(&format!("{name}.ngc"));
-    std::fs::write(&ngc, program).unwrap();
-    let out = tezgah()
-        .arg("check")
-        .arg(&ngc)
-        .args(["--tool-table", TOOLS])
-        .output()
-        .unwrap();
-    assert_success(&out, &format!("check\n{program}"));
-    let json = tmp(&format!("{name}.json"));
+    std::fs::write(tmp(&format!("{name}.ngc")), program).unwrap();
     let csv = tmp(&format!("{name}.csv"));
-    let out = tezgah()
-        .arg("run")
-        .arg(&ngc)
-        .args(["--machine", "table-ac", "--tool-table", TOOLS, "--report"])
-        .arg(&json)
-        .arg("--samples")
-        .arg(&csv)
-        .output()
-        .unwrap();
-    assert_success(&out, "run");
-    let report = read_json(&json);
-    assert_joints_within_limits(&report, false, name);
-    assert!(
-        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
-        "{report}"
-    );
+    let report = common::check_and_run(name, Some(&csv));
     // The machine ends where the program's last block says, read the way the output form
     // means it: under TCP the samples' tip is X Y Z; with joint output (TCP off, G43) the
     // joints are X Y Z with the tool length (28.5 mm) added to Z, A and C.

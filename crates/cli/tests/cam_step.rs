@@ -8,7 +8,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::{assert_joints_within_limits, assert_success, read_json, tezgah, tmp, TOOLS};
+use common::{check_and_run, read_json, tezgah, tmp, TOOLS};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,35 +43,6 @@ fn cam(name: &str, surface: &str, extra: &[&str]) -> (serde_json::Value, String,
         std::fs::read_to_string(&ngc).unwrap(),
         stderr,
     )
-}
-
-/// `tezgah check` accepts the program and `tezgah run --machine table-ac` executes it with
-/// every joint's peaks within 0.5 % of its limits and the path within 0.01 mm; the run report.
-fn check_and_run(name: &str) -> serde_json::Value {
-    let ngc = tmp(&format!("{name}.ngc"));
-    let out = tezgah()
-        .arg("check")
-        .arg(&ngc)
-        .args(["--tool-table", TOOLS])
-        .output()
-        .unwrap();
-    assert_success(&out, &format!("check {name}"));
-    let json = tmp(&format!("{name}-run.json"));
-    let out = tezgah()
-        .arg("run")
-        .arg(&ngc)
-        .args(["--machine", "table-ac", "--tool-table", TOOLS, "--report"])
-        .arg(&json)
-        .output()
-        .unwrap();
-    assert_success(&out, &format!("run {name}"));
-    let report = read_json(&json);
-    assert_joints_within_limits(&report, false, name);
-    assert!(
-        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
-        "{name}: {report}"
-    );
-    report
 }
 
 /// The tip (X Y Z, part frame under G43.4) of every feed block, G1 being modal.
@@ -154,7 +125,7 @@ fn free_form_patch_iso_scallop_is_verified_and_runs_on_table_ac() {
         f(&report, "path_length_mm") >= 100.0 * 100.0 / f(&report, "step_over_mm"),
         "{report}"
     );
-    let run = check_and_run("freeform");
+    let run = check_and_run("freeform", None);
     // The run takes at least the cutting time at the programmed feed.
     assert!(
         f(&run, "cycle_time_s") >= f(&report, "machining_time_s"),
@@ -201,7 +172,7 @@ fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
     }
     assert!(lowest < rim + 2.0, "lowest cut {lowest}, rim {rim}");
     assert!(f(&report, "gouge_depth_mm") <= 0.001, "{report}");
-    check_and_run("sphere");
+    check_and_run("sphere", None);
 }
 
 #[test]
@@ -250,7 +221,7 @@ fn sphere_cap_iso_scallop_along_parallels_is_verified_to_the_pole() {
             .any(|p| p[0].hypot(p[1]) < 1e-3 && p[2] >= radius && p[2] <= radius + tol),
         "the pole is cut (its point shifted out by the one-sided band, within the tolerance)"
     );
-    check_and_run("sphere-iso");
+    check_and_run("sphere-iso", None);
 }
 
 /// The largest and smallest table tilt (the A words) of a program, degrees.
@@ -318,7 +289,7 @@ fn vertical_cylinder_side_is_machined_with_the_table_at_90_degrees() {
         f(sphere, "radius_mm") > f(sphere, "part_radius_mm"),
         "{report}"
     );
-    check_and_run("cylinder");
+    check_and_run("cylinder", None);
 }
 
 #[test]
@@ -345,7 +316,7 @@ fn twisted_blade_face_is_machined_past_vertical_within_the_tilt_range() {
     let (a_min, a_max) = tilt_range(&program);
     assert!(a_max > 90.0 && a_max <= 120.0, "A {a_min} … {a_max}");
     assert!(a_min >= -30.0, "A {a_min} … {a_max}");
-    check_and_run("blade");
+    check_and_run("blade", None);
 }
 
 #[test]
@@ -369,7 +340,7 @@ fn twisted_blade_face_iso_scallop_holds_the_scallop_over_its_rounded_edge() {
         ],
     );
     assert_meets_issue_7(&report, h, true);
-    check_and_run("blade-iso");
+    check_and_run("blade-iso", None);
 }
 
 #[test]

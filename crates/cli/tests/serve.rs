@@ -1,7 +1,10 @@
 //! `tezgah serve` end to end: the binary on a free port, a WebSocket client that loads and
-//! runs a program, mixes in MDI, holds, resumes and aborts, and reads the status stream. The
-//! executor runs on the wall clock here, so the checks are on states and positions, never on
-//! timings.
+//! runs a program, mixes in MDI, holds, resumes and aborts, and reads the status stream; a
+//! program calling subroutine files from `--subroutine-path`, refused with the file's place or
+//! run. The executor runs on the wall clock here, so the checks are on states and positions,
+//! never on timings.
+
+mod common;
 
 use std::io::{BufRead, BufReader};
 use std::net::TcpStream;
@@ -25,9 +28,15 @@ impl Drop for Server {
 }
 
 fn start() -> (Server, Socket) {
+    start_with(&[])
+}
+
+/// The server with `extra` options.
+fn start_with(extra: &[&str]) -> (Server, Socket) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_tezgah"))
         .args(["serve", "--listen", "127.0.0.1:0", "--lead-ms", "200"])
         .args(["--status-ms", "10"])
+        .args(extra)
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
@@ -165,4 +174,40 @@ fn serve_runs_programs_mdi_hold_resume_and_abort_over_a_websocket() {
     assert_eq!(end["underruns"], 0);
     let r = request(&mut ws, json!({"command": "close"}));
     assert_eq!(r["ok"], false);
+}
+
+#[test]
+fn serve_loads_subroutine_files_and_names_them_in_errors() {
+    let dir = common::tmp_dir("serve-subs");
+    // Line 3 of far.ngc leaves mill3's X range; near.ngc ends at X20 Y5.
+    for (name, body) in [
+        ("far", "G1 X10\n  G1 X5000\n"),
+        ("near", "G1 X10\nG1 X20 Y5\n"),
+    ] {
+        let text = format!("o<{name}> sub\n{body}o<{name}> endsub\nM2\n");
+        std::fs::write(dir.join(format!("{name}.ngc")), text).unwrap();
+    }
+    let (_server, mut ws) = start_with(&["--subroutine-path", dir.to_str().unwrap()]);
+    // The program's line 3 is blank: the file's line 3 taken for the program's would show.
+    let program = |name: &str| format!("G21 G90\nF3000\n\no<{name}> call\nM2\n");
+    let r = request(
+        &mut ws,
+        json!({"id": 1, "command": "load", "program": program("far")}),
+    );
+    assert_eq!(r["ok"], false, "{r}");
+    let place = format!(
+        "{}:3:3: out of reach before anything moves",
+        dir.join("far.ngc").display()
+    );
+    assert!(r["error"].as_str().unwrap().contains(&place), "{r}");
+    let r = request(
+        &mut ws,
+        json!({"id": 2, "command": "load", "program": program("near")}),
+    );
+    assert_eq!(r["ok"], true, "{r}");
+    let r = request(&mut ws, json!({"id": 3, "command": "cycle_start"}));
+    assert_eq!(r["ok"], true, "{r}");
+    wait_for(&mut ws, |s| {
+        state(s) == "idle" && (tip(s)[0] - 20.0).abs() < 1e-9 && (tip(s)[1] - 5.0).abs() < 1e-9
+    });
 }

@@ -1,5 +1,7 @@
 //! The executor's typed errors: refused commands and failures of the motion stack below.
 
+use tezgah_gcode::sources::Located;
+
 /// Why a command was refused or a job failed.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum ExecError {
@@ -16,6 +18,10 @@ pub enum ExecError {
     NoSuchLine(u32),
     #[error("program: {0}")]
     Gcode(String),
+    /// An error of the interpreter or the path builder at a place in the program or in a
+    /// subroutine file it called.
+    #[error("{at}: {message}")]
+    At { at: Located, message: String },
     #[error("path: {0}")]
     Path(tezgah_motion::path::smooth::PathError),
     #[error("plan: {0}")]
@@ -34,8 +40,10 @@ pub enum ExecError {
     NotHomed { command: &'static str },
     #[error("no jog in progress")]
     NotJogging,
-    #[error("line {line}: out of reach before anything moves: {message}")]
-    Preflight { line: u32, message: String },
+    /// The pre-flight found a pose out of reach or past a joint limit, at `at` (the program's
+    /// line, or a subroutine file's).
+    #[error("{at}: out of reach before anything moves: {message}")]
+    Preflight { at: Located, message: String },
 }
 
 impl From<tezgah_motion::interpolate::InterpolateError> for ExecError {

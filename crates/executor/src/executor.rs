@@ -8,6 +8,7 @@
 
 use std::sync::Arc;
 
+use tezgah_gcode::interp::SubroutineLibrary;
 use tezgah_geom::{Move, MoveKind, Pose, StopKind, Vec3};
 use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
@@ -22,6 +23,7 @@ use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
 use crate::overspeed::overspeed_limits;
+use crate::program::{Origins, Program};
 use crate::scale::{PieceView, TimeScale};
 use crate::setpoint::{History, SetPoint};
 use crate::speed_override::Override;
@@ -105,7 +107,7 @@ pub struct Executor {
     machine_file: Machine,
     options: ExecOptions,
     gcode: tezgah_gcode::Config,
-    program: Option<Vec<Move>>,
+    program: Option<Program>,
     job: Option<Job>,
     current: Option<Current>,
     /// The planned item after the current one, taken early for the time scale's look-ahead.
@@ -241,6 +243,15 @@ impl Executor {
         self.switches = switches;
     }
 
+    /// Subroutines in files of their own (`o<name> call` of a name the program lacks), for
+    /// loaded programs and MDI, as `--subroutine-path` gives `tezgah run`. Set before the
+    /// first MDI block: the MDI interpreter starts afresh with it.
+    pub fn with_subroutines(mut self, library: Arc<dyn SubroutineLibrary>) -> Self {
+        self.gcode.subroutines = Some(library);
+        self.mdi = Mdi::new(self.gcode.clone());
+        self
+    }
+
     /// The joints as the drives see them (power-on frame): the status' joints plus the
     /// homing offsets. A real-time side starts from these.
     pub fn drive_joints(&self) -> Joints {
@@ -354,14 +365,23 @@ impl Executor {
     /// Builds the whole path of `moves` from `start` with the executor's smoothing options
     /// and checks every segment's joints against reach and limits (motion's pre-flight), so
     /// a program that would leave the machine's work space is refused before anything moves;
-    /// the job then plans that same path.
-    fn preflight(&self, moves: Vec<Move>, start: Pose) -> Result<BuiltPath, ExecError> {
-        let path = BuiltPath::build(moves, &self.machine, &self.job_options(), start)?;
+    /// the job then plans that same path. Errors name the place `origins` gives the moves'
+    /// lines; the path returned carries plain line numbers.
+    fn preflight(
+        &self,
+        moves: Vec<Move>,
+        start: Pose,
+        origins: &Origins,
+    ) -> Result<BuiltPath, ExecError> {
+        let mut path = BuiltPath::build(moves, &self.machine, &self.job_options(), start).map_err(
+            |e| match e {
+                ExecError::Path(e) => origins.path_error(e),
+                other => other,
+            },
+        )?;
         tezgah_motion::preflight::check_path(path.items(), &self.machine, self.pose.joints)
-            .map_err(|e| ExecError::Preflight {
-                line: e.line,
-                message: e.source.to_string(),
-            })?;
+            .map_err(|e| origins.preflight_error(&e))?;
+        path.plain_lines(origins.keys());
         Ok(path)
     }
 
@@ -373,7 +393,12 @@ impl Executor {
         Ok(())
     }
 
-    fn start_job(&mut self, moves: Vec<Move>, mode: Mode) -> Result<(), ExecError> {
+    fn start_job(
+        &mut self,
+        moves: Vec<Move>,
+        mode: Mode,
+        origins: &Origins,
+    ) -> Result<(), ExecError> {
         let start = self.program_pose();
         // The loaded program's path was built and checked at load; again if the machine
         // moved since or single block changed (it builds another path).
@@ -384,7 +409,7 @@ impl Executor {
         };
         let built = match self.built.take_if(fits) {
             Some(b) => b,
-            None => self.preflight(moves, start)?,
+            None => self.preflight(moves, start, origins)?,
         };
         let job = Job::new(built, &self.machine, self.options.plan, self.pose.joints)?;
         self.job = Some(job);
@@ -412,19 +437,18 @@ impl Executor {
                 if self.state != RunState::Idle {
                     return Err(self.busy("load"));
                 }
-                let moves = tezgah_gcode::program_moves(&program, self.gcode.clone())
-                    .map_err(|e| ExecError::Gcode(e.to_string()))?;
+                let program = Program::interpret(program, &self.gcode)?;
                 let here = self.program_pose();
-                self.built = Some(self.preflight(moves.clone(), here)?);
-                self.program = Some(moves);
+                self.built = Some(self.preflight(program.moves.clone(), here, &program.origins)?);
+                self.program = Some(program);
                 self.mode = Mode::Auto;
                 Ok(())
             }
             Command::CycleStart | Command::Resume => match self.state {
                 RunState::Idle => {
                     self.check_homed("cycle start")?;
-                    let moves = self.program.clone().ok_or(ExecError::NoProgram)?;
-                    self.start_job(moves, Mode::Auto)
+                    let program = self.program.clone().ok_or(ExecError::NoProgram)?;
+                    self.start_job(program.moves, Mode::Auto, &program.origins)
                 }
                 RunState::Held | RunState::Paused { .. } | RunState::Holding => {
                     self.state = RunState::Running;
@@ -494,7 +518,7 @@ impl Executor {
                 }
                 // A block the pre-flight refuses leaves the modal moves as they were (the
                 // interpreter's position is re-synchronised before the next block anyway).
-                self.start_job(job, Mode::Mdi)?;
+                self.start_job(job, Mode::Mdi, &Origins::mdi(&block))?;
                 self.mdi_modal = modal;
                 Ok(())
             }
@@ -504,10 +528,11 @@ impl Executor {
                 }
                 self.check_homed("restart")?;
                 let program = self.program.as_ref().ok_or(ExecError::NoProgram)?;
-                let moves = restart_moves(program, line)?;
+                let moves = restart_moves(&program.moves, line)?;
+                let origins = Arc::clone(&program.origins);
                 // A restart starts elsewhere than the program: built and checked whole.
                 self.built = None;
-                self.start_job(moves, Mode::Auto)
+                self.start_job(moves, Mode::Auto, &origins)
             }
             Command::Jog {
                 joint,

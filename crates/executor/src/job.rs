@@ -8,6 +8,7 @@
 
 use std::collections::{HashMap, VecDeque};
 
+use tezgah_gcode::sources::LineKeys;
 use tezgah_geom::{Move, MoveKind, PathMode, Pose, StopKind, Vec3};
 use tezgah_kinematics::Joints;
 use tezgah_motion::path::smooth::SmoothOptions;
@@ -79,6 +80,23 @@ impl BuiltPath {
 
     pub fn items(&self) -> &[PathItem] {
         &self.items
+    }
+
+    /// Gives the path plain line numbers (each in its own file), once the pre-flight has
+    /// located its errors by the keyed ones the moves carried (`tezgah_gcode::sources`).
+    pub fn plain_lines(&mut self, keys: &LineKeys) {
+        if keys.is_plain() {
+            return;
+        }
+        for item in &mut self.items {
+            let line = item.line_mut();
+            *line = keys.plain(*line);
+        }
+        self.stops = self
+            .stops
+            .drain()
+            .map(|(line, kind)| (keys.plain(line), kind))
+            .collect();
     }
 
     /// The pose the path starts from.

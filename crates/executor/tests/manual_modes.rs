@@ -1,15 +1,21 @@
 //! JOG, INC and HOME through the executor on a virtual clock (mill3): the set-point stream
 //! they produce (limits by finite differences, the velocity/acceleration contract, no jump),
 //! their distances against closed forms, the homing offsets, refusals while busy, and the
-//! pre-flight refusing a program out of reach at load.
+//! pre-flight refusing a program out of reach at load, with the file, line and column of the
+//! error also inside a subroutine file.
 
 mod support;
+
+use std::sync::Arc;
 
 use support::*;
 use tezgah_executor::command::{Command, Direction, Mode, RunState};
 use tezgah_executor::error::ExecError;
 use tezgah_executor::executor::{ExecOptions, Executor, Produced};
 use tezgah_executor::manual::SimulatedSwitches;
+use tezgah_gcode::interp::SubroutineLibrary;
+use tezgah_gcode::sources::Located;
+use tezgah_gcode::Span;
 use tezgah_geom::Pose;
 use tezgah_kinematics::{Joints, Machine};
 
@@ -466,8 +472,8 @@ fn a_program_past_a_limit_is_refused_at_load_and_nothing_moves() {
         })
         .unwrap_err();
     match &e {
-        ExecError::Preflight { line, message } => {
-            assert_eq!(*line, 3);
+        ExecError::Preflight { at, message } => {
+            assert_eq!((at.file.as_str(), at.span.line), ("program", 3));
             assert!(
                 message.contains('x') || message.contains("limit"),
                 "{message}"
@@ -498,6 +504,69 @@ fn a_program_past_a_limit_is_refused_at_load_and_nothing_moves() {
     run_program(&mut exec, &mut trace, "G1 X50 F1000\nG1 Y20\nM2\n");
     let (_, report) = trace.report();
     assert_within_limits(&report);
+}
+
+/// Subroutine files held in memory: (name, text).
+#[derive(Debug)]
+struct Files(Vec<(&'static str, String)>);
+
+impl SubroutineLibrary for Files {
+    fn source(&self, name: &str) -> Option<String> {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, t)| t.clone())
+    }
+}
+
+/// Loads a program whose line 4 calls subroutine `far`, with `body` as the file's lines 2 on;
+/// the program's line 3 is blank, so an error that took the file's line 3 for the program's
+/// would show. The load must be refused and leave nothing loaded.
+fn load_with_sub(body: &str) -> ExecError {
+    let file = format!("o<far> sub\n{body}o<far> endsub\nM2\n");
+    let mut exec = executor().with_subroutines(Arc::new(Files(vec![("far", file)])));
+    let e = exec
+        .command(Command::Load {
+            program: "G21 G90\nF1000\n\no<far> call\nM2\n".into(),
+        })
+        .unwrap_err();
+    assert!(!exec.status().program_loaded, "{e}");
+    e
+}
+
+#[test]
+fn load_errors_inside_a_subroutine_file_name_that_file_line_and_column() {
+    // The pre-flight: line 3 of far.ngc leaves mill3's X range [-200, 200]; its first word is
+    // in column 3, byte 2 of the line, which starts at byte 11 + 7 of the file.
+    let e = load_with_sub("G1 X10\n  G1 X5000\n");
+    let ExecError::Preflight { at, message } = &e else {
+        panic!("{e}");
+    };
+    let span = Span {
+        line: 3,
+        column: 3,
+        offset: 20,
+    };
+    assert_eq!(
+        at,
+        &Located {
+            file: "far.ngc".into(),
+            span
+        }
+    );
+    assert!(message.contains("outside its limits [-200, 200]"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("far.ngc:3:3: out of reach before anything moves: joint 0 (`x`)"),
+        "{e}"
+    );
+    // The interpreter: `Y` without a value on the file's line 3, column 8.
+    let e = load_with_sub("G1 X10\nG1 X5 Y\n");
+    assert_eq!(
+        e.to_string(),
+        "far.ngc:3:8: No characters found in reading real value \
+         (in a subroutine called from program)"
+    );
 }
 
 #[test]

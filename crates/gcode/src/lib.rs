@@ -3,7 +3,8 @@
 //! The flow inside this crate is: [`lexer`] (one line, normalised, spans kept) → [`block`]
 //! (words, evaluated with [`reader`]'s expressions and [`params`]) → [`interp`] (modal state,
 //! offsets, units, arcs) → [`canon`] calls, which [`moves`] turns into `tezgah_geom::Move`s for
-//! the planner. Nothing here knows about files or terminals.
+//! the planner; [`sources`] is the one pass that callers (`check`, `run`, the executor's load)
+//! make of it, and where their errors are. Nothing here knows about files or terminals.
 
 pub mod block;
 pub mod canon;
@@ -17,6 +18,7 @@ pub mod lexer;
 pub mod moves;
 pub mod params;
 pub mod reader;
+pub mod sources;
 pub mod span;
 pub mod tooltable;
 

@@ -16,14 +16,16 @@
 //! The ratios ours/bound are printed (`--nocapture`); they are recorded in NOTES-plan.md, not
 //! asserted beyond the bound itself and a generous ceiling for the lines-and-arcs pocket.
 
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 
-use tezgah_geom::{ArcLengthMap, Curve, Move, Pose, Vec3};
+use tezgah_geom::{ArcLengthMap, Curve, Move, Vec3};
 use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::run;
-use tezgah_motion::path::smooth::{self, SmoothOptions};
-use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::plan::PlanMachine;
 use tezgah_motion::{Junction, PathItem, SegmentFeed};
 
 /// Waypoint spacing along the path handed to TOPP-RA, mm (at least 8 per segment).
@@ -73,28 +75,12 @@ fn moves_of(text: &str) -> Vec<Move> {
     tezgah_gcode::program_moves(text, config).unwrap()
 }
 
-fn items_of(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
-    smooth::build(
-        moves.iter().cloned(),
-        &SmoothOptions {
-            tolerance: machine.motion.tolerance_mm,
-            start: Pose::ZERO,
-            ..SmoothOptions::default()
-        },
-    )
-    .unwrap()
-}
-
 /// Our duration of the items (plan + interpolate, as `tezgah run`).
 fn ours(items: Vec<PathItem>, machine: &Machine) -> f64 {
     run(
         items,
         PlanMachine::from_machine(machine).unwrap(),
-        PlanOptions {
-            period: machine.motion.period_s,
-            chord_share: smooth::CHORD_SHARE,
-            ..PlanOptions::default()
-        },
+        common::plan_options(machine),
         (Vec3::zeros(), [0.0; 3]),
         |_, _| {},
     )
@@ -193,32 +179,14 @@ fn pocket() -> String {
     s
 }
 
-/// Dense surfacing: zig-zag passes of 0.05–0.3 mm moves over a smooth bump.
-fn surfacing(passes: usize) -> String {
-    let mut s = String::from("G21 G90 G94 G64\nF3000\n");
-    let mut seed: u64 = 12345;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let z = |x: f64, y: f64| 2.0 * (-(x - 30.0).powi(2) / 400.0 - (y - 5.0).powi(2) / 100.0).exp();
-    for pass in 0..passes {
-        let y = pass as f64 * 0.5;
-        let (mut x, dir) = if pass % 2 == 0 {
-            (0.0, 1.0)
-        } else {
-            (60.0, -1.0)
-        };
-        s.push_str(&format!("G1 X{x:.4} Y{y:.4} Z{:.4}\n", z(x, y)));
-        while (0.0..=60.0).contains(&x) {
-            x += dir * (0.05 + 0.25 * next());
-            s.push_str(&format!("G1 X{x:.4} Y{y:.4} Z{:.4}\n", z(x, y)));
-        }
+/// Dense surfacing as the benches generate it: 4 passes, no approach or retract.
+fn surfacing() -> String {
+    common::Surfacing {
+        opening: "G21 G90 G94 G64\nF3000\n",
+        passes: 4,
+        closing: "M2\n",
     }
-    s.push_str("M2\n");
-    s
+    .program()
 }
 
 /// A saw-tooth of 2 mm moves turning 90° at every vertex (all blended under G64).
@@ -240,7 +208,7 @@ fn g64_cycle_time_is_at_least_the_toppra_bound() {
     let machine = Machine::default_machine();
     let programs = [
         ("pocket", pocket(), Some(3.0)),
-        ("surfacing", surfacing(4), None),
+        ("surfacing", surfacing(), None),
         ("saw 90°", saw(), None),
         (
             "demo",
@@ -250,7 +218,7 @@ fn g64_cycle_time_is_at_least_the_toppra_bound() {
     ];
     for (name, text, ceiling) in programs {
         let moves = moves_of(&text);
-        let items = items_of(&moves, &machine);
+        let items = common::smooth_items(&moves, &machine);
         let bound = toppra_bound(&python, &items, &machine);
         let ours = ours(items, &machine);
         let ratio = ours / bound;
@@ -330,7 +298,7 @@ fn g61_1_cycle_time_against_per_block_ruckig() {
         p = q4;
     }
     text.push_str("M2\n");
-    let items = items_of(&moves_of(&text), &machine);
+    let items = common::smooth_items(&moves_of(&text), &machine);
     let ours_lines = ours(items, &machine);
     let bound: f64 = ruckig_rest_to_rest(&python, &lines).iter().sum();
     println!(
@@ -346,7 +314,7 @@ fn g61_1_cycle_time_against_per_block_ruckig() {
     // its net travel, and length/feed, each bound the block from below.
     let text = pocket().replace("G64", "G61.1");
     let moves = moves_of(&text);
-    let items = items_of(&moves, &machine);
+    let items = common::smooth_items(&moves, &machine);
     let mut cases = vec![];
     let mut per_block = vec![];
     let mut last = Vec3::zeros();

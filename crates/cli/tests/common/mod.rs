@@ -1,5 +1,6 @@
 //! What the binary's end-to-end tests share: the binary, a scratch folder, the example tool
-//! table, and the checks every run report must pass (success, joint peaks within limits).
+//! table, the checks every run report must pass (success, joint peaks within limits), and the
+//! `check`-then-`run` of a posted program on table-ac that the CAM tests end with.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -69,4 +70,37 @@ pub fn assert_joints_within_limits(report: &serde_json::Value, moving: bool, wha
             );
         }
     }
+}
+
+/// `tezgah check` accepts the program `tmp("{name}.ngc")` and `tezgah run --machine table-ac`
+/// executes it with every joint's peaks within 0.5 % of its limits and the path within
+/// 0.01 mm; the run report (`tmp("{name}-run.json")`). With `samples`, the run writes its
+/// samples CSV there.
+pub fn check_and_run(name: &str, samples: Option<&Path>) -> serde_json::Value {
+    let ngc = tmp(&format!("{name}.ngc"));
+    let out = tezgah()
+        .arg("check")
+        .arg(&ngc)
+        .args(["--tool-table", TOOLS])
+        .output()
+        .unwrap();
+    assert_success(&out, &format!("check {name}"));
+    let json = tmp(&format!("{name}-run.json"));
+    let mut run = tezgah();
+    run.arg("run")
+        .arg(&ngc)
+        .args(["--machine", "table-ac", "--tool-table", TOOLS, "--report"])
+        .arg(&json);
+    if let Some(csv) = samples {
+        run.arg("--samples").arg(csv);
+    }
+    let out = run.output().unwrap();
+    assert_success(&out, &format!("run {name}"));
+    let report = read_json(&json);
+    assert_joints_within_limits(&report, false, name);
+    assert!(
+        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{name}: {report}"
+    );
+    report
 }

@@ -12,13 +12,14 @@
 //! and with a_p capped at A a plateau of (σ(v_t − v₀) − (2A² − a₀²)/(2J))/A. Phase times:
 //! t₁ = (a_p − σa₀)/J, t₂ = the plateau, t₃ = a_p/J.
 
+use tezgah_motion::profile::knots::{self, Knot};
 use tezgah_motion::profile::State;
 
 /// A ramp of three constant-jerk phases, then cruise at the target speed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VelocityRamp {
     /// Phase start times (index 3: the end) and states there.
-    knots: [(f64, State); 4],
+    knots: [Knot; 4],
 }
 
 impl VelocityRamp {
@@ -47,29 +48,10 @@ impl VelocityRamp {
         let durations = [((a_p - sigma * a0) / j).max(0.0), plateau, a_p / j];
         let jerks = [sigma * j, 0.0, -sigma * j];
         let mut knots = [(0.0, State::default()); 4];
-        let (mut t, mut x) = (
-            0.0,
-            State {
-                a: a0,
-                j: 0.0,
-                ..start
-            },
-        );
-        for k in 0..3 {
-            knots[k] = (t, State { j: jerks[k], ..x });
-            x = advance(x, jerks[k], durations[k]);
-            t += durations[k];
-        }
+        knots::integrate(start, &durations, &jerks, &mut knots);
         // The end is the target speed at rest in acceleration (rounding left aside).
-        knots[3] = (
-            t,
-            State {
-                v: target,
-                a: 0.0,
-                j: 0.0,
-                ..x
-            },
-        );
+        knots[3].1.v = target;
+        knots[3].1.a = 0.0;
         VelocityRamp { knots }
     }
 
@@ -94,19 +76,7 @@ impl VelocityRamp {
     /// The state at `t` after the start: exact on each phase; after the end it cruises at the
     /// target speed; before the start (or NaN) it is the start state.
     pub fn state_at(&self, t: f64) -> State {
-        if t >= self.duration() {
-            let (te, x) = self.knots[3];
-            return State {
-                s: x.s + x.v * (t - te),
-                ..x
-            };
-        }
-        if t.is_nan() || t <= 0.0 {
-            return self.knots[0].1;
-        }
-        let k = (0..3).rev().find(|&k| self.knots[k].0 <= t).unwrap_or(0);
-        let (t0, x) = self.knots[k];
-        advance(x, x.j, t - t0)
+        knots::state_at(&self.knots, t, || self.knots[0].1)
     }
 }
 
@@ -115,20 +85,11 @@ pub fn stopping_displacement(state: State, max_acceleration: f64, max_jerk: f64)
     VelocityRamp::new(state, 0.0, max_acceleration, max_jerk).distance()
 }
 
-/// Integrates a constant-jerk phase of length `dt`.
-fn advance(x: State, j: f64, dt: f64) -> State {
-    State {
-        s: x.s + dt * (x.v + dt * (0.5 * x.a + dt * j / 6.0)),
-        v: x.v + dt * (x.a + 0.5 * dt * j),
-        a: x.a + dt * j,
-        j,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+    use tezgah_motion::profile::knots::advance;
     use tezgah_motion::profile::{min_stopping_distance, speed_change_time, Limits};
 
     fn at(v: f64, a: f64) -> State {

@@ -675,6 +675,11 @@ impl Interpreter {
 pub trait SubroutineLibrary: std::fmt::Debug + Send + Sync {
     /// The text of the file that defines subroutine `name` (lower case), if there is one.
     fn source(&self, name: &str) -> Option<String>;
+
+    /// Where that file was read from, for reports to name it (else they say `<name>.ngc`).
+    fn path(&self, _name: &str) -> Option<std::path::PathBuf> {
+        None
+    }
 }
 
 /// A subroutine file the interpreter has loaded.

@@ -1,7 +1,8 @@
 //! The programs the motion benches and the `stages` example run, in one place so that every
 //! figure in BENCHMARKS.md is measured on the same input: the `run` pipeline's dense surfacing
 //! and lines-and-arcs programs, and the path bench's 1 M-move programs, with the stage set-ups
-//! `tezgah run` uses. Included with `#[path]` (benches and examples cannot share a module).
+//! `tezgah run` uses. Included with `#[path]` (benches, examples and tests cannot share a
+//! module); the cycle-time oracle test takes its surfacing program from here too.
 #![allow(dead_code)]
 
 use std::fmt::Write;
@@ -17,30 +18,53 @@ pub const SEGMENTS: usize = 1_000_000;
 
 /// Dense 3-axis surfacing: zig-zag passes of 0.05–0.3 mm segments over a smooth bump.
 pub fn surfacing() -> String {
-    let mut s = String::from("G21 G90 G94 G64\nF3000\nG0 X0 Y0 Z2\nG1 Z0\n");
-    let mut seed: u64 = 12345;
-    let mut next = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let z = |x: f64, y: f64| 2.0 * (-(x - 30.0).powi(2) / 400.0 - (y - 5.0).powi(2) / 100.0).exp();
-    for pass in 0..20 {
-        let y = pass as f64 * 0.5;
-        let (mut x, dir) = if pass % 2 == 0 {
-            (0.0, 1.0)
-        } else {
-            (60.0, -1.0)
-        };
-        let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
-        while (0.0..=60.0).contains(&x) {
-            x += dir * (0.05 + 0.25 * next());
-            let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
-        }
+    Surfacing {
+        opening: "G21 G90 G94 G64\nF3000\nG0 X0 Y0 Z2\nG1 Z0\n",
+        passes: 20,
+        closing: "G0 Z5\nM2\n",
     }
-    s.push_str("G0 Z5\nM2\n");
-    s
+    .program()
+}
+
+/// The dense surfacing program's frame: the lines before the first pass and after the last,
+/// and how many 60 mm passes (0.5 mm apart in Y) lie between. The benches run 20 passes
+/// with an approach and a retract; the cycle-time oracle test 4 passes without them (the
+/// TOPP-RA ratios in BENCHMARKS.md were measured on that program).
+pub struct Surfacing<'a> {
+    pub opening: &'a str,
+    pub passes: usize,
+    pub closing: &'a str,
+}
+
+impl Surfacing<'_> {
+    /// The program text; the same seed every time, so every run measures the same moves.
+    pub fn program(&self) -> String {
+        let mut s = String::from(self.opening);
+        let mut seed: u64 = 12345;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let z =
+            |x: f64, y: f64| 2.0 * (-(x - 30.0).powi(2) / 400.0 - (y - 5.0).powi(2) / 100.0).exp();
+        for pass in 0..self.passes {
+            let y = pass as f64 * 0.5;
+            let (mut x, dir) = if pass % 2 == 0 {
+                (0.0, 1.0)
+            } else {
+                (60.0, -1.0)
+            };
+            let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
+            while (0.0..=60.0).contains(&x) {
+                x += dir * (0.05 + 0.25 * next());
+                let _ = writeln!(s, "G1 X{x:.4} Y{y:.4} Z{:.4}", z(x, y));
+            }
+        }
+        s.push_str(self.closing);
+        s
+    }
 }
 
 /// Long lines and arcs: a pocket outline of 100 mm lines and R10 corners, several depths.

@@ -156,3 +156,14 @@ pub enum PathItem {
         line: u32,
     },
 }
+
+impl PathItem {
+    /// The source line the item carries, to renumber (a caller that keyed its moves' lines
+    /// gives the built path its plain numbers back).
+    pub fn line_mut(&mut self) -> &mut u32 {
+        match self {
+            PathItem::Segment(s) => &mut s.line,
+            PathItem::Dwell { line, .. } | PathItem::Stop { line } => line,
+        }
+    }
+}

@@ -7,6 +7,7 @@
 //! (tests/ruckig_oracle.rs).
 
 mod error;
+pub mod knots;
 mod limits;
 mod phases;
 mod ramp;

@@ -4,9 +4,10 @@
 //!
 //! Phase layout: jerk +σ₁J, 0, −σ₁J (speed change v0 → vm, σ₁ = ±1), cruise at vm (jerk 0),
 //! jerk +σ₂J, 0, −σ₂J (vm → v1). σ₁ = +1, σ₂ = −1 is the usual speed-up-then-slow-down; the
-//! other signs give slow-down-then-speed-up and monotone shapes. Within a phase of jerk j, from
-//! (s, v, a): v(τ) = v + aτ + jτ²/2, s(τ) = s + vτ + aτ²/2 + jτ³/6 (exact for constant jerk).
+//! other signs give slow-down-then-speed-up and monotone shapes. The phases are integrated and
+//! walked as a knot table ([`super::knots`], exact cubics), shared with the executor's ramp.
 
+use super::knots;
 use super::ramp::Ramp;
 
 /// Position, velocity, acceleration and jerk at one instant (mm, mm/s, mm/s², mm/s³).
@@ -33,14 +34,7 @@ impl Profile {
     /// the solver guarantees it, so this is not public.
     pub(crate) fn from_phases(start: State, durations: [f64; 7], jerks: [f64; 7]) -> Profile {
         let mut knots = [(0.0, State::default()); 8];
-        let (mut t, mut x) = (0.0, State { j: 0.0, ..start });
-        for k in 0..7 {
-            let (dt, j) = (durations[k], jerks[k]);
-            knots[k] = (t, State { j, ..x });
-            x = advance(x, j, dt);
-            t += dt;
-        }
-        knots[7] = (t, State { j: 0.0, ..x });
+        knots::integrate(start, &durations, &jerks, &mut knots);
         Profile {
             durations,
             jerks,
@@ -118,42 +112,19 @@ impl Profile {
     /// after the end the motion continues at the end speed (zero acceleration and jerk), as
     /// Ruckig's trajectories do. NaN gives the start state.
     pub fn state_at(&self, t: f64) -> State {
-        if t >= self.duration() {
-            let (t_end, x) = self.knots[7];
-            return State {
-                s: x.s + x.v * (t - t_end),
-                ..x
-            };
-        }
-        if t.is_nan() || t <= 0.0 {
+        knots::state_at(&self.knots, t, || {
+            // The jerk of the first phase that lasts (a zero-length one is never entered).
             let first_j = self
                 .durations
                 .iter()
                 .zip(self.jerks)
                 .find(|(d, _)| **d > 0.0)
                 .map_or(0.0, |(_, j)| j);
-            return State {
+            State {
                 j: first_j,
                 ..self.knots[0].1
-            };
-        }
-        // Last phase that starts at or before t (phases of zero duration are skipped over).
-        let k = (0..7).rev().find(|&k| self.knots[k].0 <= t).unwrap_or(0);
-        let (t0, x) = self.knots[k];
-        State {
-            j: x.j,
-            ..advance(x, x.j, t - t0)
-        }
-    }
-}
-
-/// Integrates a constant-jerk phase of length `dt` (the module comment's cubic).
-fn advance(x: State, j: f64, dt: f64) -> State {
-    State {
-        s: x.s + dt * (x.v + dt * (0.5 * x.a + dt * j / 6.0)),
-        v: x.v + dt * (x.a + 0.5 * dt * j),
-        a: x.a + dt * j,
-        j,
+            }
+        })
     }
 }
 

@@ -28,3 +28,27 @@ pub enum PathError {
     #[error("smoothing option {name} = {value} is out of range")]
     Option { name: &'static str, value: f64 },
 }
+
+impl PathError {
+    /// The source line of the move the error is about (an option's error has none).
+    pub fn line(&self) -> Option<u32> {
+        match self {
+            PathError::Curve { line, .. }
+            | PathError::Feed { line, .. }
+            | PathError::FeedPerRevolution { line }
+            | PathError::Tolerance { line, .. } => Some(*line),
+            PathError::Option { .. } => None,
+        }
+    }
+
+    /// The message without its `line N: `, for reports that name the place themselves.
+    pub fn detail(&self) -> String {
+        let text = self.to_string();
+        match self.line() {
+            Some(line) => text
+                .strip_prefix(&format!("line {line}: "))
+                .map_or_else(|| text.clone(), str::to_owned),
+            None => text,
+        }
+    }
+}

@@ -1,20 +1,21 @@
 //! Where a program's moves and errors come from: the program and the subroutine files it
-//! loaded, so that every error names the file, line and column of its block. `check` and `run`
-//! interpret a program once, here, and hand the moves on to the path and its pre-flight.
+//! loaded, so that every error names the file, line and column of its block. `tezgah check`,
+//! `tezgah run` and the executor's load interpret a program once, here, and hand the moves on
+//! to the path and its pre-flight; their reports locate errors through [`Sources`].
 //!
 //! A move keeps only a line number (`tezgah_geom::Move::line`), so a line of a subroutine file
 //! would read as the program's line of the same number. Until the motion stages carry the file,
 //! the moves given to them number the lines of subroutine files past the program's last line
 //! ([`LineKeys`]); a pre-flight error is turned back into its (file, line), and the built path
-//! into plain line numbers, before anything is reported or run.
+//! into plain line numbers ([`LineKeys::plain`]), before anything is reported or run.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
-use tezgah_gcode::{Canon, CanonSink, Config, GcodeError, Interpreter, MoveBuilder, Origin};
 use tezgah_geom::Move;
-use tezgah_motion::PathItem;
+
+use crate::{Canon, CanonSink, Config, GcodeError, Interpreter, MoveBuilder, Origin, Span};
 
 /// A line of the program (`file` 0) or of the `file`-th subroutine file it loaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -67,23 +68,20 @@ impl LineKeys {
         }
     }
 
-    /// Back to plain line numbers (each in its own file), as samples and reports print them.
-    pub fn unkey(&self, items: &mut [PathItem]) {
-        if self.lines.is_empty() {
-            return;
-        }
-        for item in items {
-            let line = match item {
-                PathItem::Segment(s) => &mut s.line,
-                PathItem::Dwell { line, .. } | PathItem::Stop { line } => line,
-            };
-            *line = self.source(*line).line;
-        }
+    /// The plain line number (in its own file) of a move's number, as samples and reports
+    /// print it.
+    pub fn plain(&self, key: u32) -> u32 {
+        self.source(key).line
+    }
+
+    /// Whether every number is already plain (no subroutine file gave a move).
+    pub fn is_plain(&self) -> bool {
+        self.lines.is_empty()
     }
 }
 
 fn memchr_count(bytes: &[u8]) -> usize {
-    bytes.iter().filter(|&&b| b == b'\n').count()
+    memchr::memchr_iter(b'\n', bytes).count()
 }
 
 /// One text errors may point into.
@@ -102,12 +100,12 @@ pub struct Sources {
 }
 
 impl Sources {
-    /// A program with no subroutine file loaded yet (an owned `String` is moved, not copied
-    /// twice).
-    pub fn new(path: &Path, text: impl Into<Arc<str>>) -> Self {
+    /// A program named `name` (the path it was read from) with no subroutine file loaded yet
+    /// (an owned `String` is moved, not copied twice).
+    pub fn new(name: impl Into<String>, text: impl Into<Arc<str>>) -> Self {
         Sources {
             program: Source {
-                name: path.display().to_string(),
+                name: name.into(),
                 text: text.into(),
             },
             subs: Vec::new(),
@@ -145,6 +143,96 @@ impl Sources {
             .iter()
             .find(|(n, _)| n == file_name)
             .map(|(_, s)| s)
+    }
+
+    /// Where an error known only by its line is reported (the path and the kinematics keep
+    /// lines, not columns): the line's first word, with the line's words as its width. The
+    /// one column rule of every such report.
+    pub fn line_at(&self, at: SourceLine) -> LineAt<'_> {
+        let source = self.file(at.file);
+        let text = &source.text;
+        let start: usize = text
+            .split_inclusive('\n')
+            .take((at.line as usize).saturating_sub(1))
+            .map(str::len)
+            .sum();
+        let body = text[start.min(text.len())..].lines().next().unwrap_or("");
+        let indent = body.len() - body.trim_start().len();
+        LineAt {
+            source,
+            span: Span::in_line(at.line, body, start, indent),
+            width: body.trim().len().max(1),
+        }
+    }
+
+    /// Where an interpreter error is and what it says: in the program, or in the subroutine
+    /// file it names, whose message then says which program called it.
+    pub fn error_at(&self, e: &GcodeError) -> ErrorAt<'_> {
+        let Some(file) = &e.file else {
+            return ErrorAt {
+                source: Some(&self.program),
+                at: Located {
+                    file: self.program.name.clone(),
+                    span: e.span,
+                },
+                message: e.kind.to_string(),
+            };
+        };
+        let source = self.named(file);
+        ErrorAt {
+            source,
+            at: Located {
+                file: source.map_or_else(|| file.clone(), |s| s.name.clone()),
+                span: e.span,
+            },
+            message: format!(
+                "{} (in a subroutine called from {})",
+                e.kind, self.program.name
+            ),
+        }
+    }
+}
+
+/// An interpreter error for people: its place, the text it is in (`None` for a subroutine
+/// file that was not loaded, which an error inside it cannot be) and its message.
+#[derive(Debug, Clone)]
+pub struct ErrorAt<'a> {
+    pub source: Option<&'a Source>,
+    pub at: Located,
+    pub message: String,
+}
+
+/// A line's place in its file: the text, the span of its first word, and the bytes its words
+/// take.
+#[derive(Debug, Clone, Copy)]
+pub struct LineAt<'a> {
+    pub source: &'a Source,
+    pub span: Span,
+    pub width: usize,
+}
+
+impl LineAt<'_> {
+    /// `file:line:col`, as every report starts.
+    pub fn located(&self) -> Located {
+        Located {
+            file: self.source.name.clone(),
+            span: self.span,
+        }
+    }
+}
+
+/// A place named for people: the file and the line and column in it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Located {
+    /// How the file is named: the path it was read from, `<name>.ngc` for a subroutine file
+    /// whose folder is not known, or the name the caller gave the program.
+    pub file: String,
+    pub span: Span,
+}
+
+impl std::fmt::Display for Located {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}", self.file, self.span)
     }
 }
 
@@ -246,5 +334,31 @@ mod tests {
         assert_eq!(keys.source(a), sub(3));
         assert_eq!(keys.source(b), sub(1));
         assert_eq!(keys.source(2), SourceLine { file: 0, line: 2 });
+    }
+
+    #[test]
+    fn a_line_is_placed_at_its_first_word_in_its_own_file() {
+        let sources = Sources::new("main.ngc", "G0 X1\n\u{e9}  G1 X2\n");
+        // Line 2 starts at byte 6 with a word (the two-byte é): column 1, the whole line wide.
+        let at = sources.line_at(SourceLine { file: 0, line: 2 });
+        assert_eq!(
+            at.located(),
+            Located {
+                file: "main.ngc".into(),
+                span: Span {
+                    line: 2,
+                    column: 1,
+                    offset: 6
+                }
+            }
+        );
+        assert_eq!(at.width, "\u{e9}  G1 X2".len());
+        let indented = Sources::new("main.ngc", "G0 X1\n   G1 X2\n");
+        let at = indented.line_at(SourceLine { file: 0, line: 2 });
+        assert_eq!((at.span.column, at.span.offset, at.width), (4, 9, 5));
+        assert_eq!(at.located().to_string(), "main.ngc:2:4");
+        // A line past the end is placed at the end, never out of the text.
+        let at = indented.line_at(SourceLine { file: 0, line: 9 });
+        assert_eq!((at.span.line, at.span.offset), (9, 15));
     }
 }
