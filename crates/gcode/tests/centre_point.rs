@@ -79,7 +79,7 @@ fn moves_carry_the_tip_under_tcp_and_the_gauge_point_without() {
                 format!("CentrePoint {{ tool_length: 35.0 }} {}", z(-35.0))
             ),
             (3, format!("feed {}", z(5.0))),
-            (4, format!("Joints {}", z(40.0))),
+            (4, format!("Joints {{ tool_length: 0.0 }} {}", z(40.0))),
             (5, format!("feed {}", z(10.0))),
         ]
     );

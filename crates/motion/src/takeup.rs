@@ -52,9 +52,39 @@ impl TakeUp {
         }
     }
 
+    /// Whether `item` is a segment under another reading of the program point than the one
+    /// before (TCP switched, or its tool length changed): the machine is then at rest before
+    /// it, and the caller may run everything before it and give the joints reached to
+    /// [`TakeUp::before_from`].
+    pub fn switches(&self, item: &PathItem) -> bool {
+        matches!(item, PathItem::Segment(seg) if !seg.control.same_reading(&self.control))
+    }
+
     /// The take-up segment to run before `item` (a segment under another control than the
-    /// one before), or `None`.
+    /// one before), or `None`. The old joints are worked out from the last segment's end,
+    /// nearest the joints of the previous switch: exact where the program angles are the
+    /// joints (trunnions), but an endless C that follows the tip (Y-Z-C-A) and turned more
+    /// than half a turn since may come out a turn off; prefer [`TakeUp::before_from`] where
+    /// the joints reached are known.
     pub fn before(&mut self, item: &PathItem) -> Result<Option<PathItem>, TakeUpError> {
+        self.take_up(item, None)
+    }
+
+    /// As [`TakeUp::before`], from `reached`: the joints the machine actually reached (the
+    /// interpolator's last sample) at the end of the last segment, which pick its turn.
+    pub fn before_from(
+        &mut self,
+        item: &PathItem,
+        reached: &Joints,
+    ) -> Result<Option<PathItem>, TakeUpError> {
+        self.take_up(item, Some(reached))
+    }
+
+    fn take_up(
+        &mut self,
+        item: &PathItem,
+        reached: Option<&Joints>,
+    ) -> Result<Option<PathItem>, TakeUpError> {
         let PathItem::Segment(seg) = item else {
             return Ok(None);
         };
@@ -65,10 +95,13 @@ impl TakeUp {
         let (a, b) = seg.curve.domain();
         let start = (seg.curve.point(a), seg.rotary[0]);
         let mut out = None;
-        if seg.control != self.control {
+        if !seg.control.same_reading(&self.control) {
             let m = &self.machine;
+            // The last segment's end, on the turn nearest the joints reached there (the last
+            // sample may fall just short of the end, off the period grid).
+            let near = reached.unwrap_or(&self.joints);
             let old = m
-                .joints(self.control, &self.end.0, &self.end.1, &self.joints)
+                .joints(self.control, &self.end.0, &self.end.1, near)
                 .map_err(err)?;
             let new = m
                 .joints(seg.control, &start.0, &start.1, &old)
@@ -83,9 +116,10 @@ impl TakeUp {
                     joint_line(m, &old, &new, seg).map_err(err)?,
                 ));
             }
-            self.control = seg.control;
             self.joints = new;
         }
+        // A new G43 length with TCP off reads the same joints: only remembered.
+        self.control = seg.control;
         self.end = (seg.curve.point(b), seg.rotary[1]);
         Ok(out)
     }
@@ -112,7 +146,7 @@ fn joint_line(
         feed: SegmentFeed::Rapid,
         end: Junction::Stop,
         tolerance: next.tolerance,
-        control: ToolControl::Joints,
+        control: ToolControl::OFF,
         tool_axis_travel: None,
         axis: None,
     })

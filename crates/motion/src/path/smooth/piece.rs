@@ -361,7 +361,7 @@ impl Piece {
             end,
             tolerance: self.tolerance,
             // The builder stamps the control in force when it emits the segment.
-            control: tezgah_geom::ToolControl::Joints,
+            control: tezgah_geom::ToolControl::OFF,
             tool_axis_travel: None,
             axis,
         }
