@@ -70,8 +70,8 @@ impl TakeUp {
         self.take_up(item, None)
     }
 
-    /// As [`TakeUp::before`], from `reached`: the joints the machine actually reached (the
-    /// interpolator's last sample) at the end of the last segment, which pick its turn.
+    /// As [`TakeUp::before`], from `reached`: the joints the machine actually stands at, at
+    /// the end of the last segment (the interpolator's exact end pose, not a sample).
     pub fn before_from(
         &mut self,
         item: &PathItem,
@@ -97,12 +97,12 @@ impl TakeUp {
         let mut out = None;
         if !seg.control.same_reading(&self.control) {
             let m = &self.machine;
-            // The last segment's end, on the turn nearest the joints reached there (the last
-            // sample may fall just short of the end, off the period grid).
-            let near = reached.unwrap_or(&self.joints);
-            let old = m
-                .joints(self.control, &self.end.0, &self.end.1, near)
-                .map_err(err)?;
+            let old = match reached {
+                Some(q) => *q,
+                None => m
+                    .joints(self.control, &self.end.0, &self.end.1, &self.joints)
+                    .map_err(err)?,
+            };
             let new = m
                 .joints(seg.control, &start.0, &start.1, &old)
                 .map_err(err)?;
@@ -150,4 +150,53 @@ fn joint_line(
         tool_axis_travel: None,
         axis: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tezgah_kinematics::Machine;
+
+    fn line(a: Vec3, b: Vec3, rotary: [f64; 3], control: ToolControl) -> PathItem {
+        let l = Line::new(a, b).unwrap();
+        PathItem::Segment(Segment {
+            length: l.length(),
+            curve: Box::new(l),
+            rotary: [rotary, rotary],
+            line: 1,
+            feed: SegmentFeed::Rapid,
+            end: Junction::Stop,
+            tolerance: 0.01,
+            control,
+            tool_axis_travel: None,
+            axis: None,
+        })
+    }
+
+    /// The take-up starts from the joints given as reached — here C a turn on from where the
+    /// end point's joints alone would put it — and turns C back by that turn, not from the
+    /// joints worked out from the program point.
+    #[test]
+    fn the_take_up_starts_from_the_joints_reached() {
+        let pm = PlanMachine::from_machine(&Machine::builtin("table-ac").unwrap()).unwrap();
+        let tcp = ToolControl::CentrePoint { tool_length: 35.0 };
+        let (p, q) = (Vec3::new(10.0, 5.0, 20.0), Vec3::new(20.0, 5.0, 20.0));
+        let rotary = [30.0, 0.0, 40.0];
+        let start = pm
+            .joints(ToolControl::OFF, &p, &rotary, &Joints::zeros(5))
+            .unwrap();
+        let mut takeup = TakeUp::new(&pm, (p, rotary), start);
+        assert!(takeup.before(&line(p, q, rotary, tcp)).unwrap().is_some());
+        let off = line(q, p, rotary, ToolControl::OFF);
+        assert!(takeup.switches(&off));
+        let mut reached = pm.joints(tcp, &q, &rotary, &start).unwrap();
+        reached.as_mut_slice()[4] += std::f64::consts::TAU;
+        let Some(PathItem::Segment(t)) = takeup.before_from(&off, &reached).unwrap() else {
+            panic!("a take-up is needed");
+        };
+        assert!((t.rotary[0][2] - 400.0).abs() < 1e-9, "{:?}", t.rotary);
+        assert!((t.rotary[1][2] - 40.0).abs() < 1e-9, "{:?}", t.rotary);
+        let from = pm.joint_mode_point(&reached).unwrap().0;
+        assert!((t.curve.point(t.curve.domain().0) - from).norm() < 1e-12);
+    }
 }
