@@ -358,3 +358,28 @@ M2
         "tip",
     );
 }
+
+/// The delta: the forward map of the carriage heights (reference 002), less
+/// G43's 35 mm, is the program point; no tool axis but +Z.
+#[test]
+fn linear_delta_tip_is_the_program_point_under_g43() {
+    let machine = Machine::builtin("linear-delta").unwrap();
+    let program = "G21 G90 G94\nG43 H1\nG0 X10 Y5 Z-20\nG1 X-15 Y12 Z-30 F3000\nM2\n";
+    let (rows, report) = run_program(&machine, program);
+    assert_within_limits(&report);
+    for r in rows.iter().filter(|r| r.sample.line >= 3) {
+        near(
+            &r.pose.tip,
+            &(r.sample.tip - Vec3::new(0.0, 0.0, 35.0)),
+            1e-9,
+            "tip",
+        );
+        near(&r.pose.axis.into_inner(), &Vec3::z(), 1e-15, "axis");
+    }
+    near(
+        &rows.last().unwrap().pose.tip,
+        &Vec3::new(-15.0, 12.0, -30.0),
+        1e-9,
+        "end",
+    );
+}
