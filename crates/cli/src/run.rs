@@ -12,6 +12,7 @@ use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
 use tezgah_motion::interpolate::{run as run_items, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::tool_pose::SampleTool;
 use tezgah_motion::verify::{Report, Verifier};
 
 use crate::diagnostics::report_line;
@@ -92,6 +93,13 @@ pub const DEMO_TOOLS: &str = include_str!("../../../examples/tools.tbl");
 
 /// Samples after which a progress bar is shown (about a minute of machining at 1 ms).
 const PROGRESS_SAMPLES: u64 = 60_000;
+
+/// Why the samples CSV could not be written: the file, or a sample's forward kinematics
+/// (joints the interpolator produced are always finite and in limits, so not expected).
+enum SinkError {
+    Write(std::io::Error),
+    Forward(u32, tezgah_kinematics::KinematicsError),
+}
 
 /// The command line of `tezgah run` (DESIGN.md "Command-line contract").
 #[derive(clap::Args)]
@@ -215,6 +223,12 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         ..PlanOptions::default()
     };
 
+    // DESIGN.md: the tool axis columns for machines with rotary joints.
+    let with_axis = machine
+        .joints
+        .iter()
+        .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary);
+    let mut tool = SampleTool::new(&pm);
     let mut csv = match &args.samples {
         Some(p) => {
             let f = std::fs::File::create(p)
@@ -222,7 +236,12 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
                 .wrap_err_with(|| format!("cannot write {}", p.display()))?;
             let mut w = std::io::BufWriter::new(f);
             let names: Vec<&str> = machine.joints.iter().map(|j| j.name.as_str()).collect();
-            writeln!(w, "t,line,{},tip_x,tip_y,tip_z", names.join(",")).into_diagnostic()?;
+            let axis = if with_axis {
+                ",tool_i,tool_j,tool_k"
+            } else {
+                ""
+            };
+            writeln!(w, "t,line,{},tip_x,tip_y,tip_z{axis}", names.join(",")).into_diagnostic()?;
             Some(w)
         }
         None => None,
@@ -250,7 +269,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let mut trace = args.plot.as_ref().map(|_| Trace::new(machine.joints.len()));
     let bar = indicatif::ProgressBar::hidden();
-    let mut write_error: Option<std::io::Error> = None;
+    let mut write_error: Option<SinkError> = None;
     let mut count: u64 = 0;
     let mut line_buf = String::with_capacity(256);
     let sink = |s: &Sample, seg: &[std::sync::Arc<tezgah_motion::Segment>]| {
@@ -268,9 +287,22 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
             for (i, q) in s.joints.as_slice().iter().enumerate() {
                 let _ = write!(line_buf, ",{:.12}", q * scales[i]);
             }
-            let _ = write!(line_buf, ",{:.12},{:.12},{:.12}", s.tip.x, s.tip.y, s.tip.z);
-            if let Err(e) = writeln!(w, "{line_buf}") {
-                write_error.get_or_insert(e);
+            // The tool as the joints hold it (the verifier reads the program point `s.tip`).
+            match tool.pose(s, seg) {
+                Ok(pose) => {
+                    let p = pose.tip;
+                    let _ = write!(line_buf, ",{:.12},{:.12},{:.12}", p.x, p.y, p.z);
+                    if with_axis {
+                        let k = pose.axis;
+                        let _ = write!(line_buf, ",{:.12},{:.12},{:.12}", k.x, k.y, k.z);
+                    }
+                    if let Err(e) = writeln!(w, "{line_buf}") {
+                        write_error.get_or_insert(SinkError::Write(e));
+                    }
+                }
+                Err(e) => {
+                    write_error.get_or_insert(SinkError::Forward(s.line, e));
+                }
             }
         }
         count += 1;
@@ -296,8 +328,14 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     )
     .map_err(|e| miette!("{e}"))?;
     bar.finish_and_clear();
-    if let Some(e) = write_error {
-        return Err(e).into_diagnostic().wrap_err("writing the samples");
+    match write_error {
+        Some(SinkError::Write(e)) => {
+            return Err(e).into_diagnostic().wrap_err("writing the samples")
+        }
+        Some(SinkError::Forward(line, e)) => {
+            return Err(miette!("line {line}: the samples' tool pose: {e}"))
+        }
+        None => {}
     }
     if let Some(mut w) = csv {
         w.flush().into_diagnostic()?;

@@ -98,7 +98,9 @@ fn check_and_run(program: &str, name: &str) -> serde_json::Value {
             .unwrap()
     };
     let (x, y, z, a, c) = (word('X'), word('Y'), word('Z'), word('A'), word('C'));
-    // Columns: t, line, x, y, z, a, c, tip_x, tip_y, tip_z.
+    // Columns: t, line, x, y, z, a, c, tip_x, tip_y, tip_z, tool_i, tool_j, tool_k (the tip
+    // is the tool tip by forward kinematics: X Y Z under TCP; with TCP off the joints carry
+    // the program axes, read here).
     let (got, want) = if program.contains("G43.4") {
         ([last[7], last[8], last[9]], [x, y, z])
     } else {

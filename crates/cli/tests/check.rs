@@ -133,3 +133,38 @@ fn check_with_a_machine_counts_and_passes_a_program_with_subroutines() {
         assert!(lines.contains(&line), "{lines:?}");
     }
 }
+
+/// `check --machine` reads the program as `run` does on a machine with `tcp = "always"`: Z-390
+/// is the joint z itself with TCP off (inside ±400), but under TCP the tip at Z-390 puts the
+/// gauge point at −150 + 50 − 390 = −490 on table-ac: refused with the block's place.
+#[test]
+fn check_with_a_tcp_always_machine_reads_the_program_under_tcp() {
+    let dir = tmp_dir("tcp-always");
+    let program = dir.join("deep.ngc");
+    std::fs::write(&program, "G21 G90\nG0 X0 Y0 Z-390\nM2\n").unwrap();
+    let machine = dir.join("always.toml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../machines/table-ac.toml"
+    ))
+    .unwrap()
+    .replace("tcp = \"program\"", "tcp = \"always\"");
+    std::fs::write(&machine, text).unwrap();
+    let ok = tezgah()
+        .arg("check")
+        .arg(&program)
+        .args(["--machine", "table-ac"])
+        .output()
+        .unwrap();
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let refused = tezgah()
+        .arg("check")
+        .arg(&program)
+        .arg("--machine")
+        .arg(&machine)
+        .output()
+        .unwrap();
+    assert!(!refused.status.success());
+    let err = stderr(&refused);
+    assert!(err.contains("deep.ngc:2:1: joint 2 (`z`)"), "{err}");
+}

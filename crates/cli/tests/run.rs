@@ -274,3 +274,155 @@ fn servo_drive_reports_tracking_and_contour_errors() {
     assert_eq!(ideal["drive"], "ideal");
     assert!(ideal.get("tracking").is_none());
 }
+
+/// The samples CSV of `program` on `machine`: its header and rows.
+fn samples(machine: &str, program: &str, name: &str) -> (String, Vec<Vec<f64>>) {
+    let (ngc, csv, json) = (
+        tmp(&format!("{name}.ngc")),
+        tmp(&format!("{name}.csv")),
+        tmp(&format!("{name}.json")),
+    );
+    std::fs::write(&ngc, program).unwrap();
+    let out = tezgah()
+        .arg("run")
+        .arg(&ngc)
+        .args(["--machine", machine, "--tool-table", TOOLS, "--samples"])
+        .arg(&csv)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let report = succeeded_with_report(&out, &json);
+    assert!(
+        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{report}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap().to_owned();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+fn close(got: [f64; 3], want: [f64; 3], tol: f64, what: &str) {
+    let d = (0..3)
+        .map(|i| (got[i] - want[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(d < tol, "{what}: {got:?} vs {want:?}");
+}
+
+/// table-ac with TCP off: the joints are the program axes, and the tip columns are the tool
+/// tip by DESIGN.md's convention — p = Rz(−C)·(Rx(−A)·(q − L·ẑ − pivot) − c_offset) with
+/// G43's L = 28.5 (T2) — and the tool axis (sin A sin C, sin A cos C, cos A). Columns print 12
+/// decimals, hence the 1e-9.
+#[test]
+fn samples_tip_and_tool_axis_are_the_forward_kinematics_on_table_ac() {
+    let program = "G21 G90 G94 G61\nG43 H2\nG0 X10 Y20 Z30 A0 C0\n\
+                   G1 X40 Y-10 Z20 A25 C70 F2000\nG1 A10 C200 F3000\nM2\n";
+    let (header, rows) = samples("table-ac", program, "kin-ac");
+    assert_eq!(
+        header,
+        "t,line,x,y,z,a,c,tip_x,tip_y,tip_z,tool_i,tool_j,tool_k"
+    );
+    let (pivot, c_offset) = ([0.0, 0.0, -150.0], [0.0, 2.0, 50.0]);
+    let mut tilted = 0;
+    for r in &rows {
+        assert_eq!(r.len(), 13);
+        let (a, c) = (r[5].to_radians(), r[6].to_radians());
+        let w = [r[2] - pivot[0], r[3] - pivot[1], r[4] - 28.5 - pivot[2]];
+        let (sa, ca) = a.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        let u = [
+            w[0] - c_offset[0],
+            ca * w[1] + sa * w[2] - c_offset[1],
+            -sa * w[1] + ca * w[2] - c_offset[2],
+        ];
+        let tip = [cc * u[0] + sc * u[1], -sc * u[0] + cc * u[1], u[2]];
+        close([r[7], r[8], r[9]], tip, 1e-9, "tip");
+        close([r[10], r[11], r[12]], [sa * sc, sa * cc, ca], 1e-11, "axis");
+        tilted += usize::from(r[5] > 1.0);
+    }
+    assert!(tilted > 500, "{tilted} tilted rows");
+    // While A = C = 0 (the G0, ending at rest under G61), the tip is the program point
+    // (the joints less G43's 28.5 in z) less pivot + c_offset = (0, 2, −100).
+    let on_g0: Vec<&Vec<f64>> = rows.iter().filter(|r| r[1] == 3.0).collect();
+    assert!(on_g0.len() > 10);
+    for r in on_g0 {
+        assert_eq!((r[5], r[6]), (0.0, 0.0));
+        close(
+            [r[7], r[8], r[9]],
+            [r[2], r[3] - 2.0, r[4] - 28.5 + 100.0],
+            1e-9,
+            "A = C = 0",
+        );
+    }
+}
+
+/// yzca with TCP off (joints y z c a): tip (r cos C, −r sin C, z − L cos A) with
+/// r = y + L sin A, axis (−sin A cos C, sin A sin C, cos A) (README's yzca convention).
+#[test]
+fn samples_tip_and_tool_axis_are_the_forward_kinematics_on_yzca() {
+    let program = "G21 G90 G94\nG43 H2\nG0 Y50 Z20 A0 C0\nG1 Y80 Z10 A20 C120 F2000\nM2\n";
+    let (header, rows) = samples("yzca", program, "kin-yzca");
+    assert_eq!(
+        header,
+        "t,line,y,z,c,a,tip_x,tip_y,tip_z,tool_i,tool_j,tool_k"
+    );
+    for r in &rows {
+        let (c, a) = (r[4].to_radians(), r[5].to_radians());
+        let (sa, ca) = a.sin_cos();
+        let (sc, cc) = c.sin_cos();
+        let rad = r[2] + 28.5 * sa;
+        close(
+            [r[6], r[7], r[8]],
+            [rad * cc, -rad * sc, r[3] - 28.5 * ca],
+            1e-9,
+            "tip",
+        );
+        close([r[9], r[10], r[11]], [-sa * cc, sa * sc, ca], 1e-11, "axis");
+    }
+}
+
+/// TCP on (G43.4 H1): the tip columns are the program's tip — at the end the last block's
+/// X Y Z — and after G49 on a Cartesian mill the tip is the gauge point (no length in force).
+#[test]
+fn samples_tip_is_the_program_tip_under_tcp_and_the_tool_tip_under_g43() {
+    let program = "G21 G90 G94\nG43.4 H1\nG0 X10 Y5 Z20 A0 C0\nG1 A30 C40 F3600\n\
+                   G1 X20 Y-10 Z-3 F900\nM2\n";
+    let (_, rows) = samples("table-ac", program, "kin-tcp");
+    let last = rows.last().unwrap();
+    close(
+        [last[7], last[8], last[9]],
+        [20.0, -10.0, -3.0],
+        1e-9,
+        "end",
+    );
+    let (a, c) = (30f64.to_radians(), 40f64.to_radians());
+    close(
+        [last[10], last[11], last[12]],
+        [a.sin() * c.sin(), a.sin() * c.cos(), a.cos()],
+        1e-11,
+        "axis",
+    );
+    // mill3: G43 H1 (35 mm) then down to Z-2: the tip at -2 while the spindle (z) is at 33;
+    // no tool axis columns (no rotary joint).
+    let (header, rows) = samples(
+        "mill3",
+        "G21 G90\nG43 H1\nG0 X10 Y20 Z5\nG1 Z-2 F600\nM2\n",
+        "kin-mill",
+    );
+    assert_eq!(header, "t,line,x,y,z,tip_x,tip_y,tip_z");
+    for r in &rows[1..] {
+        assert!((r[4] - r[7] - 35.0).abs() < 1e-9, "{r:?}");
+    }
+    let last = rows.last().unwrap();
+    close(
+        [last[5], last[6], last[7]],
+        [10.0, 20.0, -2.0],
+        1e-9,
+        "mill3 end",
+    );
+}

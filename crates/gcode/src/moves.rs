@@ -35,6 +35,8 @@ pub struct MoveBuilder<F: FnMut(Move)> {
     /// the length. Announced before the first move.
     centre_point_always: bool,
     announced: bool,
+    /// The line of a G43/G49 with TCP off whose length is still to be announced.
+    length_pending: Option<u32>,
     /// The current point without the tool offset (`g5x + R(p + g92)`, mm): where the next
     /// move starts, in the coordinates of TCP; the tool is added to it with TCP off.
     tipless: Pose,
@@ -53,6 +55,7 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
             centre_point: None,
             centre_point_always: false,
             announced: false,
+            length_pending: None,
             tipless: Pose::ZERO,
         }
     }
@@ -91,7 +94,9 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
         self.announced = true;
         let control = match self.centre_point {
             Some(tool_length) => ToolControl::CentrePoint { tool_length },
-            None => ToolControl::Joints,
+            None => ToolControl::Joints {
+                tool_length: self.tool.z() * self.units.mm(),
+            },
         };
         let at = self.with_tool(self.tipless);
         self.push(line, MoveKind::ToolControl { control, at });
@@ -123,6 +128,14 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
             // Set-up calls come before line 1; the switch is the program's from its start.
             self.announce(line.max(1));
         }
+        if !matches!(
+            call,
+            Canon::UseToolLengthOffset(_) | Canon::SetToolCentrePoint(_)
+        ) {
+            if let Some(at) = self.length_pending.take() {
+                self.announce(at);
+            }
+        }
         match call {
             Canon::UseLengthUnits(u) => self.units = u,
             Canon::SetG5xOffset { offset, .. } => self.g5x = offset,
@@ -136,9 +149,15 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 if self.centre_point_always {
                     self.centre_point = Some(p.z() * self.units.mm());
                     self.announce(line);
+                } else if self.centre_point.is_none() {
+                    // TCP off: the length is in the moves' Z already; announced (at the next
+                    // call, unless G43.4 switches TCP on meanwhile) so that the tool tip can
+                    // be read back from the joints (forward kinematics).
+                    self.length_pending = Some(line);
                 }
             }
             Canon::SetToolCentrePoint(length) if !self.centre_point_always => {
+                self.length_pending = None;
                 self.centre_point = length.map(|l| l * self.units.mm());
                 self.announce(line);
             }

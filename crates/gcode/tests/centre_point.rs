@@ -79,7 +79,7 @@ fn moves_carry_the_tip_under_tcp_and_the_gauge_point_without() {
                 format!("CentrePoint {{ tool_length: 35.0 }} {}", z(-35.0))
             ),
             (3, format!("feed {}", z(5.0))),
-            (4, format!("Joints {}", z(40.0))),
+            (4, format!("Joints {{ tool_length: 0.0 }} {}", z(40.0))),
             (5, format!("feed {}", z(10.0))),
         ]
     );
@@ -132,4 +132,34 @@ fn g43_4_needs_an_h_word_naming_a_tool_of_the_table() {
     // G43.4 and G49 share modal group 8.
     let err = program_moves("G21\nG43.4 H1 G49\nM2\n", config()).unwrap_err();
     assert!(err.to_string().contains("modal group"), "{err}");
+}
+
+#[test]
+fn g43_with_tcp_off_announces_its_length_once_the_block_is_done() {
+    // G43 H1 (35 mm) then G49, TCP off: each length is announced at the next call, with the
+    // point unchanged (the gauge point); G43 H2 followed by G43.4 H2 announces only TCP.
+    let moves = program_moves(
+        "G21 G90\nG43 H1\nG1 Z5 F100\nG49\nG1 Z10\nG43 H2\nG43.4 H2\nG1 Z0\nM2\n",
+        config(),
+    )
+    .unwrap();
+    let controls: Vec<(u32, ToolControl, f64)> = moves
+        .iter()
+        .filter_map(|m| match m.kind {
+            MoveKind::ToolControl { control, at } => Some((m.line, control, at.z())),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        controls,
+        vec![
+            (2, ToolControl::Joints { tool_length: 35.0 }, 0.0),
+            (4, ToolControl::Joints { tool_length: 0.0 }, 40.0),
+            (
+                7,
+                ToolControl::CentrePoint { tool_length: 28.5 },
+                10.0 - 28.5
+            ),
+        ]
+    );
 }

@@ -98,17 +98,49 @@ pub enum MoveKind {
 }
 
 /// How the program axes reach the joints.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ToolControl {
     /// TCP off (G49, or no G43.4): program axes are joints. On machines whose rotary joints
     /// orient the tool, X Y Z A B C drive the joints of those names and moves are straight in
-    /// joint space; Cartesian and delta machines keep X Y Z as the gauge point (tool length,
-    /// if any, already added along Z by G43).
-    #[default]
-    Joints,
+    /// joint space; Cartesian and delta machines keep X Y Z as the gauge point. `tool_length`
+    /// is G43's offset in force (mm, 0 after G49), already added to the moves' Z: the joints
+    /// do not need it, the tool tip read back from them does (forward kinematics).
+    Joints { tool_length: f64 },
     /// TCP on (G43.4): X Y Z are the tool tip in the workpiece frame and A B C orient the tool;
     /// the joints follow, with the tip `tool_length` mm from the gauge point along the tool axis.
     CentrePoint { tool_length: f64 },
+}
+
+impl Default for ToolControl {
+    /// TCP off with no tool length: the state before any G43 or G43.4.
+    fn default() -> Self {
+        ToolControl::OFF
+    }
+}
+
+impl ToolControl {
+    /// TCP off, no tool length in force.
+    pub const OFF: ToolControl = ToolControl::Joints { tool_length: 0.0 };
+
+    /// Whether TCP is off (program axes are joints), whatever the G43 length.
+    pub fn is_joints(&self) -> bool {
+        matches!(self, ToolControl::Joints { .. })
+    }
+
+    /// The tool length in force (mm): G43.4's under TCP, G43's with TCP off.
+    pub fn tool_length(&self) -> f64 {
+        match *self {
+            ToolControl::Joints { tool_length } | ToolControl::CentrePoint { tool_length } => {
+                tool_length
+            }
+        }
+    }
+
+    /// Whether the two read program points into the same joints: both TCP off (G43's length
+    /// is already in the moves' Z, so it changes nothing), or both TCP on with one length.
+    pub fn same_reading(&self, other: &ToolControl) -> bool {
+        self.is_joints() && other.is_joints() || self == other
+    }
 }
 
 /// Feed-rate interpretation.

@@ -371,7 +371,8 @@ impl From<crate::takeup::TakeUpError> for RunError {
 /// Plans and samples a stream of path items from the start pose (tip, A B C, under the
 /// machine's initial tool control), calling `sink` for every sample; returns the unrounded
 /// duration. Where the tool control switches and the joints of the current point differ
-/// between the two readings, a take-up move ([`crate::takeup`]) is run first. Memory stays
+/// between the two readings, a take-up move ([`crate::takeup`]) is run first, from the joints
+/// the interpolator reached. Memory stays
 /// bounded by the planner's window: items are planned and sampled as they come.
 pub fn run(
     items: impl IntoIterator<Item = crate::path::PathItem>,
@@ -386,7 +387,16 @@ pub fn run(
     let mut takeup = TakeUp::new(&machine, start, interp.joints);
     let mut planner = crate::plan::Planner::new(machine, options)?;
     for item in items {
-        if let Some(t) = takeup.before(&item)? {
+        if takeup.switches(&item) {
+            // The machine stops before a switch anyway: run everything up to it, so that the
+            // take-up starts from the joints reached (an endless C following the tip may have
+            // turned any number of times since the last switch).
+            planner.finish()?;
+            while let Some(p) = planner.pop() {
+                interp.push(&p, &mut sink)?;
+            }
+        }
+        if let Some(t) = takeup.before_from(&item, &interp.joints)? {
             planner.push(t)?;
         }
         planner.push(item)?;

@@ -7,7 +7,8 @@
 //! (samples at the period, joints by the kinematics under each segment's tool control;
 //! [`cursor`] places the tool at any path coordinate of a piece, for the executor's re-timed
 //! sampling) and
-//! [`verify`] (the post-run replay).
+//! [`verify`] (the post-run replay) and [`tool_pose`] (each sample's tool tip and axis in the
+//! workpiece frame, by forward kinematics).
 
 pub mod cursor;
 pub mod interpolate;
@@ -16,6 +17,7 @@ pub mod plan;
 pub mod preflight;
 pub mod profile;
 pub mod takeup;
+pub mod tool_pose;
 pub mod verify;
 
 pub use path::{Junction, PathItem, Segment, SegmentFeed};

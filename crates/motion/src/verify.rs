@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use tezgah_geom::deviation::{closest_point, point_segment_distance};
-use tezgah_geom::{Curve, Vec3};
+use tezgah_geom::{Curve, ToolControl, Vec3};
 use tezgah_kinematics::Joints;
 
 use crate::interpolate::Sample;
@@ -61,6 +61,9 @@ pub struct Verifier {
     peaks: Vec<JointPeaks>,
     samples: u64,
     last: Option<(Sample, Option<Arc<Segment>>)>,
+    /// The tool control of the last segment a sample lay on: a dwell's samples lie on none,
+    /// and a switch may follow a dwell.
+    last_control: Option<ToolControl>,
     cycle_time: f64,
     max_deviation: f64,
     max_deviation_line: u32,
@@ -96,6 +99,7 @@ impl Verifier {
             peaks,
             samples: 0,
             last: None,
+            last_control: None,
             cycle_time: 0.0,
             max_deviation: 0.0,
             max_deviation_line: 0,
@@ -159,10 +163,10 @@ impl Verifier {
             // samples — every segment passed, not only the two ends: at speed, short segments
             // and blends are entered and left within one period and the chord runs past them.
             // Across a tool-control switch (at rest) the tip is read two ways: no chord there.
-            let same_reading = match &self.last {
-                Some((_, Some(ps))) => ps.control == seg.control,
-                _ => true,
-            };
+            let same_reading = self
+                .last_control
+                .is_none_or(|c| c.same_reading(&seg.control));
+            self.last_control = Some(seg.control);
             if let (Some((p, pseg)), true) = (&self.last, same_reading) {
                 let mid = 0.5 * (p.tip + s.tip);
                 let mut dm = path

@@ -166,7 +166,7 @@ fn g49_returns_to_joint_mode_where_moves_are_straight_in_joint_space() {
     let on_g0: Vec<&Sample> = out
         .samples
         .iter()
-        .filter(|(_, c, e)| *c == Some(ToolControl::Joints) && *e == Some(end))
+        .filter(|(_, c, e)| *c == Some(ToolControl::OFF) && *e == Some(end))
         .map(|(s, _, _)| s)
         .collect();
     assert!(on_g0.len() > 100, "{} samples", on_g0.len());
@@ -189,7 +189,7 @@ fn g49_returns_to_joint_mode_where_moves_are_straight_in_joint_space() {
     let takeup = out
         .samples
         .iter()
-        .filter(|(s, c, e)| s.line == 8 && *c == Some(ToolControl::Joints) && *e != Some(end))
+        .filter(|(s, c, e)| s.line == 8 && *c == Some(ToolControl::OFF) && *e != Some(end))
         .count();
     assert!(takeup > 10, "{takeup} take-up samples");
 }
@@ -238,7 +238,8 @@ fn a_switch_at_a_point_whose_joints_agree_needs_no_take_up() {
     .unwrap();
     assert_eq!(segments, 2);
     let tcp = ToolControl::CentrePoint { tool_length: 35.0 };
-    assert_eq!(lines, [(3, ToolControl::Joints), (5, tcp)]);
+    let g43 = ToolControl::Joints { tool_length: 35.0 };
+    assert_eq!(lines, [(3, g43), (5, tcp)]);
     let q = last.unwrap();
     assert_eq!(q.as_slice(), &[1.0, 0.0, 30.0]);
 }

@@ -111,7 +111,7 @@ fn the_machine_gives_the_closed_form_axis() {
     }
     // TCP off: the angles are joints, there is no axis to carry.
     assert_eq!(
-        pm.axis(ToolControl::Joints, &Vec3::zeros(), &[30.0, 0.0, 0.0]),
+        pm.axis(ToolControl::OFF, &Vec3::zeros(), &[30.0, 0.0, 0.0]),
         None
     );
     // Y-Z-C-A: C follows the tip, the axis is not the angles' alone.

@@ -25,7 +25,7 @@ fn run_moves(moves: &[Move]) -> Out {
 }
 
 fn run_on(machine: &Machine, moves: &[Move]) -> Out {
-    run_under(machine, moves, ToolControl::Joints)
+    run_under(machine, moves, ToolControl::OFF)
 }
 
 /// Tool-centre-point control from the start (the machine file's `tcp = "always"`), no tool.

@@ -45,7 +45,7 @@ impl Default for DirectOptions {
             tolerance: 0.01,
             exact_tangent_angle: 1e-6,
             continuous_tangent_angle: 0.05,
-            control: ToolControl::Joints,
+            control: ToolControl::OFF,
         }
     }
 }

@@ -108,7 +108,7 @@ impl PlanMachine {
             max_jerk: j,
             axes,
             initial: match machine.tcp {
-                TcpSwitch::Program => ToolControl::Joints,
+                TcpSwitch::Program => ToolControl::OFF,
                 TcpSwitch::Always => ToolControl::CentrePoint { tool_length: 0.0 },
             },
         })
@@ -193,7 +193,7 @@ impl PlanMachine {
         let direct = match self.model {
             Model::Cartesian(_) => true,
             Model::LinearDelta(_) => false,
-            _ => control == ToolControl::Joints,
+            _ => control.is_joints(),
         };
         if direct {
             self.map.as_deref()
@@ -208,7 +208,7 @@ impl PlanMachine {
         let Some(map) = self.map.as_deref() else {
             return Ok(());
         };
-        if seg.control != ToolControl::Joints || !self.orients() {
+        if !seg.control.is_joints() || !self.orients() {
             return Ok(());
         }
         let (a, b) = seg.curve.domain();
@@ -279,7 +279,7 @@ impl PlanMachine {
         }
         let length = match control {
             ToolControl::CentrePoint { tool_length } => tool_length,
-            ToolControl::Joints => Tool::default().length,
+            ToolControl::Joints { .. } => Tool::default().length,
         };
         // One pass over the joints, with the model's own input checks (`check_input`: every
         // previous joint finite) fused in: this runs once per sample.
@@ -315,7 +315,7 @@ impl PlanMachine {
     ) -> Result<Joints, KinematicsError> {
         let tool = match control {
             ToolControl::CentrePoint { tool_length } => Tool::with_length(tool_length),
-            ToolControl::Joints if self.orients() => {
+            ToolControl::Joints { .. } if self.orients() => {
                 let map = self
                     .map
                     .as_deref()
@@ -335,7 +335,7 @@ impl PlanMachine {
                 return Ok(q);
             }
             // Cartesian and delta: X Y Z are the gauge point (the G43 length already in Z).
-            ToolControl::Joints => Tool::default(),
+            ToolControl::Joints { .. } => Tool::default(),
         };
         let pose = Pose::new(tip.x, tip.y, tip.z, rotary[0], rotary[1], rotary[2]);
         let p = ProgramPose::from_program(&pose, &self.axes)?;
@@ -522,7 +522,7 @@ mod tests {
             let control = if tcp {
                 ToolControl::CentrePoint { tool_length: length }
             } else {
-                ToolControl::Joints
+                ToolControl::OFF
             };
             for pm in machines() {
                 let previous = Joints::zeros(pm.joint_count());

@@ -95,7 +95,7 @@ impl Default for SmoothOptions {
             angular_tolerance: 0.1,
             start: Pose::ZERO,
             window: 512,
-            control: ToolControl::Joints,
+            control: ToolControl::OFF,
             orientation: None,
         }
     }

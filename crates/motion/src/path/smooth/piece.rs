@@ -361,7 +361,7 @@ impl Piece {
             end,
             tolerance: self.tolerance,
             // The builder stamps the control and override switch in force when it emits it.
-            control: tezgah_geom::ToolControl::Joints,
+            control: tezgah_geom::ToolControl::OFF,
             feed_override: true,
             tool_axis_travel: None,
             axis,
