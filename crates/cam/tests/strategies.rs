@@ -176,8 +176,10 @@ fn iso_scallop_is_shorter_where_curvature_varies() {
     let r2 = compare("freeform, warped", &testing::freeform(0.6), &cutter, 0.05);
     let r3 = compare("saddle", &testing::saddle(50.0, 40.0), &cutter, 0.05);
     assert!(r1 > 0.05 && r2 > r1 && r3 > 0.0, "{r1} {r2} {r3}");
-    // The reductions the README and the notes report (−9.1 %, −35.7 %, −26.2 %), to ±1 %.
-    for (r, want) in [(r1, 0.091), (r2, 0.357), (r3, 0.262)] {
+    // The reductions the README and the notes report (−9.1 %, −35.7 %, −24.3 %), to ±1 %.
+    // (The saddle's was −26.2 % while the fronts' ends left the v = 1 edge and were put back
+    // on it 1.1–1.46 steps from the old ends; they slide along it now.)
+    for (r, want) in [(r1, 0.091), (r2, 0.357), (r3, 0.243)] {
         assert!((r - want).abs() < 0.01, "{r1} {r2} {r3}");
     }
 }

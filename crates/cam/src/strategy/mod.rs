@@ -10,6 +10,7 @@
 mod band;
 mod iso_parametric;
 mod iso_scallop;
+mod reach;
 mod true_cusp;
 
 use std::fmt;
@@ -339,7 +340,21 @@ pub fn plan(
         refused: Vec::new(),
         corrected: 0,
     };
-    for r in results {
+    let out_of_reach = results
+        .iter()
+        .flat_map(|r| &r.refused)
+        .any(|f| f.refusal == Refusal::OutOfReach);
+    // Where passes ran out of reach, the edge of the reach is cut too: the strip between the
+    // last reachable pass and the edge would otherwise keep up to a side step's scallop.
+    let edges: Vec<PassResult> = if out_of_reach {
+        ctx.reach_edges()
+            .par_iter()
+            .map(|edge| ctx.run_pass(&PassPath::Poly(edge.clone()), false))
+            .collect::<Result<_, _>>()?
+    } else {
+        Vec::new()
+    };
+    for r in results.into_iter().chain(edges) {
         plan.path.passes.extend(r.passes);
         plan.refused.extend(r.refused);
         plan.corrected += r.corrected;
@@ -742,6 +757,9 @@ impl<'a> Context<'a> {
                 self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
+        if self.settings.max_axis_tilt_deg.is_some() {
+            self.end_on_reach(&mut ts, &mut placed, &contact_at);
+        }
         if self.settings.band.is_some() {
             self.refine_chords(path, &mut ts, &mut placed, contact_at);
         }
@@ -767,6 +785,47 @@ impl<'a> Context<'a> {
         }
         self.close_pass(&mut out.passes, current);
         Ok(out)
+    }
+
+    /// Ends the pieces of a pass on the edge of the reach: between a placed contact and a
+    /// neighbour refused as out of reach, the last placeable contact is added.
+    fn end_on_reach(
+        &self,
+        ts: &mut Vec<f64>,
+        placed: &mut Vec<Result<Placed, GougeReport>>,
+        contact_at: &impl Fn(f64) -> Contact,
+    ) {
+        let out_of_reach = |p: &Result<Placed, GougeReport>| matches!(p, Err(r) if r.refusal == Refusal::OutOfReach);
+        let ok: Vec<bool> = placed.iter().map(|p| p.is_ok()).collect();
+        let away: Vec<bool> = placed.iter().map(out_of_reach).collect();
+        if !away.contains(&true) {
+            return;
+        }
+        let place_at = |t: f64| {
+            let c = contact_at(t);
+            self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
+        };
+        let n = ts.len();
+        let mut new_ts = Vec::with_capacity(n + 4);
+        let mut new_placed = Vec::with_capacity(n + 4);
+        for (i, item) in std::mem::take(placed).into_iter().enumerate() {
+            if i > 0 && away[i - 1] && ok[i] {
+                if let Some((t, p)) = self.reach_end(ts[i], ts[i - 1], place_at) {
+                    new_ts.push(t);
+                    new_placed.push(Ok(p));
+                }
+            }
+            new_ts.push(ts[i]);
+            new_placed.push(item);
+            if i + 1 < n && ok[i] && away[i + 1] {
+                if let Some((t, p)) = self.reach_end(ts[i], ts[i + 1], place_at) {
+                    new_ts.push(t);
+                    new_placed.push(Ok(p));
+                }
+            }
+        }
+        *ts = new_ts;
+        *placed = new_placed;
     }
 
     /// Keeps a pass of two or more locations, with its run-out when the band is on.
