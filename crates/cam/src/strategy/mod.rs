@@ -943,15 +943,23 @@ mod tests {
                 // Out of reach means the normal leans more than the limit: below z = r cos 50°.
                 assert!(f.contact.z < r * cos + 1e-6, "{kind}: {f:?}");
             }
-            // The kept part reaches down to the limit (within a forward step of 5 mm).
-            let lowest = p
-                .path
-                .passes
-                .iter()
-                .flat_map(|q| &q.points)
-                .map(|c| c.contact.z)
-                .fold(f64::INFINITY, f64::min);
-            assert!(lowest < r * cos + 5.0, "{kind}: {lowest}");
+            // The kept part reaches down to the limit: passes that cross it end on it, and
+            // the edge (the parallel at latitude 40°) is cut as a pass of its own.
+            let on_edge = |c: &CutterLocation| (c.contact.z - r * cos).abs() < 1e-6;
+            assert!(
+                p.path.passes.iter().any(|q| q.points.iter().all(on_edge)),
+                "{kind}: no pass along the edge"
+            );
+            for q in &p.path.passes {
+                let (a, b) = (&q.points[0], &q.points[q.points.len() - 1]);
+                // Every pass ends on the edge or on the patch's own boundary.
+                for c in [a, b] {
+                    let boundary = [c.uv.0, c.uv.1]
+                        .iter()
+                        .any(|x| *x < 1e-9 || *x > 1.0 - 1e-9);
+                    assert!(on_edge(c) || boundary, "{kind}: pass ends at {c:?}");
+                }
+            }
         }
         let mut bad = Settings::new(StrategyKind::ZigZag, 0.2, 0.01);
         bad.max_axis_tilt_deg = Some(f64::NAN);

@@ -201,3 +201,43 @@ impl Context<'_> {
         best
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Context, Settings, StrategyKind};
+    use crate::cutter::{Cutter, CutterShape};
+
+    #[test]
+    fn the_reach_edge_of_a_sphere_patch_is_its_parallel_at_the_limit() {
+        // Sphere R 30 between latitudes 10° and 60°: with 50° of tilt the edge is the
+        // parallel at latitude 40° (normals 50° from +Z), one polyline across the patch's
+        // longitudes, every point on it to rounding and on the reachable side.
+        let r = 30.0;
+        let surface = crate::testing::sphere(r);
+        let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+        let mut settings = Settings::new(StrategyKind::ZigZag, 0.2, 0.01);
+        settings.max_axis_tilt_deg = Some(50.0);
+        let ctx = Context::new(&surface, &cutter, &settings).unwrap();
+        let edges = ctx.reach_edges();
+        assert_eq!(edges.len(), 1, "{edges:?}");
+        let z = r * 40f64.to_radians().sin();
+        let (mut x_min, mut y_min) = (f64::INFINITY, f64::INFINITY);
+        for &(u, v) in &edges[0].points {
+            let p = surface.point(u, v);
+            let n = surface.normal(u, v).unwrap();
+            assert!((p.z - z).abs() < 1e-6, "{p:?}");
+            assert!(n.z >= 50f64.to_radians().cos(), "{n:?}");
+            x_min = x_min.min(p.x);
+            y_min = y_min.min(p.y);
+        }
+        // From one longitude edge (x = 0 or y = 0) of the patch to the other.
+        assert!(x_min.abs() < 1e-9 && y_min.abs() < 1e-9, "{x_min} {y_min}");
+        // No limit, or a limit every normal keeps: no edge.
+        settings.max_axis_tilt_deg = Some(85.0);
+        let ctx = Context::new(&surface, &cutter, &settings).unwrap();
+        assert!(ctx.reach_edges().is_empty());
+        settings.max_axis_tilt_deg = None;
+        let ctx = Context::new(&surface, &cutter, &settings).unwrap();
+        assert!(ctx.reach_edges().is_empty());
+    }
+}
