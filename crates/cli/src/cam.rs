@@ -401,9 +401,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     };
     // The program is judged on everything it is meant to machine: the whole face, less what
     // leans beyond the machine's reach (the same limit the planner left out).
-    let region = MachinedRegion::Reachable {
-        max_tilt_deg: max_tilt_deg,
-    };
+    let region = MachinedRegion::Reachable { max_tilt_deg };
     let done = finish(
         &surface,
         &path,

@@ -306,7 +306,7 @@ fn fill_gaps(
         .zip(&nearest)
         .zip(steps)
         .map(|((p, n), w)| {
-            if p.repeat || !(n.0 > w * (1.0 + GAP_SLACK)) {
+            if p.repeat || n.0.is_nan() || n.0 <= w * (1.0 + GAP_SLACK) {
                 0
             } else {
                 ((n.0 / w).ceil() as usize)
