@@ -86,6 +86,7 @@ fn assert_within(
     let options = VerifyOptions {
         cell_mm: cell,
         sweep_spacing_mm: spacing,
+        region: tezgah_cam::verify::MachinedRegion::ContactBox,
     };
     let poses = path_poses(&p.path, spacing);
     let v = simulate(surface, &p.path, &poses, &options).unwrap();
@@ -270,6 +271,7 @@ fn without_the_band_chords_cut_into_a_convex_surface() {
     let options = VerifyOptions {
         cell_mm: 0.12,
         sweep_spacing_mm: spacing,
+        region: tezgah_cam::verify::MachinedRegion::ContactBox,
     };
     let measure = |settings: &Settings| {
         let p = plan(&s, &cutter, settings).unwrap();

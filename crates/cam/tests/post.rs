@@ -317,6 +317,7 @@ fn the_posted_joint_program_cuts_without_gouging() {
         &tezgah_cam::verify::VerifyOptions {
             cell_mm: s / 10.0,
             sweep_spacing_mm: 0.1,
+            region: tezgah_cam::verify::MachinedRegion::ContactBox,
         },
     )
     .unwrap();

@@ -176,8 +176,10 @@ fn iso_scallop_is_shorter_where_curvature_varies() {
     let r2 = compare("freeform, warped", &testing::freeform(0.6), &cutter, 0.05);
     let r3 = compare("saddle", &testing::saddle(50.0, 40.0), &cutter, 0.05);
     assert!(r1 > 0.05 && r2 > r1 && r3 > 0.0, "{r1} {r2} {r3}");
-    // The reductions the README and the notes report (−9.1 %, −35.7 %, −26.2 %), to ±1 %.
-    for (r, want) in [(r1, 0.091), (r2, 0.357), (r3, 0.262)] {
+    // The reductions the README and the notes report (−9.1 %, −35.7 %, −24.3 %), to ±1 %.
+    // (The saddle's was −26.2 % while the fronts' ends left the v = 1 edge and were put back
+    // on it 1.1–1.46 steps from the old ends; they slide along it now.)
+    for (r, want) in [(r1, 0.091), (r2, 0.357), (r3, 0.243)] {
         assert!((r - want).abs() < 0.01, "{r1} {r2} {r3}");
     }
 }
@@ -653,4 +655,114 @@ fn zigzag_along_u_reaches_the_sphere_poles() {
     for c in p.path.passes.iter().flat_map(|q| &q.points) {
         assert!((c.normal - c.contact / 40.0).norm() < 1e-6, "{c:?}");
     }
+}
+
+/// Issue 7's settings for the STEP sphere's cap within 45° of +Z: a ball D6, target scallop
+/// `h`, tolerance 0.01 shared as the CLI shares it (the one-sided band), passes along `dir`.
+fn sphere_cap_settings(kind: StrategyKind, h: f64, dir: FeedDirection) -> Settings {
+    let shares = tezgah_cam::ToleranceShares::of(0.01);
+    let mut settings = Settings::new(kind, h, shares.chord);
+    settings.band = Some(shares.band());
+    settings.gouge.depth_tolerance = 0.0005;
+    settings.direction = dir;
+    settings.max_axis_tilt_deg = Some(45.0);
+    settings
+}
+
+/// The dexel simulation of `path` along its own passes over `region` (cell 0.5 mm, poses
+/// 0.15 mm apart).
+fn simulate_cap(
+    s: &NurbsSurface,
+    path: &tezgah_cam::ToolPath,
+    region: tezgah_cam::verify::MachinedRegion,
+) -> tezgah_cam::verify::Verification {
+    use tezgah_cam::verify::{path_poses, simulate, VerifyOptions};
+    let options = VerifyOptions {
+        cell_mm: 0.5,
+        sweep_spacing_mm: 0.15,
+        region,
+    };
+    simulate(s, path, &path_poses(path, 0.15), &options).unwrap()
+}
+
+const CAP: tezgah_cam::verify::MachinedRegion =
+    tezgah_cam::verify::MachinedRegion::Reachable { max_tilt_deg: 45.0 };
+
+#[test]
+fn iso_scallop_along_meridians_machines_the_whole_sphere_cap() {
+    // Fronts from the seam meridian fold and fan out toward the poles; ends sliding along
+    // the feed-end boundaries, fill passes where the gap to the previous front exceeds the
+    // step, and the reach edge cut as a pass keep every part of the cap within the target
+    // (it left 0.80 mm at the rim of the cap).
+    let (radius, h) = (40.0, 0.2);
+    let s = step_sphere();
+    let settings = sphere_cap_settings(StrategyKind::IsoScallop, h, FeedDirection::AlongV);
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    assert!(p.refused.iter().all(|r| r.refusal == Refusal::OutOfReach));
+    let v = simulate_cap(&s, &p.path, CAP);
+    eprintln!("{v:?}");
+    assert_eq!(v.uncut, 0, "{v:?}");
+    assert!(v.max_scallop_mm - v.sweep_bound_mm <= h, "{v:?}");
+    assert!(v.max_scallop_mm > 0.75 * h, "{v:?}");
+    assert!(v.gouge_depth_mm <= 0.001, "{v:?}");
+    // The region judged is the whole cap: from the rim (latitude 45°) to the pole.
+    assert!(
+        v.region_v.0 <= std::f64::consts::FRAC_PI_4
+            && v.region_v.1 >= std::f64::consts::FRAC_PI_2 - 1e-9,
+        "{v:?}"
+    );
+    let rim = radius * std::f64::consts::FRAC_1_SQRT_2;
+    let lowest = p
+        .path
+        .passes
+        .iter()
+        .flat_map(|q| &q.points)
+        .map(|c| c.contact.z)
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        (lowest - rim).abs() < 1e-6,
+        "lowest contact {lowest}, rim {rim}"
+    );
+}
+
+#[test]
+fn a_strip_left_uncut_at_the_rim_of_the_sphere_cap_fails_verification() {
+    // The parallels' plan of the cap verifies; without its outermost passes (the reach edge
+    // and the lowest parallel) the strip between the next parallel and the rim is left, and
+    // the verification over the reachable cap reports it — the contact box, which ends at the
+    // lowest remaining pass, does not see it.
+    let h = 0.2;
+    let s = step_sphere();
+    let settings = sphere_cap_settings(StrategyKind::IsoScallop, h, FeedDirection::AlongU);
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    let whole = simulate_cap(&s, &p.path, CAP);
+    assert!(
+        whole.uncut == 0 && whole.max_scallop_mm - whole.sweep_bound_mm <= h,
+        "{whole:?}"
+    );
+    let lowest = |q: &Pass| {
+        q.points
+            .iter()
+            .map(|c| c.contact.z)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut path = p.path.clone();
+    for _ in 0..2 {
+        let k = (0..path.passes.len())
+            .min_by(|&a, &b| lowest(&path.passes[a]).total_cmp(&lowest(&path.passes[b])))
+            .unwrap();
+        path.passes.remove(k);
+    }
+    let cut = simulate_cap(&s, &path, CAP);
+    assert!(cut.max_scallop_mm - cut.sweep_bound_mm > 2.0 * h, "{cut:?}");
+    // Below every remaining pass: in the strip.
+    let (_, at) = cut.max_scallop_at.unwrap();
+    let remaining = path.passes.iter().map(lowest).fold(f64::INFINITY, f64::min);
+    assert!(at.z < remaining, "{cut:?}");
+    eprintln!("whole {whole:?}\nwithout {cut:?}");
+    let boxed = simulate_cap(&s, &path, tezgah_cam::verify::MachinedRegion::ContactBox);
+    assert!(
+        boxed.max_scallop_mm - boxed.sweep_bound_mm <= h,
+        "{boxed:?}"
+    );
 }

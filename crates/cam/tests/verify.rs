@@ -15,6 +15,7 @@ fn run(
     let options = VerifyOptions {
         cell_mm: s / 20.0,
         sweep_spacing_mm: 0.1,
+        region: tezgah_cam::verify::MachinedRegion::ContactBox,
     };
     let poses = path_poses(path, options.sweep_spacing_mm);
     let v = simulate(surface, path, &poses, &options).unwrap();
@@ -121,6 +122,7 @@ fn bad_options_are_errors() {
         let options = VerifyOptions {
             cell_mm: cell,
             sweep_spacing_mm: spacing,
+            region: tezgah_cam::verify::MachinedRegion::ContactBox,
         };
         assert!(
             simulate(&surface, &path, &[], &options).is_err(),
@@ -151,7 +153,7 @@ mod no_panic {
                 .into_iter()
                 .map(|(t, a)| CutterPose { tip: t.into(), axis: nalgebra::Vector3::from(a).normalize() })
                 .collect();
-            let options = VerifyOptions { cell_mm: cell, sweep_spacing_mm: 0.1 };
+            let options = VerifyOptions { cell_mm: cell, sweep_spacing_mm: 0.1 ,    region: tezgah_cam::verify::MachinedRegion::ContactBox,};
             if let Ok(v) = simulate(&surface, &path, &poses, &options) {
                 prop_assert!(v.max_scallop_mm >= 0.0 && v.gouge_depth_mm >= 0.0);
             }

@@ -9,7 +9,7 @@ use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
-use tezgah_cam::verify::{self, Verification, VerifyOptions, MAX_DEXELS};
+use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
@@ -399,7 +399,17 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         blend_mm: Some(shares.blend),
         ..PostOptions::new(feed, shares.linearisation)
     };
-    let done = finish(&surface, &path, &machine, &options, args.verify_cell_mm)?;
+    // The program is judged on everything it is meant to machine: the whole face, less what
+    // leans beyond the machine's reach (the same limit the planner left out).
+    let region = MachinedRegion::Reachable { max_tilt_deg };
+    let done = finish(
+        &surface,
+        &path,
+        &machine,
+        &options,
+        args.verify_cell_mm,
+        region,
+    )?;
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
@@ -442,15 +452,16 @@ impl Finished {
     }
 }
 
-/// Post `path` and simulate the cut along the program as the machine moves it: dexels every
-/// twentieth of the step-over (coarser where the grid would not fit in memory), poses close enough that the sweep error is a tenth of the
-/// tolerance.
+/// Post `path` and simulate the cut along the program as the machine moves it over `region`:
+/// dexels every twentieth of the step-over (coarser where the grid would not fit in memory),
+/// poses close enough that the sweep error is a tenth of the tolerance.
 pub fn finish(
     surface: &NurbsSurface,
     path: &ToolPath,
     machine: &Machine,
     options: &PostOptions,
     cell_mm: Option<f64>,
+    region: MachinedRegion,
 ) -> Result<Finished> {
     let posted = post(path, machine, options).into_diagnostic()?;
     let step_over = verify::step_over(path).unwrap_or(2.0 * path.cutter.shape.radius());
@@ -478,6 +489,7 @@ pub fn finish(
     let mut verify_options = VerifyOptions {
         cell_mm: cell_mm.unwrap_or(step_over / 20.0),
         sweep_spacing_mm: spacing,
+        region,
     };
     let poses = posted.sweep(machine, spacing).into_diagnostic()?;
     // A surface whose parametric speed varies (STEP fits often run 5:1) needs its dexel grid
@@ -543,6 +555,7 @@ fn report_json(
         "max_scallop_at": at(&v.max_scallop_at),
         "gouge_depth_mm": v.gouge_depth_mm,
         "gouge_at": at(&v.gouge_at),
+        "machined_region": region_json(v),
         "verification": {
             "cell_mm": v.cell_mm,
             "dexels": v.dexels,
@@ -554,6 +567,23 @@ fn report_json(
         "gouge_limit_mm": GOUGE_LIMIT_MM,
         "planned_scallop_mm": scallop - args.tolerance,
         "verified": done.verified(scallop),
+    })
+}
+
+/// The region the verification judged, as the report states it.
+fn region_json(v: &Verification) -> serde_json::Value {
+    let (kind, tilt) = match v.region {
+        MachinedRegion::ContactBox => ("contact box", None),
+        MachinedRegion::Reachable { max_tilt_deg } => {
+            ("whole face within the tilt reach", Some(max_tilt_deg))
+        }
+    };
+    serde_json::json!({
+        "kind": kind,
+        "max_normal_tilt_deg": tilt,
+        "u": [v.region_u.0, v.region_u.1],
+        "v": [v.region_v.0, v.region_v.1],
+        "dexels": v.dexels,
     })
 }
 
@@ -647,7 +677,10 @@ mod tests {
         let machine = Machine::builtin("table-ac").unwrap();
         let (surface, path) = plane_job(1.0);
         let options = PostOptions::new(1000.0, 0.01);
-        let done = finish(&surface, &path, &machine, &options, None).unwrap();
+        let region = MachinedRegion::Reachable {
+            max_tilt_deg: 120.0,
+        };
+        let done = finish(&surface, &path, &machine, &options, None, region).unwrap();
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.
         let h = 1.5 - (2.25_f64 - 0.25).sqrt();

@@ -170,7 +170,10 @@ fn sphere_cap_within_the_tilt_limit_is_verified_and_runs_on_table_ac() {
         assert!(p[2] >= rim - tol, "{p:?} below the cap");
         lowest = lowest.min(p[2]);
     }
-    assert!(lowest < rim + 2.0, "lowest cut {lowest}, rim {rim}");
+    // The reach edge is cut as a pass: the cuts reach the rim itself (its points shifted
+    // out by the one-sided band, up along the 45° normal by at most the tolerance).
+    assert!(lowest < rim + tol, "lowest cut {lowest}, rim {rim}");
+    assert_cap_judged_whole(&report, max_tilt);
     assert!(f(&report, "gouge_depth_mm") <= 0.001, "{report}");
     check_and_run("sphere", None);
 }
@@ -214,7 +217,8 @@ fn sphere_cap_iso_scallop_along_parallels_is_verified_to_the_pole() {
         assert!(p[2] >= rim - tol, "{p:?} below the cap");
         lowest = lowest.min(p[2]);
     }
-    assert!(lowest < rim + flat, "lowest cut {lowest}, rim {rim}");
+    assert!(lowest < rim + tol, "lowest cut {lowest}, rim {rim}");
+    assert_cap_judged_whole(&report, max_tilt);
     assert!(
         points
             .iter()
@@ -222,6 +226,93 @@ fn sphere_cap_iso_scallop_along_parallels_is_verified_to_the_pole() {
         "the pole is cut (its point shifted out by the one-sided band, within the tolerance)"
     );
     check_and_run("sphere-iso", None);
+}
+
+/// The verification judged the whole cap the machine reaches (the rational sphere's full
+/// longitude, from below the rim's latitude to the pole), as the report says.
+fn assert_cap_judged_whole(report: &serde_json::Value, max_tilt: f64) {
+    let region = &report["machined_region"];
+    assert_eq!(
+        region["kind"], "whole face within the tilt reach",
+        "{report}"
+    );
+    assert_eq!(f(region, "max_normal_tilt_deg"), max_tilt, "{report}");
+    let (u, v) = (&region["u"], &region["v"]);
+    let rim = (90.0 - max_tilt).to_radians();
+    assert!(
+        u[0].as_f64().unwrap() <= 0.0
+            && u[1].as_f64().unwrap() >= 2.0 * std::f64::consts::PI - 1e-9,
+        "{report}"
+    );
+    assert!(
+        v[0].as_f64().unwrap() <= rim
+            && v[1].as_f64().unwrap() >= std::f64::consts::FRAC_PI_2 - 1e-9,
+        "{report}"
+    );
+}
+
+#[test]
+fn sphere_cap_iso_scallop_along_meridians_is_verified_to_the_rim() {
+    // Iso-scallop with the passes along v (fronts from the seam meridian, folding and fanning
+    // toward the poles): fill passes close the gaps between fronts and the reach edge is cut,
+    // so the whole cap meets the target (it left 0.80 mm at the rim).
+    let (radius, max_tilt, h, tol) = (40.0_f64, 45.0_f64, 0.2, 0.01);
+    let (report, program, _) = cam(
+        "sphere-iso-v",
+        "rational_sphere.stp",
+        &[
+            "--strategy",
+            "iso-scallop",
+            "--feed-along",
+            "v",
+            "--scallop",
+            "0.2",
+            "--max-tilt",
+            "45",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_eq!(report["feed_along"], "v", "{report}");
+    assert_meets_issue_7(&report, h, true);
+    assert_cap_judged_whole(&report, max_tilt);
+    let rim = radius * max_tilt.to_radians().cos();
+    for p in feed_points(&program) {
+        let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        assert!(r >= radius - tol, "{p:?} inside the sphere");
+        assert!(p[2] >= rim - tol, "{p:?} below the cap");
+    }
+    check_and_run("sphere-iso-v");
+}
+
+#[test]
+fn whole_sphere_along_meridians_is_verified_within_the_tilt_reach() {
+    // At table-ac's default reach (120°) the fronts from the seam run below the equator,
+    // where they fan out: without the fill passes the scallop there was 0.3036 mm at h 0.3
+    // (and 1.36 mm at the rim of the reachable zone before the reach edge was cut).
+    let h = 0.3;
+    let (report, _, _) = cam(
+        "sphere-full-v",
+        "rational_sphere.stp",
+        &[
+            "--strategy",
+            "iso-scallop",
+            "--feed-along",
+            "v",
+            "--scallop",
+            "0.3",
+            "--verify-cell",
+            "1",
+        ],
+    );
+    assert_meets_issue_7(&report, h, true);
+    // Judged down to latitude −30° (normals 120° from +Z), all the way round.
+    let region = &report["machined_region"];
+    assert_eq!(f(region, "max_normal_tilt_deg"), 120.0, "{report}");
+    assert!(
+        region["v"][0].as_f64().unwrap() <= -std::f64::consts::FRAC_PI_6,
+        "{report}"
+    );
 }
 
 /// The largest and smallest table tilt (the A words) of a program, degrees.

@@ -6,6 +6,14 @@
 //! found by a bracketed root search. Points that run past the far edge are clamped onto it;
 //! where a point was already on the edge the pass there would only repeat the previous one,
 //! so that part is not cut again. The plan ends with the front lying wholly on the far edge.
+//!
+//! A propagated front can fold (its offsets cross where it is concave, and the points that
+//! fall back are dropped) or fan out (near a pole, where a step across the feed is a large
+//! parameter step), and the cleaned front may then run farther from the old one than the step
+//! allowed. Each new front is therefore checked from the old one: wherever an old point lies
+//! farther than its step from the new front, extra passes are inserted between the two there
+//! (Lin & Koren 1996; Feng & Li 2002 fill such gaps the same way), so no gap between
+//! neighbouring cuts exceeds the step.
 
 use tezgah_geom::Vec3;
 
@@ -39,6 +47,12 @@ const TANGENT_STENCIL: usize = 3;
 const SEAM_SCAN: usize = 64;
 /// Root-search iterations for one offset (bracketed, so the bound only stops a stall).
 const OFFSET_ITERATIONS: usize = 40;
+/// Relative excess of an old point's distance to the new front over its step above which a
+/// fill pass is inserted there.
+const GAP_SLACK: f64 = 0.05;
+/// Most fill passes between two fronts (a gap wider than this many steps is split into this
+/// many, which the verification would then flag).
+const MAX_FILLS: usize = 16;
 
 /// Spacing of the front's points (mm): fine enough that the front between them is close to
 /// linear in the parameter plane.
@@ -73,7 +87,9 @@ pub(super) fn passes(ctx: &Context) -> Result<Vec<PassPath>, CamError> {
         if front.iter().all(|p| p.edge) {
             return Ok(out);
         }
-        front = advance(ctx, &front, guide)?;
+        let (next, fills) = advance(ctx, &front, guide)?;
+        out.extend(fills);
+        front = next;
     }
     Err(CamError::TooLarge {
         what: "passes",
@@ -106,11 +122,18 @@ fn emit_runs(ctx: &Context, front: &[FrontPoint], out: &mut Vec<PassPath>) {
 }
 
 /// The next front: every point offset by its side step, then cleaned (feed parameter
-/// increasing, both feed ends reached, no gaps wider than the guide spacing).
-fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontPoint>, CamError> {
+/// increasing, both feed ends reached, no gaps wider than the guide spacing); and the fill
+/// passes between the old front and it where they run farther apart than the step.
+fn advance(
+    ctx: &Context,
+    front: &[FrontPoint],
+    guide: f64,
+) -> Result<(Vec<FrontPoint>, Vec<PassPath>), CamError> {
     let axes = ctx.axes;
     let n = front.len();
+    let tiny = (axes.feed.1 - axes.feed.0) * 1e-9;
     let mut next = Vec::with_capacity(n + 8);
+    let mut ends = Vec::with_capacity(n);
     let mut steps = Vec::with_capacity(n);
     let mut kept = Vec::with_capacity(n);
     for i in 0..n {
@@ -133,7 +156,16 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
             crate::scallop::stepover_exact(ctx.shape().radius(), 0.0, ctx.settings.scallop)
                 .unwrap_or(ctx.settings.scallop)
         });
-        let (dir_s, dir_f) = cross_direction(ctx, &local);
+        // The front's ends slide along the feed-end boundaries: offset across the front, an
+        // end would leave the boundary and the front's end, put back on it, would then stand
+        // more than the step from the old end (a saddle's edge: 1.46 steps).
+        let on_end =
+            (i == 0 && p.f <= axes.feed.0 + tiny) || (i + 1 == n && p.f >= axes.feed.1 - tiny);
+        let (dir_s, dir_f) = if on_end {
+            along_side(ctx, &local)
+        } else {
+            cross_direction(ctx, &local)
+        };
         let mut moved = offset(ctx, p, (dir_s, dir_f), &local.d.point, w);
         // The step is set by the curvature at the old pass; where it changes quickly across
         // the step (a blade's rounded edge) the surface between the passes allows less, and
@@ -166,6 +198,7 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
             moved = fitted.unwrap_or_else(|| offset(ctx, p, (dir_s, dir_f), &local.d.point, lo));
         }
         next.push(moved);
+        ends.push(on_end);
         steps.push(w);
         kept.push(p);
     }
@@ -174,10 +207,22 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
         return Err(CamError::Degenerate { u, v });
     }
     // The feed parameter must increase along the front: a point that falls back (where the
-    // front folds over itself near a converging region) is dropped.
+    // front folds over itself near a converging region) is dropped. So is an inner point
+    // clamped onto a feed-end boundary where the front's end slid along it: it stopped short
+    // of its offset, and the end's own offset stands for the front there.
     let mut clean: Vec<FrontPoint> = Vec::with_capacity(next.len());
-    let tiny = (axes.feed.1 - axes.feed.0) * 1e-9;
-    for p in next {
+    let on_feed_end = |p: &FrontPoint| p.f <= axes.feed.0 + tiny || p.f >= axes.feed.1 - tiny;
+    let slid = |k: usize| ends[k] && on_feed_end(&next[k]);
+    let (first_slid, last_slid) = (slid(0), slid(next.len() - 1));
+    let last_index = next.len() - 1;
+    for (k, p) in next.iter().copied().enumerate() {
+        let inner = k != 0 && k != last_index;
+        if inner
+            && ((first_slid && p.f <= axes.feed.0 + tiny)
+                || (last_slid && p.f >= axes.feed.1 - tiny))
+        {
+            continue;
+        }
         if clean.last().is_none_or(|q| p.f > q.f + tiny) {
             clean.push(p);
         }
@@ -203,7 +248,100 @@ fn advance(ctx: &Context, front: &[FrontPoint], guide: f64) -> Result<Vec<FrontP
     }
     let mut dense = densify(ctx, clean, guide);
     pull_back(ctx, &kept, &steps, &mut dense);
-    Ok(dense)
+    let fills = fill_gaps(ctx, &kept, &steps, &dense);
+    Ok((dense, fills))
+}
+
+/// The nearest point of `front`'s polyline (on the surface, between its points' surface
+/// points) to `x`: its distance and parameters.
+fn nearest_on(front: &[FrontPoint], front_xyz: &[Vec3], x: &Vec3) -> (f64, f64, f64) {
+    let mut best = (f64::INFINITY, front[0].s, front[0].f);
+    for k in 0..front.len() {
+        let (a, b) = (front_xyz[k], front_xyz[(k + 1).min(front.len() - 1)]);
+        let ab = b - a;
+        let len2 = ab.norm_squared();
+        let t = if len2 > 0.0 {
+            ((x - a).dot(&ab) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d = (x - (a + ab * t)).norm();
+        if d < best.0 {
+            let q = front[(k + 1).min(front.len() - 1)];
+            let p = front[k];
+            best = (d, p.s + (q.s - p.s) * t, p.f + (q.f - p.f) * t);
+        }
+    }
+    best
+}
+
+/// Fill passes between the old front (`old`, cut with side steps `steps`) and the new one:
+/// every run of old points that lies farther than its step from the new front gets
+/// `⌈gap / step⌉ − 1` passes between it and the nearest new points (straight in the parameters
+/// from each old point to its nearest new point, at equal fractions), widened by one old point
+/// on either side so they join the cuts around the gap.
+fn fill_gaps(
+    ctx: &Context,
+    old: &[FrontPoint],
+    steps: &[f64],
+    new: &[FrontPoint],
+) -> Vec<PassPath> {
+    let axes = ctx.axes;
+    let xyz = |p: &FrontPoint| {
+        let (u, v) = axes.uv(p.s, p.f);
+        ctx.surface.point(u, v)
+    };
+    if new.is_empty() || old.is_empty() {
+        return Vec::new();
+    }
+    let new_xyz: Vec<Vec3> = new.iter().map(xyz).collect();
+    let nearest: Vec<(f64, f64, f64)> = old
+        .iter()
+        .map(|p| nearest_on(new, &new_xyz, &xyz(p)))
+        .collect();
+    // How many passes the gap at each old point needs (0: none). An old point on the edge
+    // that was already cut before (`repeat`) was not cut now and judges nothing.
+    let need: Vec<usize> = old
+        .iter()
+        .zip(&nearest)
+        .zip(steps)
+        .map(|((p, n), w)| {
+            if p.repeat || n.0.is_nan() || n.0 <= w * (1.0 + GAP_SLACK) {
+                0
+            } else {
+                ((n.0 / w).ceil() as usize)
+                    .saturating_sub(1)
+                    .clamp(1, MAX_FILLS)
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < old.len() {
+        if need[i] == 0 {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < old.len() && need[i] > 0 {
+            i += 1;
+        }
+        let (a, b) = (start.saturating_sub(1), i.min(old.len() - 1));
+        let count = need[start..i].iter().copied().max().unwrap_or(1);
+        for m in 1..=count {
+            let x = m as f64 / (count + 1) as f64;
+            let points = (a..=b)
+                .map(|k| {
+                    let (p, n) = (old[k], nearest[k]);
+                    axes.uv(p.s + (n.1 - p.s) * x, p.f + (n.2 - p.f) * x)
+                })
+                .collect::<Vec<_>>();
+            if points.len() >= 2 {
+                out.push(PassPath::Poly(UvPolyline { points }));
+            }
+        }
+    }
+    out
 }
 
 /// Where the new front runs farther from the old one than the side step allowed there (the
@@ -266,10 +404,19 @@ fn cross_direction(ctx: &Context, local: &super::Local) -> (f64, f64) {
         (ds, df) = (-ds, -df);
     }
     if !(ds.is_finite() && df.is_finite()) || ds <= 1e-12 * (ds.abs() + df.abs()) {
-        let ss = if ctx.axes.along_v { d.su } else { d.sv };
-        return (1.0 / ss.norm().max(1e-300), 0.0);
+        return along_side(ctx, local);
     }
     (ds, df)
+}
+
+/// The side parameter's direction `+s` (unit speed) at a front point.
+fn along_side(ctx: &Context, local: &super::Local) -> (f64, f64) {
+    let ss = if ctx.axes.along_v {
+        local.d.su
+    } else {
+        local.d.sv
+    };
+    (1.0 / ss.norm().max(1e-300), 0.0)
 }
 
 /// Samples of the way between a front point and its offset where [`narrowest_step`] looks.

@@ -10,6 +10,7 @@
 mod band;
 mod iso_parametric;
 mod iso_scallop;
+mod reach;
 mod true_cusp;
 
 use std::fmt;
@@ -339,7 +340,21 @@ pub fn plan(
         refused: Vec::new(),
         corrected: 0,
     };
-    for r in results {
+    let out_of_reach = results
+        .iter()
+        .flat_map(|r| &r.refused)
+        .any(|f| f.refusal == Refusal::OutOfReach);
+    // Where passes ran out of reach, the edge of the reach is cut too: the strip between the
+    // last reachable pass and the edge would otherwise keep up to a side step's scallop.
+    let edges: Vec<PassResult> = if out_of_reach {
+        ctx.reach_edges()
+            .par_iter()
+            .map(|edge| ctx.run_pass(&PassPath::Poly(edge.clone()), false))
+            .collect::<Result<_, _>>()?
+    } else {
+        Vec::new()
+    };
+    for r in results.into_iter().chain(edges) {
         plan.path.passes.extend(r.passes);
         plan.refused.extend(r.refused);
         plan.corrected += r.corrected;
@@ -742,6 +757,9 @@ impl<'a> Context<'a> {
                 self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
+        if self.settings.max_axis_tilt_deg.is_some() {
+            self.end_on_reach(&mut ts, &mut placed, &contact_at);
+        }
         if self.settings.band.is_some() {
             self.refine_chords(path, &mut ts, &mut placed, contact_at);
         }
@@ -767,6 +785,47 @@ impl<'a> Context<'a> {
         }
         self.close_pass(&mut out.passes, current);
         Ok(out)
+    }
+
+    /// Ends the pieces of a pass on the edge of the reach: between a placed contact and a
+    /// neighbour refused as out of reach, the last placeable contact is added.
+    fn end_on_reach(
+        &self,
+        ts: &mut Vec<f64>,
+        placed: &mut Vec<Result<Placed, GougeReport>>,
+        contact_at: &impl Fn(f64) -> Contact,
+    ) {
+        let out_of_reach = |p: &Result<Placed, GougeReport>| matches!(p, Err(r) if r.refusal == Refusal::OutOfReach);
+        let ok: Vec<bool> = placed.iter().map(|p| p.is_ok()).collect();
+        let away: Vec<bool> = placed.iter().map(out_of_reach).collect();
+        if !away.contains(&true) {
+            return;
+        }
+        let place_at = |t: f64| {
+            let c = contact_at(t);
+            self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
+        };
+        let n = ts.len();
+        let mut new_ts = Vec::with_capacity(n + 4);
+        let mut new_placed = Vec::with_capacity(n + 4);
+        for (i, item) in std::mem::take(placed).into_iter().enumerate() {
+            if i > 0 && away[i - 1] && ok[i] {
+                if let Some((t, p)) = self.reach_end(ts[i], ts[i - 1], place_at) {
+                    new_ts.push(t);
+                    new_placed.push(Ok(p));
+                }
+            }
+            new_ts.push(ts[i]);
+            new_placed.push(item);
+            if i + 1 < n && ok[i] && away[i + 1] {
+                if let Some((t, p)) = self.reach_end(ts[i], ts[i + 1], place_at) {
+                    new_ts.push(t);
+                    new_placed.push(Ok(p));
+                }
+            }
+        }
+        *ts = new_ts;
+        *placed = new_placed;
     }
 
     /// Keeps a pass of two or more locations, with its run-out when the band is on.
@@ -884,15 +943,23 @@ mod tests {
                 // Out of reach means the normal leans more than the limit: below z = r cos 50°.
                 assert!(f.contact.z < r * cos + 1e-6, "{kind}: {f:?}");
             }
-            // The kept part reaches down to the limit (within a forward step of 5 mm).
-            let lowest = p
-                .path
-                .passes
-                .iter()
-                .flat_map(|q| &q.points)
-                .map(|c| c.contact.z)
-                .fold(f64::INFINITY, f64::min);
-            assert!(lowest < r * cos + 5.0, "{kind}: {lowest}");
+            // The kept part reaches down to the limit: passes that cross it end on it, and
+            // the edge (the parallel at latitude 40°) is cut as a pass of its own.
+            let on_edge = |c: &CutterLocation| (c.contact.z - r * cos).abs() < 1e-6;
+            assert!(
+                p.path.passes.iter().any(|q| q.points.iter().all(on_edge)),
+                "{kind}: no pass along the edge"
+            );
+            for q in &p.path.passes {
+                let (a, b) = (&q.points[0], &q.points[q.points.len() - 1]);
+                // Every pass ends on the edge or on the patch's own boundary.
+                for c in [a, b] {
+                    let boundary = [c.uv.0, c.uv.1]
+                        .iter()
+                        .any(|x| *x < 1e-9 || *x > 1.0 - 1e-9);
+                    assert!(on_edge(c) || boundary, "{kind}: pass ends at {c:?}");
+                }
+            }
         }
         let mut bad = Settings::new(StrategyKind::ZigZag, 0.2, 0.01);
         bad.max_axis_tilt_deg = Some(f64::NAN);

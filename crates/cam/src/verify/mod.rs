@@ -4,8 +4,10 @@
 //! gouge on the surface, with their error bounds.
 //!
 //! Dexels stand on the surface along its outward normal at the nodes of a grid in (u, v) over
-//! the machined region (the box of the cutter-contact parameters), spaced at most `cell` mm
-//! apart on the surface. Each holds the material height above its foot; every cutter pose
+//! the machined region ([`MachinedRegion`]: the surface's whole domain limited to what the
+//! machine reaches, or only the box of the cutter-contact parameters), spaced at most `cell`
+//! mm apart on the surface. A strip of the region that no pass touched shows as uncut or as
+//! a scallop: the region is what the program is meant to machine, not what it did. Each holds the material height above its foot; every cutter pose
 //! lowers it to where the dexel enters the cutter ([`solid`]). Afterwards a positive height is
 //! a scallop, a negative one a gouge.
 //!
@@ -43,6 +45,21 @@ pub struct VerifyOptions {
     pub cell_mm: f64,
     /// Largest motion of any cutter point between two simulated poses, mm.
     pub sweep_spacing_mm: f64,
+    /// Where the surface is judged.
+    pub region: MachinedRegion,
+}
+
+/// The part of the surface a program is meant to machine, which the simulation judges.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MachinedRegion {
+    /// The box of the path's contact parameters: what the path reached. A strip beyond its
+    /// outermost passes (toward a boundary the path should have reached) is not looked at.
+    ContactBox,
+    /// The surface's whole domain (an untrimmed face) limited to the points whose outward
+    /// normal leans at most `max_tilt_deg` from +Z: what a table-tilting machine reaches with
+    /// the tool along the normal (the planner's `max_axis_tilt_deg`). Where the normal is
+    /// undefined (a pole) there is no dexel.
+    Reachable { max_tilt_deg: f64 },
 }
 
 /// What the simulation measured.
@@ -67,6 +84,10 @@ pub struct Verification {
     pub grid_bound_mm: f64,
     /// Sweep error bound, mm (measured heights exceed the true ones by at most this).
     pub sweep_bound_mm: f64,
+    /// The region judged, and the (u, v) box its grid spans.
+    pub region: MachinedRegion,
+    pub region_u: (f64, f64),
+    pub region_v: (f64, f64),
 }
 
 /// Why the simulation could not run.
@@ -78,6 +99,8 @@ pub enum VerifyError {
     Empty,
     #[error("the grid would need {0} dexels (more than {MAX_DEXELS}); use a coarser cell")]
     TooFine(usize),
+    #[error("no point of the surface lies within the machined region ({0:?})")]
+    EmptyRegion(MachinedRegion),
 }
 
 /// Memory guard: 4 M dexels are ~0.35 GB of grid data.
@@ -183,22 +206,33 @@ pub fn simulate(
     let spacing = positive("the sweep spacing", options.sweep_spacing_mm)?;
     let cls: Vec<_> = path.passes.iter().flat_map(|p| &p.points).collect();
     let first = cls.first().ok_or(VerifyError::Empty)?;
-    // The machined region in (u, v).
-    let (mut u0, mut u1, mut v0, mut v1) = (
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-        f64::INFINITY,
-        f64::NEG_INFINITY,
-    );
-    for c in &cls {
-        u0 = u0.min(c.uv.0);
-        u1 = u1.max(c.uv.0);
-        v0 = v0.min(c.uv.1);
-        v1 = v1.max(c.uv.1);
-    }
-    let (du0, du1) = surface.domain_u();
-    let (dv0, dv1) = surface.domain_v();
-    let (u0, u1, v0, v1) = (u0.max(du0), u1.min(du1), v0.max(dv0), v1.min(dv1));
+    // Orient the normals out of the material as the path's first contact says.
+    let flip = surface
+        .normal(first.uv.0, first.uv.1)
+        .is_some_and(|n| n.dot(&first.normal) < 0.0);
+    let outward = |u: f64, v: f64| {
+        surface.normal(u, v).map(|n| {
+            if flip {
+                -n.into_inner()
+            } else {
+                n.into_inner()
+            }
+        })
+    };
+    // cos of the largest lean a judged dexel's normal may have from +Z.
+    let min_normal_z = match options.region {
+        MachinedRegion::ContactBox => None,
+        MachinedRegion::Reachable { max_tilt_deg } => {
+            let t = positive("the region's tilt limit", max_tilt_deg)?;
+            Some(t.min(180.0).to_radians().cos() - REACH_SLACK)
+        }
+    };
+    let (u0, u1, v0, v1) = match min_normal_z {
+        None => contact_box(surface, &cls),
+        Some(z) => {
+            reachable_box(surface, z, &outward).ok_or(VerifyError::EmptyRegion(options.region))?
+        }
+    };
     // Grid lines at equal steps of arc length (each parameter's speed taken as its largest
     // across the other parameter): a surface whose parametric speed varies — STEP fits often
     // run 5:1 — gets nodes no denser than the cell where it is slow.
@@ -222,10 +256,6 @@ pub fn simulate(
         let t = (k % f) as f64 / f as f64;
         nodes[i] + (nodes[i + 1] - nodes[i]) * t
     };
-    // Orient the normals out of the material as the path's first contact says.
-    let flip = surface
-        .normal(first.uv.0, first.uv.1)
-        .is_some_and(|n| n.dot(&first.normal) < 0.0);
     // The surface's largest convex curvature (bending away from the outward normal): a scallop
     // flank rises over it as over a plane under a cutter of the smaller effective radius
     // 1/(1/ρ + κ), so the grid bound uses that.
@@ -252,10 +282,14 @@ pub fn simulate(
     let dexel = |node: (usize, usize), u: f64, v: f64| {
         let d = surface.derivs(u, v);
         let n = d.normal()?.into_inner();
+        let n = if flip { -n } else { n };
+        if min_normal_z.is_some_and(|z| n.z < z) {
+            return None;
+        }
         Some(Dexel {
             node,
             foot: d.point,
-            normal: if flip { -n } else { n },
+            normal: n,
             uv: (u, v),
             height: up,
         })
@@ -284,6 +318,9 @@ pub fn simulate(
         gouge_at: None,
         grid_bound_mm: 0.0,
         sweep_bound_mm: 0.0,
+        region: options.region,
+        region_u: (u0, u1),
+        region_v: (v0, v1),
     };
     out.uncut = dexels.iter().filter(|d| d.height >= up).count();
     measure(&dexels, up, &mut out);
@@ -347,6 +384,81 @@ pub fn simulate(
         grid_bound(&out, rho_flank, achieved)
     };
     Ok(out)
+}
+
+/// The (u, v) box of the path's contact points, within the domain.
+fn contact_box(
+    surface: &NurbsSurface,
+    cls: &[&crate::toolpath::CutterLocation],
+) -> (f64, f64, f64, f64) {
+    let (mut u0, mut u1, mut v0, mut v1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for c in cls {
+        u0 = u0.min(c.uv.0);
+        u1 = u1.max(c.uv.0);
+        v0 = v0.min(c.uv.1);
+        v1 = v1.max(c.uv.1);
+    }
+    let (du0, du1) = surface.domain_u();
+    let (dv0, dv1) = surface.domain_v();
+    (u0.max(du0), u1.min(du1), v0.max(dv0), v1.min(dv1))
+}
+
+/// A dexel whose normal's z falls short of the reach limit's cosine by less than this still
+/// counts as reachable (the planner's own test allows 10⁻¹² and a contact exactly on the
+/// limit must stay judged).
+const REACH_SLACK: f64 = 1e-9;
+
+/// Samples per parameter when [`reachable_box`] looks for the reachable part of the domain.
+const REACH_SAMPLES: usize = 128;
+
+/// The (u, v) box holding every reachable point (outward normal's z ≥ `min_z`): the sampled
+/// reachable nodes' box grown by one sample spacing (the region's edge lies between a
+/// reachable node and an unreachable neighbour), within the domain; `None` if no node is
+/// reachable. Nodes without a normal (a pole) count as reachable when a neighbour is, so a
+/// cap around a pole keeps its pole inside the box.
+fn reachable_box(
+    surface: &NurbsSurface,
+    min_z: f64,
+    outward: &impl Fn(f64, f64) -> Option<Vec3>,
+) -> Option<(f64, f64, f64, f64)> {
+    let (du, dv) = (surface.domain_u(), surface.domain_v());
+    let n = REACH_SAMPLES;
+    let at = |k: usize, r: (f64, f64)| r.0 + (r.1 - r.0) * k as f64 / n as f64;
+    let (mut i0, mut i1, mut j0, mut j1) = (usize::MAX, 0, usize::MAX, 0);
+    for i in 0..=n {
+        for j in 0..=n {
+            let (u, v) = (at(i, du), at(j, dv));
+            let reach = |z: Option<Vec3>| z.is_some_and(|n| n.z >= min_z);
+            let here = outward(u, v);
+            let inside = reach(here)
+                || (here.is_none()
+                    && [
+                        (i.saturating_sub(1), j),
+                        ((i + 1).min(n), j),
+                        (i, j.saturating_sub(1)),
+                        (i, (j + 1).min(n)),
+                    ]
+                    .iter()
+                    .any(|&(a, b)| reach(outward(at(a, du), at(b, dv)))));
+            if inside {
+                (i0, i1, j0, j1) = (i0.min(i), i1.max(i), j0.min(j), j1.max(j));
+            }
+        }
+    }
+    if i0 == usize::MAX {
+        return None;
+    }
+    Some((
+        at(i0.saturating_sub(1), du),
+        at((i1 + 1).min(n), du),
+        at(j0.saturating_sub(1), dv),
+        at((j1 + 1).min(n), dv),
+    ))
 }
 
 /// Candidate nodes refined at most (each adds up to (2·REFINE + 1)² sub-dexels, fewer where
