@@ -15,17 +15,25 @@
 //! `dist(x, core_k) ≥ (1 − e₁)·dist(x, core_P) − e₁|x − c_P| − e₀`, and a point of the cutter
 //! at pose `k` (distance ≤ r to its core) on a dexel whose ends lie within `M` of `c_P` is
 //! within `(r + e₀ + e₁M)/(1 − e₁)` of `P`'s core.
+//!
+//! A ball's bound is far tighter where the dexel passes below every ball centre of the run
+//! (`z_k(x) = (x − c_k)·a_k < 0`, which `z_P(x) < −(e₀ + e₁M)` at both ends of the dexel proves,
+//! `|z_k − z_P| ≤ e₀ + e₁M`): there its solid is the ball `|x − c_k| ≤ r` alone, and the balls of
+//! a run lie in the capsule of radius `r + d` about the chord of their centres, `d` the centres'
+//! largest distance from it — near the continuous sweep itself on a smooth pass.
 
 use rayon::prelude::*;
 use tezgah_geom::Vec3;
 
-use super::solid::{CutterPose, CutterSolid};
+use super::solid::{capsule_entry, CutterPose, CutterSolid};
 use super::Dexel;
 
 /// Poses at the tree's leaves (entered one by one).
 const LEAF: usize = 4;
-/// Runs of at most this many poses are what a tile collects (and each dexel descends into).
-const RUN: usize = 32;
+/// Runs whose poses' core bottoms span at most this many tool radii are what a tile collects (and
+/// each dexel descends into): the sweep spaces poses by the motion of the cutter's farthest
+/// point, so near a turn of the axis they crowd at the tip, and a count would not do.
+const RUN_RADII: f64 = 1.0;
 /// Runs whose axis turns this much (2 sin(θ/2)) are not bounded by their representative.
 const MAX_TURN: f64 = 0.5;
 /// Slack on the bounds against rounding: a run is entered when its bound is this close.
@@ -57,6 +65,10 @@ struct Node {
     /// Box holding every pose's solid.
     min: Vec3,
     max: Vec3,
+    /// Chord from the first to the last ball centre (core bottom: start, unit direction,
+    /// length) and the centres' largest distance from it.
+    chord: (Vec3, Vec3, f64),
+    deviation: f64,
 }
 
 struct PoseTree {
@@ -97,6 +109,18 @@ impl PoseTree {
         }
         // Every solid lies within R of its axis segment from the core's bottom to its top.
         let (min, max) = (min.add_scalar(-radius), max.add_scalar(radius));
+        let (c0, c1) = (bottom(&poses[lo]), bottom(&poses[hi - 1]));
+        let deviation = poses[lo..hi]
+            .iter()
+            .map(|p| point_segment_distance(&bottom(p), &c0, &c1))
+            .fold(0.0, f64::max);
+        let len = (c1 - c0).norm();
+        let along = if len > 0.0 {
+            (c1 - c0) / len
+        } else {
+            poses[rep].axis
+        };
+        let chord = (c0, along, len);
         let at = self.nodes.len();
         self.nodes.push(Node {
             lo: lo as u32,
@@ -107,6 +131,8 @@ impl PoseTree {
             e1,
             min,
             max,
+            chord,
+            deviation,
         });
         if hi - lo > LEAF {
             let left = self.grow(poses, lo, rep, bottom, top, radius);
@@ -116,8 +142,8 @@ impl PoseTree {
         at as u32
     }
 
-    /// The runs of at most [`RUN`] poses whose boxes meet the box `lo`–`hi`.
-    fn runs_meeting(&self, lo: &Vec3, hi: &Vec3, out: &mut Vec<u32>) {
+    /// The runs whose core bottoms span at most `span` mm whose boxes meet the box `lo`–`hi`.
+    fn runs_meeting(&self, lo: &Vec3, hi: &Vec3, span: f64, out: &mut Vec<u32>) {
         let mut stack = vec![0u32];
         while let Some(k) = stack.pop() {
             let node = &self.nodes[k as usize];
@@ -125,7 +151,7 @@ impl PoseTree {
                 continue;
             }
             match node.children {
-                Some((l, r)) if (node.hi - node.lo) as usize > RUN => {
+                Some((l, r)) if 2.0 * node.e0 > span => {
                     stack.push(r);
                     stack.push(l);
                 }
@@ -133,6 +159,17 @@ impl PoseTree {
             }
         }
     }
+}
+
+fn point_segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    let s = if len2 > 0.0 {
+        ((p - a).dot(&d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * s)).norm()
 }
 
 fn boxes_meet(a0: &Vec3, a1: &Vec3, b0: &Vec3, b1: &Vec3) -> bool {
@@ -146,6 +183,36 @@ struct Ray {
     height: f64,
     /// The pose that last lowered it.
     best: Option<u32>,
+    /// Its deepest point, its point at the current height, and the box of the two.
+    bottom: Vec3,
+    top: Vec3,
+    min: Vec3,
+    max: Vec3,
+}
+
+impl Ray {
+    fn new(d: &Dexel, depth: f64) -> Self {
+        let bottom = d.foot - d.normal * depth;
+        let mut ray = Ray {
+            foot: d.foot,
+            normal: d.normal,
+            height: d.height,
+            best: None,
+            bottom,
+            top: bottom,
+            min: bottom,
+            max: bottom,
+        };
+        ray.lower(d.height);
+        ray
+    }
+
+    fn lower(&mut self, height: f64) {
+        self.height = height;
+        self.top = self.foot + self.normal * height;
+        self.min = self.bottom.inf(&self.top);
+        self.max = self.bottom.sup(&self.top);
+    }
 }
 
 impl Sweeper {
@@ -224,7 +291,7 @@ impl Sweeper {
             hi = hi.sup(&a).sup(&b);
         }
         let mut runs = Vec::new();
-        tree.runs_meeting(&lo, &hi, &mut runs);
+        tree.runs_meeting(&lo, &hi, RUN_RADII * self.radius, &mut runs);
         // Nearest runs first: the first dexel finds its low point early and prunes the rest.
         let centre = (lo + hi) * 0.5;
         let mut keyed: Vec<(f64, u32)> = runs
@@ -241,12 +308,7 @@ impl Sweeper {
             .iter()
             .map(|&(_, k)| {
                 let d = &dexels[k as usize];
-                let mut ray = Ray {
-                    foot: d.foot,
-                    normal: d.normal,
-                    height: d.height,
-                    best: None,
-                };
+                let mut ray = Ray::new(d, self.depth);
                 // The neighbour's lowest pose is most often this dexel's too.
                 if let Some(h) = hint {
                     self.leaf(&mut ray, &poses[h as usize], h);
@@ -268,7 +330,7 @@ impl Sweeper {
             .entry(pose, &ray.foot, &ray.normal, -self.depth, ray.height)
         {
             if t < ray.height {
-                ray.height = t;
+                ray.lower(t);
                 ray.best = Some(k);
             }
         }
@@ -306,10 +368,8 @@ impl Sweeper {
     /// Whether some pose of `node` may enter the dexel below its current height (the bound of
     /// the module's doc).
     fn may_cut(&self, ray: &Ray, node: &Node, poses: &[CutterPose]) -> bool {
-        let a = ray.foot - ray.normal * self.depth;
-        let b = ray.foot + ray.normal * ray.height;
-        let (smin, smax) = (a.inf(&b), a.sup(&b));
-        if !boxes_meet(&node.min, &node.max, &smin, &smax) {
+        let (a, b) = (ray.bottom, ray.top);
+        if !boxes_meet(&node.min, &node.max, &ray.min, &ray.max) {
             return false;
         }
         if node.e1 >= MAX_TURN {
@@ -318,6 +378,15 @@ impl Sweeper {
         let rep = &poses[node.rep as usize];
         let c = rep.tip + rep.axis * self.solid.corner;
         let m = (a - c).norm().max((b - c).norm());
+        if self.solid.core_radius == 0.0 {
+            let below = (a - c).dot(&rep.axis).max((b - c).dot(&rep.axis));
+            if below < -(node.e0 + node.e1 * m) {
+                let (c0, along, len) = node.chord;
+                let reach = self.solid.corner + node.deviation;
+                return capsule_entry(&c0, &along, len, reach, &ray.foot, &ray.normal, -self.depth)
+                    .is_some_and(|t| t < ray.height + SLACK);
+            }
+        }
         let reach = (self.solid.corner + node.e0 + node.e1 * m) / (1.0 - node.e1);
         self.solid
             .entry_within(
