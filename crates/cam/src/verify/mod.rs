@@ -30,13 +30,17 @@
 //!
 
 pub mod solid;
+mod sweep;
 
 use tezgah_geom::{NurbsSurface, Vec3};
 
 pub use solid::{CutterPose, CutterSolid};
 
+use rayon::prelude::*;
+
 use crate::arc_grid::{arc_nodes, spread};
 use crate::toolpath::ToolPath;
+use sweep::Sweeper;
 
 /// How finely to simulate.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -294,17 +298,23 @@ pub fn simulate(
             height: up,
         })
     };
-    let mut dexels: Vec<Dexel> = Vec::with_capacity(count);
-    for (i, &u) in u_nodes.iter().enumerate() {
-        for (j, &v) in v_nodes.iter().enumerate() {
-            dexels.extend(dexel((i, j), u, v));
-        }
-    }
+    let dexels: Vec<Vec<Dexel>> = u_nodes
+        .par_iter()
+        .enumerate()
+        .map(|(i, &u)| {
+            v_nodes
+                .iter()
+                .enumerate()
+                .filter_map(|(j, &v)| dexel((i, j), u, v))
+                .collect()
+        })
+        .collect();
+    let mut dexels: Vec<Dexel> = dexels.into_iter().flatten().collect();
     let sweeper = Sweeper {
         solid: CutterSolid::of(&path.cutter),
         radius: r,
         depth,
-        bucket: r.max(4.0 * cell),
+        tile: TILE_CELLS * cell,
     };
     sweeper.run(&mut dexels, poses);
     let mut out = Verification {
@@ -461,6 +471,9 @@ fn reachable_box(
     ))
 }
 
+/// Edge of the simulation's tiles, in cells (a tile's dexels share their candidate poses).
+const TILE_CELLS: f64 = 16.0;
+
 /// Candidate nodes refined at most (each adds up to (2·REFINE + 1)² sub-dexels, fewer where
 /// neighbours share them).
 const REFINE_CAP: usize = 4096;
@@ -526,230 +539,4 @@ fn grid_bound(out: &Verification, rho: f64, cell: f64) -> f64 {
         e = (slope * cell / std::f64::consts::SQRT_2).min(rho);
     }
     e
-}
-
-/// Lowers dexels to where they enter the cutter at each pose.
-struct Sweeper {
-    solid: CutterSolid,
-    radius: f64,
-    depth: f64,
-    bucket: f64,
-}
-
-impl Sweeper {
-    fn run(&self, dexels: &mut [Dexel], poses: &[CutterPose]) {
-        let grid = Buckets::new(dexels, self.bucket);
-        let (r, depth, solid) = (self.radius, self.depth, &self.solid);
-        // Dexels reach at most this far from their feet.
-        let reach_out = dexels.iter().map(|d| d.height).fold(depth, f64::max);
-        for pose in poses {
-            let axis = pose.axis;
-            // The solid lies within R of its axis segment from the corner's centre to the top.
-            let (s0, s1) = (
-                pose.tip + axis * solid.corner,
-                pose.tip + axis * solid.core_top,
-            );
-            let grow = r + reach_out;
-            let lo = s0.inf(&s1).add_scalar(-grow);
-            let hi = s0.sup(&s1).add_scalar(grow);
-            grid.visit(&lo, &hi, |k| {
-                let d = &mut dexels[k];
-                let (a, b) = (d.foot - d.normal * depth, d.foot + d.normal * d.height);
-                if segment_distance(&a, &b, &s0, &s1) > r {
-                    return;
-                }
-                if let Some(t) = solid.entry(pose, &d.foot, &d.normal, -depth, d.height) {
-                    if t < d.height {
-                        d.height = t;
-                    }
-                }
-            });
-        }
-    }
-}
-
-/// Distance between the segments p0–p1 and q0–q1 (Ericson, *Real-Time Collision Detection*,
-/// §5.1.9: the closest points by clamped parameters).
-fn segment_distance(p0: &Vec3, p1: &Vec3, q0: &Vec3, q1: &Vec3) -> f64 {
-    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
-    let (a, e, f) = (d1.norm_squared(), d2.norm_squared(), d2.dot(&r));
-    let (s, t) = if a <= f64::EPSILON && e <= f64::EPSILON {
-        (0.0, 0.0)
-    } else if a <= f64::EPSILON {
-        (0.0, (f / e).clamp(0.0, 1.0))
-    } else {
-        let c = d1.dot(&r);
-        if e <= f64::EPSILON {
-            ((-c / a).clamp(0.0, 1.0), 0.0)
-        } else {
-            let b = d1.dot(&d2);
-            let denom = a * e - b * b;
-            let mut s = if denom > 0.0 {
-                ((b * f - c * e) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let mut t = (b * s + f) / e;
-            if t < 0.0 {
-                t = 0.0;
-                s = (-c / a).clamp(0.0, 1.0);
-            } else if t > 1.0 {
-                t = 1.0;
-                s = ((b - c) / a).clamp(0.0, 1.0);
-            }
-            (s, t)
-        }
-    };
-    ((p0 + d1 * s) - (q0 + d2 * t)).norm()
-}
-
-/// A uniform grid of buckets over the dexel feet, for the poses' neighbourhood queries.
-struct Buckets {
-    origin: Vec3,
-    size: f64,
-    dims: [usize; 3],
-    start: Vec<u32>,
-    items: Vec<u32>,
-}
-
-impl Buckets {
-    fn new(dexels: &[Dexel], size: f64) -> Self {
-        let mut lo = Vec3::repeat(f64::INFINITY);
-        let mut hi = Vec3::repeat(f64::NEG_INFINITY);
-        for d in dexels {
-            lo = lo.inf(&d.foot);
-            hi = hi.sup(&d.foot);
-        }
-        if dexels.is_empty() {
-            lo = Vec3::zeros();
-            hi = Vec3::zeros();
-        }
-        // The feet lie on a surface, so most of a 3-D grid is empty: buckets grow until the
-        // grid has at most a few cells per dexel (a part far larger than the tool would
-        // otherwise ask for billions of cells).
-        let limit = 4 * dexels.len() + 4096;
-        let mut size = size;
-        let mut dims = [1usize; 3];
-        for _ in 0..200 {
-            dims = [0, 1, 2].map(|i| ((hi[i] - lo[i]) / size).floor().clamp(0.0, 1e6) as usize + 1);
-            if dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) <= limit {
-                break;
-            }
-            size *= 1.5;
-        }
-        let cells = dims[0] * dims[1] * dims[2];
-        let index = |p: &Vec3| -> usize {
-            let c = [0, 1, 2]
-                .map(|i| (((p[i] - lo[i]) / size).floor().max(0.0) as usize).min(dims[i] - 1));
-            (c[0] * dims[1] + c[1]) * dims[2] + c[2]
-        };
-        let mut count = vec![0u32; cells + 1];
-        for d in dexels {
-            count[index(&d.foot) + 1] += 1;
-        }
-        for i in 0..cells {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut items = vec![0u32; dexels.len()];
-        for (k, d) in dexels.iter().enumerate() {
-            let b = index(&d.foot);
-            items[fill[b] as usize] = k as u32;
-            fill[b] += 1;
-        }
-        Buckets {
-            origin: lo,
-            size,
-            dims,
-            start: count,
-            items,
-        }
-    }
-
-    fn visit(&self, lo: &Vec3, hi: &Vec3, mut f: impl FnMut(usize)) {
-        let range = |i: usize| -> Option<(usize, usize)> {
-            let a = ((lo[i] - self.origin[i]) / self.size).floor();
-            let b = ((hi[i] - self.origin[i]) / self.size).floor();
-            if b < 0.0 || a > (self.dims[i] - 1) as f64 {
-                return None;
-            }
-            Some((a.max(0.0) as usize, (b as usize).min(self.dims[i] - 1)))
-        };
-        let (Some(x), Some(y), Some(z)) = (range(0), range(1), range(2)) else {
-            return;
-        };
-        for i in x.0..=x.1 {
-            for j in y.0..=y.1 {
-                let row = (i * self.dims[1] + j) * self.dims[2];
-                let (s, e) = (
-                    self.start[row + z.0] as usize,
-                    self.start[row + z.1 + 1] as usize,
-                );
-                for &k in &self.items[s..e] {
-                    f(k as usize);
-                }
-            }
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn dexel(foot: Vec3) -> Dexel {
-        Dexel {
-            node: (0, 0),
-            foot,
-            normal: Vec3::z(),
-            uv: (0.0, 0.0),
-            height: 1.0,
-        }
-    }
-
-    #[test]
-    fn buckets_stay_small_on_a_huge_sparse_part_and_find_their_dexels() {
-        // Two feet a kilometre apart with 1 mm buckets: 10¹⁸ cells if the grid did not grow.
-        let dexels = [dexel(Vec3::zeros()), dexel(Vec3::new(1e6, 1e6, 1e6))];
-        let b = Buckets::new(&dexels, 1.0);
-        assert!(b.start.len() <= 4 * 2 + 4096 + 1);
-        let mut seen = Vec::new();
-        b.visit(&Vec3::repeat(-1.0), &Vec3::repeat(1.0), |k| seen.push(k));
-        assert!(seen.contains(&0));
-        let mut all = Vec::new();
-        b.visit(&Vec3::repeat(-1.0), &Vec3::repeat(2e6), |k| all.push(k));
-        all.sort();
-        assert_eq!(all, vec![0, 1]);
-    }
-
-    #[test]
-    fn segment_distance_matches_closed_forms() {
-        let o = Vec3::zeros();
-        // Skew perpendicular lines 2 apart.
-        let d = segment_distance(
-            &o,
-            &Vec3::x(),
-            &Vec3::new(0.5, -1.0, 2.0),
-            &Vec3::new(0.5, 1.0, 2.0),
-        );
-        assert!((d - 2.0).abs() < 1e-12);
-        // Parallel, overlapping.
-        let d = segment_distance(
-            &o,
-            &Vec3::x(),
-            &Vec3::new(0.5, 3.0, 0.0),
-            &Vec3::new(2.0, 3.0, 0.0),
-        );
-        assert!((d - 3.0).abs() < 1e-12);
-        // End to end, and a point.
-        let d = segment_distance(
-            &o,
-            &Vec3::x(),
-            &Vec3::new(4.0, 4.0, 0.0),
-            &Vec3::new(5.0, 4.0, 0.0),
-        );
-        assert!((d - 5.0).abs() < 1e-12);
-        let p = Vec3::new(0.5, 0.0, 1.0);
-        assert!((segment_distance(&o, &Vec3::x(), &p, &p) - 1.0).abs() < 1e-12);
-    }
 }
