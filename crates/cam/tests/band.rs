@@ -123,7 +123,7 @@ fn convex_roller_ball_flat_and_bull_nose() {
         s.direction = FeedDirection::AlongU;
         s
     };
-    let (b, f) = (around(banded(z, 0.05, 0.0)), around(banded(z, 0.05, 10.0)));
+    let (b, f) = (around(banded(z, 0.05, 0.0)), around(banded(z, 0.05, 5.0)));
     assert_within("roller ball D6", &s, &ball(6.0), &b, 0.12);
     assert_within("roller flat D8", &s, &flat(8.0), &f, 0.12);
     assert_within("roller bull D8 r2", &s, &bull(8.0, 2.0), &f, 0.12);
@@ -144,14 +144,14 @@ fn concave_trough_ball_flat_and_bull_nose() {
         "trough flat D8",
         &s,
         &flat(8.0),
-        &banded(z, 0.05, 10.0),
+        &banded(z, 0.05, 5.0),
         0.15,
     );
     assert_within(
         "trough bull D8 r2",
         &s,
         &bull(8.0, 2.0),
-        &banded(z, 0.05, 10.0),
+        &banded(z, 0.05, 5.0),
         0.15,
     );
 }
@@ -161,12 +161,12 @@ fn sphere_patch_ball_flat_and_bull_nose() {
     let s = testing::sphere(15.0);
     let z = StrategyKind::ZigZag;
     assert_within("sphere ball D6", &s, &ball(6.0), &banded(z, 0.1, 0.0), 0.2);
-    assert_within("sphere flat D8", &s, &flat(8.0), &banded(z, 0.1, 10.0), 0.2);
+    assert_within("sphere flat D8", &s, &flat(8.0), &banded(z, 0.1, 5.0), 0.2);
     assert_within(
         "sphere bull D8 r2",
         &s,
         &bull(8.0, 2.0),
-        &banded(z, 0.1, 10.0),
+        &banded(z, 0.1, 5.0),
         0.2,
     );
 }
@@ -176,18 +176,12 @@ fn saddle_ball_flat_and_bull_nose() {
     let s = testing::saddle(10.0, 40.0);
     let z = StrategyKind::IsoScallop;
     assert_within("saddle ball D6", &s, &ball(6.0), &banded(z, 0.1, 0.0), 0.15);
-    assert_within(
-        "saddle flat D8",
-        &s,
-        &flat(8.0),
-        &banded(z, 0.1, 10.0),
-        0.15,
-    );
+    assert_within("saddle flat D8", &s, &flat(8.0), &banded(z, 0.1, 5.0), 0.15);
     assert_within(
         "saddle bull D8 r2",
         &s,
         &bull(8.0, 2.0),
-        &banded(z, 0.1, 10.0),
+        &banded(z, 0.1, 5.0),
         0.15,
     );
 }
@@ -207,14 +201,14 @@ fn free_form_patch_ball_flat_and_bull_nose() {
         "free-form flat D8",
         &s,
         &flat(8.0),
-        &banded(z, 0.4, 10.0),
+        &banded(z, 0.4, 5.0),
         0.8,
     );
     assert_within(
         "free-form bull D8 r2",
         &s,
         &bull(8.0, 2.0),
-        &banded(z, 0.4, 10.0),
+        &banded(z, 0.4, 5.0),
         0.8,
     );
 }
@@ -244,14 +238,14 @@ fn step_free_form_fixture_ball_flat_and_bull_nose() {
         "STEP flat D8",
         s,
         &flat(8.0),
-        &with(banded(z, 0.4, 10.0)),
+        &with(banded(z, 0.4, 5.0)),
         0.8,
     );
     assert_within(
         "STEP bull D8 r2",
         s,
         &bull(8.0, 2.0),
-        &with(banded(z, 0.4, 10.0)),
+        &with(banded(z, 0.4, 5.0)),
         0.8,
     );
 }

@@ -65,7 +65,8 @@ pub fn collision(
             p0.sup(&p1) + Vec3::repeat(reach),
         );
         let mut hit = None;
-        grid.visit_box(&lo, &hi, |p| {
+        grid.visit_box(&lo, &hi, |s| {
+            let p = &s.point;
             let d = p - tip;
             let z = d.dot(&a);
             if z < c.from || z > c.from + c.length {

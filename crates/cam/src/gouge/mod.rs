@@ -72,7 +72,7 @@ impl Default for GougeSettings {
 pub struct GougeChecker {
     cutter: Cutter,
     settings: GougeSettings,
-    fine: Option<PointGrid>,
+    fine: Option<rear::RearIndex>,
     coarse: Option<PointGrid>,
 }
 
@@ -94,13 +94,17 @@ impl GougeChecker {
             })
         };
         let fine = if settings.rear {
-            Some(PointGrid::new(sample(settings.rear_spacing)?, 2.0 * r))
+            Some(rear::RearIndex::new(
+                surface,
+                sample(settings.rear_spacing)?,
+                2.0 * r,
+            ))
         } else {
             None
         };
         let coarse = if settings.global {
             Some(PointGrid::new(
-                sample(settings.global_spacing)?,
+                sample(settings.global_spacing)?.samples,
                 (2.0 * r).max(4.0 * settings.global_spacing),
             ))
         } else {
@@ -117,9 +121,8 @@ impl GougeChecker {
     /// Rear and global checks of the cutter standing at `tip` along `axis` (the local check
     /// needs the contact's curvature and lives in [`local`]).
     pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {
-        if let Some(grid) = &self.fine {
-            if let Some(rear::Penetration { depth, point }) = rear::first_penetration(
-                grid,
+        if let Some(index) = &self.fine {
+            if let Some(rear::Penetration { depth, point }) = index.first_penetration(
                 &self.cutter.shape,
                 tip,
                 axis,

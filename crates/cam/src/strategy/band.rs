@@ -190,6 +190,74 @@ impl Context<'_> {
     }
 }
 
+/// Rounds of raising the leads at the ends of a chord whose middle gouges.
+const CHORD_ROUNDS: usize = 4;
+/// Lead added per round at both ends of such a chord, degrees.
+const CHORD_LEAD_STEP_DEG: f64 = 1.0;
+
+impl Context<'_> {
+    /// The machine sweeps the cutter along a straight tip move with the axis turning on a
+    /// great circle between two placed locations; the rear and global checks only saw the
+    /// ends. The pose half-way (lifted as the band will lift its ends, so the chord's own sag
+    /// near the contact, which the band removes, does not count) is checked too, and where it
+    /// gouges both ends are placed again
+    /// leaning further (by [`CHORD_LEAD_STEP_DEG`] a round); ends still gouging in the middle
+    /// after [`CHORD_ROUNDS`] are refused (reported, never emitted).
+    pub(super) fn clear_chords(
+        &self,
+        path: &impl SurfacePath,
+        ts: &[f64],
+        contacts: &[super::Contact],
+        placed: &mut [Result<Placed, super::GougeReport>],
+        band: Band,
+    ) {
+        let step = CHORD_LEAD_STEP_DEG.to_radians();
+        for round in 0..=CHORD_ROUNDS {
+            let mut gouging = vec![None; placed.len()];
+            for i in 0..placed.len().saturating_sub(1) {
+                if let (Ok(a), Ok(b)) = (&placed[i], &placed[i + 1]) {
+                    let (a, b) = (&a.location, &b.location);
+                    let axis = axis_between(&a.axis, &b.axis, 0.5);
+                    // Both ends will be lifted by at least the band's motion plus this chord's
+                    // inward sag (`shift_outward`): the middle as the machine will sweep it.
+                    let sag = self.chord_sag(path, (ts[i], ts[i + 1]), a, b);
+                    let normal = (a.normal + b.normal).normalize();
+                    let lift = (band.motion + sag.inward) * normal.dot(&a.normal).min(1.0);
+                    let tip = 0.5 * (a.tip + b.tip) + normal * lift;
+                    if let Some(g) = self.checker.check(&tip, &axis) {
+                        gouging[i] = Some(g);
+                        gouging[i + 1] = Some(g);
+                    }
+                }
+            }
+            if gouging.iter().all(Option::is_none) {
+                return;
+            }
+            for (i, g) in gouging.into_iter().enumerate() {
+                let (Some(g), Ok(p)) = (g, &placed[i]) else {
+                    continue;
+                };
+                let c = contacts[i];
+                let report = super::GougeReport {
+                    uv: c.uv,
+                    contact: p.location.contact,
+                    refusal: super::Refusal::Gouge(g),
+                };
+                let lead = p.lead + step;
+                let max_lead = match self.settings.axis {
+                    super::ToolAxis::Surface { max_lead_deg, .. } => max_lead_deg.to_radians(),
+                    super::ToolAxis::Fixed(_) => f64::NEG_INFINITY,
+                };
+                placed[i] = if round == CHORD_ROUNDS || lead > max_lead + 1e-12 {
+                    Err(report)
+                } else {
+                    self.place(c.uv.0, c.uv.1, c.tangent, lead)
+                };
+            }
+        }
+    }
+}
+
 /// How one tolerance `T` (DESIGN.md "Tolerance": what the machine's motion may depart from
 /// the exact CL surface) is shared between the stages when the band is on: the strategy's
 /// chords `T/2`, the post's linearisation `T/8`, the controller's blending (`G64 P`) `T/8`.
@@ -223,6 +291,10 @@ impl ToleranceShares {
 
 /// Halvings of a run-out that gouges before it is left out.
 const RUN_OUT_TRIALS: usize = 4;
+/// Largest step between the checked poses of a run-out, mm: between two poses a surface
+/// point's depth in the cutter changes by at most the step (the depth is 1-Lipschitz), and
+/// the poses' bottoms overlap.
+const RUN_OUT_POSE_STEP: f64 = 0.25;
 
 impl Context<'_> {
     /// A flat or bull-nose cutter's run-out past the end of a pass (`prev` then `last`):
@@ -268,9 +340,19 @@ impl Context<'_> {
             y.min(radius)
         };
         for _ in 0..RUN_OUT_TRIALS {
-            let tip = last.tip + feed * d;
-            if self.checker.check(&tip, &axis).is_none() {
-                return Some(CutterLocation { tip, ..*last });
+            // The whole move, not only where it ends: poses every RUN_OUT_POSE_STEP along it
+            // (a tangent move over a surface curving up ahead cuts in mid-way and clears
+            // again at its end: 2.3 µm on the STEP patch, bull-nose D6 at 5° lead).
+            let poses = (d / RUN_OUT_POSE_STEP).ceil().max(1.0) as usize;
+            let clear = (1..=poses).all(|k| {
+                let tip = last.tip + feed * (d * k as f64 / poses as f64);
+                self.checker.check(&tip, &axis).is_none()
+            });
+            if clear {
+                return Some(CutterLocation {
+                    tip: last.tip + feed * d,
+                    ..*last
+                });
             }
             d *= 0.5;
         }

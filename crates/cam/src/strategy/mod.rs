@@ -445,8 +445,8 @@ const LIMIT_NUDGE: f64 = 1e-8;
 const MATCH_MARGIN: f64 = 0.05;
 /// Bisections of a side step against the true silhouette (the bracket shrinks by 2⁻³⁰).
 const SILHOUETTE_BISECTIONS: usize = 30;
-/// Lean added per correction trial, degrees.
-const CORRECTION_STEP_DEG: f64 = 1.0;
+/// A gouge's correction raises the lead by bisection to within this, degrees.
+const CORRECTION_RESOLUTION_DEG: f64 = 0.5;
 
 struct Context<'a> {
     surface: &'a NurbsSurface,
@@ -678,48 +678,70 @@ impl<'a> Context<'a> {
             .settings
             .max_axis_tilt_deg
             .map(|t| t.to_radians().cos() - 1e-12);
-        loop {
+        // The cutter at `angles`: placed, or why not.
+        let stand = |angles: LeadTilt| -> Result<CutterLocation, Refusal> {
             let axis = self.axis_for(&local.frame, angles);
             if min_axis_z.is_some_and(|z| axis.z < z) {
-                return Err(refuse(Refusal::OutOfReach));
+                return Err(Refusal::OutOfReach);
             }
             let margin = local_margin(shape, &local.frame, &axis, &local.curvature);
-            let problem = if margin < -1e-9 {
-                Gouge::Local { margin }
-            } else {
-                let tip = shape.tip_for_contact(&local.d.point, &local.frame, &axis);
-                match self.checker.check(&tip, &axis) {
-                    None => {
-                        let location = CutterLocation {
-                            tip,
-                            axis: axis.into_inner(),
-                            contact: local.d.point,
-                            normal: local.frame.normal.into_inner(),
-                            uv: (u, v),
-                        };
-                        return Ok(Placed {
-                            location,
-                            corrected,
-                            lead: angles.lead,
-                        });
-                    }
-                    Some(g) => g,
-                }
-            };
-            let ball_local =
-                matches!(shape, CutterShape::Ball { .. }) && matches!(problem, Gouge::Local { .. });
-            match self.settings.axis {
-                ToolAxis::Surface { max_lead_deg, .. }
-                    if !ball_local
-                        && angles.lead.to_degrees() + CORRECTION_STEP_DEG
-                            <= max_lead_deg + 1e-9 =>
-                {
-                    angles.lead += CORRECTION_STEP_DEG.to_radians();
-                    corrected = true;
-                }
-                _ => return Err(refuse(Refusal::Gouge(problem))),
+            if margin < -1e-9 {
+                return Err(Refusal::Gouge(Gouge::Local { margin }));
+            }
+            let tip = shape.tip_for_contact(&local.d.point, &local.frame, &axis);
+            match self.checker.check(&tip, &axis) {
+                Some(g) => Err(Refusal::Gouge(g)),
+                None => Ok(CutterLocation {
+                    tip,
+                    axis: axis.into_inner(),
+                    contact: local.d.point,
+                    normal: local.frame.normal.into_inner(),
+                    uv: (u, v),
+                }),
+            }
+        };
+        let problem = match stand(angles) {
+            Ok(location) => {
+                return Ok(Placed {
+                    location,
+                    corrected,
+                    lead: angles.lead,
+                })
+            }
+            Err(problem) => problem,
+        };
+        // A ball's local gouge does not depend on its lean; a fixed axis cannot lean; the
+        // machine's reach is not a gouge.
+        let ball_local = matches!(shape, CutterShape::Ball { .. })
+            && matches!(problem, Refusal::Gouge(Gouge::Local { .. }));
+        let max_lead = match self.settings.axis {
+            ToolAxis::Surface { max_lead_deg, .. } if !ball_local => max_lead_deg.to_radians(),
+            _ => return Err(refuse(problem)),
+        };
+        if matches!(problem, Refusal::OutOfReach) || max_lead <= angles.lead {
+            return Err(refuse(problem));
+        }
+        // Raise the lead: the largest allowed must clear, then bisection between the nominal
+        // (gouging) and the clearing lead keeps the lowest clearing one found (each kept lead
+        // is checked, so the gouge-free leads need not form an interval).
+        let at = |lead: f64| stand(LeadTilt { lead, ..angles });
+        let mut best = match at(max_lead) {
+            Ok(location) => (max_lead, location),
+            Err(_) => return Err(refuse(problem)),
+        };
+        let mut low = angles.lead;
+        while best.0 - low > CORRECTION_RESOLUTION_DEG.to_radians() {
+            let mid = 0.5 * (low + best.0);
+            match at(mid) {
+                Ok(location) => best = (mid, location),
+                Err(_) => low = mid,
             }
         }
+        Ok(Placed {
+            location: best.1,
+            corrected: true,
+            lead: best.0,
+        })
     }
 
     /// Steps along `path` by the chord error and places the cutter at every contact point;
@@ -763,11 +785,12 @@ impl<'a> Context<'a> {
         if self.settings.band.is_some() {
             self.refine_chords(path, &mut ts, &mut placed, contact_at);
         }
+        let contacts: Vec<Contact> = ts.iter().map(|&t| contact_at(t)).collect();
         if let (Some(rate), None) = (self.settings.max_lead_change_deg, self.fixed_axis) {
-            let contacts: Vec<Contact> = ts.iter().map(|&t| contact_at(t)).collect();
             self.limit_lead_change(&contacts, &mut placed, rate.to_radians());
         }
         if let Some(band) = self.settings.band {
+            self.clear_chords(path, &ts, &contacts, &mut placed, band);
             self.shift_outward(path, &ts, &mut placed, band);
         }
         let mut current = Pass::default();
