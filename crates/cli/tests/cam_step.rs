@@ -282,7 +282,7 @@ fn sphere_cap_iso_scallop_along_meridians_is_verified_to_the_rim() {
         assert!(r >= radius - tol, "{p:?} inside the sphere");
         assert!(p[2] >= rim - tol, "{p:?} below the cap");
     }
-    check_and_run("sphere-iso-v");
+    check_and_run("sphere-iso-v", None);
 }
 
 #[test]
