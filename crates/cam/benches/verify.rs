@@ -4,7 +4,7 @@
 //! the timed loop.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use tezgah_cam::verify::{path_poses, simulate, step_over, VerifyOptions};
+use tezgah_cam::verify::{path_poses, simulate, step_over, MachinedRegion, VerifyOptions};
 use tezgah_cam::{plan, testing, Cutter, CutterShape, Settings, StrategyKind};
 
 fn verify_freeform(c: &mut Criterion) {
@@ -18,6 +18,7 @@ fn verify_freeform(c: &mut Criterion) {
     let options = VerifyOptions {
         cell_mm: step_over(&path).expect("passes") / 20.0,
         sweep_spacing_mm: spacing,
+        region: MachinedRegion::ContactBox,
     };
     let v = simulate(&surface, &path, &poses, &options).expect("simulate");
     eprintln!(

@@ -10,6 +10,8 @@ pub const CLOSEST_SEEDS_PER_SPAN: usize = 8;
 /// Newton iterations allowed per cell to [`NurbsSurface::closest_point`] (it converges
 /// quadratically; the cap only bounds the work on a pathological surface).
 const CLOSEST_MAX_ITERATIONS: usize = 50;
+/// A parameter this fraction of its cell's width from an edge counts as on the edge.
+const EDGE_SNAP: f64 = 1e-9;
 
 /// The foot of the perpendicular from a point to the surface: parameters, point and distance.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,6 +71,8 @@ impl NurbsSurface {
             point: start,
             distance: (start - q).norm(),
         };
+        let mut best_cell = (self.u.first, self.v.first);
+        let visits = cells.len();
         for (bound, su, sv) in cells {
             if bound >= best.distance {
                 break;
@@ -76,9 +80,42 @@ impl NurbsSurface {
             let c = self.closest_in_cell(q, su, sv, tolerance);
             if c.distance < best.distance {
                 best = c;
+                best_cell = (su, sv);
             }
         }
-        Ok(best)
+        Ok(self.continue_across_knots(q, best, best_cell, tolerance, visits))
+    }
+
+    /// A cell's search can end held on one of its edges with the descent pointing out of the
+    /// cell; where that edge is an interior knot line and not the domain's boundary, the
+    /// surface goes on and so does the descent: Newton is resumed in the neighbouring cell
+    /// from that point (a narrow valley the neighbour's seed lattice did not resolve is found
+    /// this way). Each resumption lowers the distance, and there are at most `visits` of them.
+    fn continue_across_knots(
+        &self,
+        q: &Vec3,
+        mut best: ClosestPoint,
+        (mut su, mut sv): (usize, usize),
+        tolerance: f64,
+        visits: usize,
+    ) -> ClosestPoint {
+        for _ in 0..visits {
+            let d = self.derivs_at(su, sv, best.u, best.v);
+            let r = d.point - q;
+            let next_u = self.u.span_across(su, best.u, r.dot(&d.su));
+            let next_v = self.v.span_across(sv, best.v, r.dot(&d.sv));
+            if next_u.is_none() && next_v.is_none() {
+                break;
+            }
+            let (nu, nv) = (next_u.unwrap_or(su), next_v.unwrap_or(sv));
+            let seed = (best.u, best.v, best.distance * best.distance);
+            let c = self.newton_in_cell(q, nu, nv, seed, tolerance);
+            if c.distance >= best.distance {
+                break;
+            }
+            (best, su, sv) = (c, nu, nv);
+        }
+        best
     }
 
     /// [`NurbsSurface::closest_point`] confined to the piece of knot spans `(su, sv)`: Newton
@@ -153,19 +190,18 @@ impl NurbsSurface {
             let (mut du, mut dv) = if newton {
                 ((g * j01 - f * j11) / det, (f * j01 - g * j00) / det)
             } else {
-                // Not a minimum's neighbourhood: descend along the scaled gradient instead.
-                let (a, b) = (d.su.norm_squared(), d.sv.norm_squared());
-                (
-                    if a > 0.0 { -f / a } else { 0.0 },
-                    if b > 0.0 { -g / b } else { 0.0 },
-                )
+                gauss_newton_step(&d.su, &d.sv, f, g)
             };
             // On a cell edge where the descent direction −(f, g) points out, the edge holds
             // that parameter and the step becomes the 1-D one along the other (projected
-            // Newton); held on both, the corner is a minimum (the KKT conditions hold).
+            // Newton); held on both, the corner is a minimum (the KKT conditions hold). A
+            // parameter within rounding of the edge is on it: a step that lands 1e-14 inside
+            // would otherwise be clamped back at once and halved to nothing, ending the search
+            // before it has slid along the edge.
+            let (eu, ev) = (EDGE_SNAP * (u1 - u0), EDGE_SNAP * (v1 - v0));
             let (u_held, v_held) = (
-                (u == u0 && f > 0.0) || (u == u1 && f < 0.0),
-                (v == v0 && g > 0.0) || (v == v1 && g < 0.0),
+                (u - u0 <= eu && f > 0.0) || (u1 - u <= eu && f < 0.0),
+                (v - v0 <= ev && g > 0.0) || (v1 - v <= ev && g < 0.0),
             );
             let along = |grad: f64, curv: f64, speed2: f64| {
                 if curv > 0.0 {
@@ -216,6 +252,45 @@ impl NurbsSurface {
             v,
             point,
             distance: (point - q).norm(),
+        }
+    }
+}
+
+/// The Gauss–Newton step for `|S − q|²` where the Hessian is not positive definite (away from
+/// a minimum, or on a saddle-shaped piece): the curvature terms `r·S_uu …` dropped, the
+/// first fundamental form `[E F; F G]` stands in for the Hessian (Nocedal & Wright §10.3). It
+/// is a descent direction wherever the surface is regular, and keeps the skew of the
+/// parameters (`F`): a step scaled per parameter alone zig-zags down a skewed valley and can
+/// spend the iteration budget short of the minimum. A degenerate metric (a pole) falls back to
+/// the per-parameter scaling.
+fn gauss_newton_step(su: &Vec3, sv: &Vec3, f: f64, g: f64) -> (f64, f64) {
+    let (e, ff, gg) = (su.norm_squared(), su.dot(sv), sv.norm_squared());
+    let det = e * gg - ff * ff;
+    if det > 1e-12 * e * gg {
+        ((g * ff - f * gg) / det, (f * ff - g * e) / det)
+    } else {
+        (
+            if e > 0.0 { -f / e } else { 0.0 },
+            if gg > 0.0 { -g / gg } else { 0.0 },
+        )
+    }
+}
+
+impl super::Direction {
+    /// The knot span beyond span `s`'s edge that the parameter `t` sits on (within
+    /// [`EDGE_SNAP`] of its width), when the slope `grad` of the distance along this
+    /// direction descends across that edge and the edge is not the end of the domain.
+    fn span_across(&self, s: usize, t: f64, grad: f64) -> Option<usize> {
+        let (t0, t1) = (self.knots[s], self.knots[s + 1]);
+        let snap = EDGE_SNAP * (t1 - t0);
+        if t1 - t <= snap && grad < 0.0 {
+            (s + 1..=self.last).find(|&k| self.knots[k] < self.knots[k + 1])
+        } else if t - t0 <= snap && grad > 0.0 {
+            (self.first..s)
+                .rev()
+                .find(|&k| self.knots[k] < self.knots[k + 1])
+        } else {
+            None
         }
     }
 }
