@@ -190,7 +190,7 @@ impl NurbsSurface {
             let (mut du, mut dv) = if newton {
                 ((g * j01 - f * j11) / det, (f * j01 - g * j00) / det)
             } else {
-                gauss_newton_step(&d.su, &d.sv, f, g)
+                saddle_free_step(&d.su, &d.sv, [j00, j01, j11], f, g)
             };
             // On a cell edge where the descent direction −(f, g) points out, the edge holds
             // that parameter and the step becomes the 1-D one along the other (projected
@@ -256,25 +256,61 @@ impl NurbsSurface {
     }
 }
 
-/// The Gauss–Newton step for `|S − q|²` where the Hessian is not positive definite (away from
-/// a minimum, or on a saddle-shaped piece): the curvature terms `r·S_uu …` dropped, the
-/// first fundamental form `[E F; F G]` stands in for the Hessian (Nocedal & Wright §10.3). It
-/// is a descent direction wherever the surface is regular, and keeps the skew of the
-/// parameters (`F`): a step scaled per parameter alone zig-zags down a skewed valley and can
-/// spend the iteration budget short of the minimum. A degenerate metric (a pole) falls back to
-/// the per-parameter scaling.
-fn gauss_newton_step(su: &Vec3, sv: &Vec3, f: f64, g: f64) -> (f64, f64) {
+/// The descent step where the Hessian `[j00 j01; j01 j11]` of `|S − q|²/2` is not positive
+/// definite (a saddle of the distance: the point is beyond a centre of curvature in one
+/// direction): the saddle-free Newton step (Dauphin et al. 2014), each eigen-direction of the
+/// Hessian taken with the magnitude of its curvature, so that the negative one is descended
+/// rather than climbed. The eigenproblem is the generalised one `H v = λ M v` against the
+/// first fundamental form `M = [E F; F G]`: on a surface `H = M + (S − q)·S''`, so the `λ`
+/// are `1 − d κᵢ` (`κᵢ` the principal curvatures toward `q`), dimensionless, and floored at
+/// [`SADDLE_FLOOR`] where a direction is nearly flat. A Gauss–Newton or per-parameter step
+/// zig-zags down the curved valley such a saddle region makes and can spend the iteration
+/// budget short of the minimum. A degenerate metric (a pole) falls back to the
+/// per-parameter scaling.
+fn saddle_free_step(su: &Vec3, sv: &Vec3, [h00, h01, h11]: [f64; 3], f: f64, g: f64) -> (f64, f64) {
     let (e, ff, gg) = (su.norm_squared(), su.dot(sv), sv.norm_squared());
-    let det = e * gg - ff * ff;
-    if det > 1e-12 * e * gg {
-        ((g * ff - f * gg) / det, (f * ff - g * e) / det)
-    } else {
-        (
+    let det_m = e * gg - ff * ff;
+    if det_m <= 1e-12 * e * gg {
+        return (
             if e > 0.0 { -f / e } else { 0.0 },
             if gg > 0.0 { -g / gg } else { 0.0 },
-        )
+        );
     }
+    // det(H − λM) = det_m λ² − b λ + det_h = 0.
+    let b = h00 * gg + h11 * e - 2.0 * h01 * ff;
+    let det_h = h00 * h11 - h01 * h01;
+    let root = (b * b - 4.0 * det_m * det_h).max(0.0).sqrt();
+    let mut step = (0.0, 0.0);
+    for lambda in [(b - root) / (2.0 * det_m), (b + root) / (2.0 * det_m)] {
+        // (H − λM) v = 0: v is orthogonal to the larger of the matrix's two rows.
+        let r0 = (h00 - lambda * e, h01 - lambda * ff);
+        let r1 = (h01 - lambda * ff, h11 - lambda * gg);
+        let row = if r0.0.hypot(r0.1) >= r1.0.hypot(r1.1) {
+            r0
+        } else {
+            r1
+        };
+        let (mut a, mut c) = (-row.1, row.0);
+        if a == 0.0 && c == 0.0 {
+            // H is a multiple of M: any direction is an eigen-direction; take the
+            // M-orthogonal pair u and its complement.
+            (a, c) = if step == (0.0, 0.0) {
+                (1.0, 0.0)
+            } else {
+                (-ff, e)
+            };
+        }
+        let m_norm2 = a * a * e + 2.0 * a * c * ff + c * c * gg;
+        let slope = f * a + g * c;
+        let scale = slope / (m_norm2 * lambda.abs().max(SADDLE_FLOOR));
+        step = (step.0 - scale * a, step.1 - scale * c);
+    }
+    step
 }
+
+/// The smallest curvature magnitude, relative to the metric, [`saddle_free_step`] divides by:
+/// a nearly flat direction gets at most this many times a Gauss–Newton step.
+const SADDLE_FLOOR: f64 = 0.05;
 
 impl super::Direction {
     /// The knot span beyond span `s`'s edge that the parameter `t` sits on (within
