@@ -14,6 +14,7 @@ pub mod forward_step;
 pub mod gouge;
 pub mod orientation;
 pub mod post;
+pub mod region;
 pub mod scallop;
 pub mod select;
 pub mod silhouette;

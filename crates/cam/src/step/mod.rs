@@ -10,6 +10,7 @@ mod conic;
 mod entity;
 mod error;
 mod exchange;
+mod face_region;
 mod geometry;
 mod lexer;
 mod model;
@@ -24,6 +25,7 @@ use std::path::Path;
 use tezgah_geom::{Nurbs, NurbsSurface};
 
 pub use error::{At, StepError};
+pub use face_region::FaceRegionError;
 pub use model::{
     Bound, BoundEdge, BoundKind, Face, LengthUnit, PCurve, ReadOptions, StepModel, Uv,
     UNTRIMMED_SAMPLES_PER_EDGE,

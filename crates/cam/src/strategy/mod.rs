@@ -27,6 +27,7 @@ use crate::forward_step::{forward_steps, IsoLine, SurfacePath, UvPolyline};
 use crate::gouge::local::{local_margin, surface_curvature, Curvature2};
 use crate::gouge::{Gouge, GougeChecker, GougeSettings};
 use crate::orientation::ContactFrame;
+use crate::region::FaceRegion;
 use crate::scallop::stepover_exact;
 use crate::toolpath::{CutterLocation, Pass, ToolPath};
 
@@ -173,6 +174,10 @@ pub struct Settings {
     /// locations touch the surface exactly and chords straddle it (the contact-point chord
     /// error within `tolerance`).
     pub band: Option<Band>,
+    /// A trimmed face's region in (u, v): contact points outside it are left out as
+    /// [`Refusal::OutsideFace`], passes that cross its boundary end on it, and its loops are
+    /// cut as passes of their own (the strip along the trim). `None`: the whole domain.
+    pub region: Option<FaceRegion>,
 }
 
 impl Settings {
@@ -194,6 +199,7 @@ impl Settings {
             max_axis_tilt_deg: None,
             gouge: GougeSettings::default(),
             band: None,
+            region: None,
         }
     }
 
@@ -272,9 +278,18 @@ pub enum Refusal {
     /// The tool axis would lean further from +Z than [`Settings::max_axis_tilt_deg`]: the
     /// machine cannot reach this point from above (not a gouge).
     OutOfReach,
+    /// The contact point lies outside the trimmed face ([`Settings::region`]): not part of
+    /// what is machined (not a gouge).
+    OutsideFace,
 }
 
 impl Refusal {
+    /// True for a point beyond the machined region (out of reach or outside the face):
+    /// passes end on that region's edge.
+    pub fn is_beyond(&self) -> bool {
+        matches!(self, Refusal::OutOfReach | Refusal::OutsideFace)
+    }
+
     /// True for a gouge (the cutter would cut into the part here), false for a point the
     /// machine cannot reach or where the surface has no normal.
     pub fn is_gouge(&self) -> bool {
@@ -354,7 +369,21 @@ pub fn plan(
     } else {
         Vec::new()
     };
-    for r in results.into_iter().chain(edges) {
+    // A trimmed face's loops are cut too: passes end on the trim, but where the trim runs
+    // along the passes the strip between the last pass and it would keep up to a side step.
+    let trims: Vec<PassResult> = match &settings.region {
+        Some(region) => region
+            .loops()
+            .par_iter()
+            .map(|l| {
+                let mut points = l.clone();
+                points.push(l[0]);
+                ctx.run_pass(&PassPath::Poly(UvPolyline { points }), false)
+            })
+            .collect::<Result<_, _>>()?,
+        None => Vec::new(),
+    };
+    for r in results.into_iter().chain(edges).chain(trims) {
         plan.path.passes.extend(r.passes);
         plan.refused.extend(r.refused);
         plan.corrected += r.corrected;
@@ -661,6 +690,14 @@ impl<'a> Context<'a> {
             contact,
             refusal,
         };
+        if self
+            .settings
+            .region
+            .as_ref()
+            .is_some_and(|r| !r.contains(u, v))
+        {
+            return Err(refuse(Refusal::OutsideFace));
+        }
         let local = self
             .local_of(d, tangent_uv)
             .ok_or_else(|| refuse(Refusal::NoNormal))?;
@@ -779,7 +816,7 @@ impl<'a> Context<'a> {
                 self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
-        if self.settings.max_axis_tilt_deg.is_some() {
+        if self.settings.max_axis_tilt_deg.is_some() || self.settings.region.is_some() {
             self.end_on_reach(&mut ts, &mut placed, &contact_at);
         }
         if self.settings.band.is_some() {
@@ -810,15 +847,17 @@ impl<'a> Context<'a> {
         Ok(out)
     }
 
-    /// Ends the pieces of a pass on the edge of the reach: between a placed contact and a
-    /// neighbour refused as out of reach, the last placeable contact is added.
+    /// Ends the pieces of a pass on the edge of the reach or of the face: between a placed
+    /// contact and a neighbour refused as beyond it ([`Refusal::is_beyond`]), the last
+    /// placeable contact is added.
     fn end_on_reach(
         &self,
         ts: &mut Vec<f64>,
         placed: &mut Vec<Result<Placed, GougeReport>>,
         contact_at: &impl Fn(f64) -> Contact,
     ) {
-        let out_of_reach = |p: &Result<Placed, GougeReport>| matches!(p, Err(r) if r.refusal == Refusal::OutOfReach);
+        let out_of_reach =
+            |p: &Result<Placed, GougeReport>| matches!(p, Err(r) if r.refusal.is_beyond());
         let ok: Vec<bool> = placed.iter().map(|p| p.is_ok()).collect();
         let away: Vec<bool> = placed.iter().map(out_of_reach).collect();
         if !away.contains(&true) {

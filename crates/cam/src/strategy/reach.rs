@@ -11,7 +11,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{Context, GougeReport, Placed, Refusal};
+use super::{Context, GougeReport, Placed};
 use crate::forward_step::UvPolyline;
 
 /// Grid cells per parameter for tracing the edge (its topology; the points are exact).
@@ -193,7 +193,7 @@ impl Context<'_> {
                     lo = mid;
                     best = Some((mid, p));
                 }
-                Err(r) if r.refusal == Refusal::OutOfReach => hi = mid,
+                Err(r) if r.refusal.is_beyond() => hi = mid,
                 // Something else refuses the way to the edge (a gouge): leave the pass as is.
                 Err(_) => return None,
             }

@@ -39,6 +39,7 @@ pub use solid::{CutterPose, CutterSolid};
 use rayon::prelude::*;
 
 use crate::arc_grid::{arc_nodes, spread};
+use crate::region::FaceRegion;
 use crate::toolpath::ToolPath;
 use sweep::Sweeper;
 
@@ -206,6 +207,21 @@ pub fn simulate(
     poses: &[CutterPose],
     options: &VerifyOptions,
 ) -> Result<Verification, VerifyError> {
+    simulate_on(surface, path, poses, options, None)
+}
+
+/// [`simulate`] on a trimmed face: only the surface inside `face` (its (u, v) region) is
+/// judged, within `options.region`. Outside the face the surface is not part of the part, so
+/// the cutter reaching past the trim (by up to its radius, as it must to cut up to the trim)
+/// is neither a gouge nor anything else there; on the face itself both checks hold as on a
+/// whole surface.
+pub fn simulate_on(
+    surface: &NurbsSurface,
+    path: &ToolPath,
+    poses: &[CutterPose],
+    options: &VerifyOptions,
+    face: Option<&FaceRegion>,
+) -> Result<Verification, VerifyError> {
     let cell = positive("the cell size", options.cell_mm)?;
     let spacing = positive("the sweep spacing", options.sweep_spacing_mm)?;
     let cls: Vec<_> = path.passes.iter().flat_map(|p| &p.points).collect();
@@ -235,6 +251,17 @@ pub fn simulate(
         None => contact_box(surface, &cls),
         Some(z) => {
             reachable_box(surface, z, &outward).ok_or(VerifyError::EmptyRegion(options.region))?
+        }
+    };
+    let (u0, u1, v0, v1) = match face {
+        None => (u0, u1, v0, v1),
+        Some(f) => {
+            let ((fu0, fu1), (fv0, fv1)) = f.bounds();
+            let b = (u0.max(fu0), u1.min(fu1), v0.max(fv0), v1.min(fv1));
+            if !(b.0 < b.1 && b.2 < b.3) {
+                return Err(VerifyError::EmptyRegion(options.region));
+            }
+            b
         }
     };
     // Grid lines at equal steps of arc length (each parameter's speed taken as its largest
@@ -284,6 +311,9 @@ pub fn simulate(
     // One dexel on the surface at (u, v), along its outward normal (none where that is
     // undefined); one surface evaluation each.
     let dexel = |node: (usize, usize), u: f64, v: f64| {
+        if face.is_some_and(|f| !f.contains(u, v)) {
+            return None;
+        }
         let d = surface.derivs(u, v);
         let n = d.normal()?.into_inner();
         let n = if flip { -n } else { n };
