@@ -62,7 +62,7 @@ impl FaceRegion {
             (r.0.min(p.1), r.1.max(p.1))
         });
         let extent = (u_range.1 - u_range.0).max(v_range.1 - v_range.0);
-        if !(extent > 0.0) {
+        if extent.is_nan() || extent <= 0.0 {
             return Err(RegionError::Empty);
         }
         let vertices: usize = loops.iter().map(Vec::len).sum();
