@@ -167,6 +167,35 @@ impl FaceRegion {
     }
 }
 
+/// The area of `surface` over `region` (its whole domain for `None`), mm²: the midpoint rule
+/// on a `samples` × `samples` grid over the region's box, `|S_u × S_v|` at the cells whose
+/// centre is inside. A cell straddling the trim counts whole or not at all, so the error is
+/// at most the trim's length times a cell's diagonal on the surface.
+pub fn surface_area(
+    surface: &tezgah_geom::NurbsSurface,
+    region: Option<&FaceRegion>,
+    samples: usize,
+) -> f64 {
+    let n = samples.max(1);
+    let ((u0, u1), (v0, v1)) = match region {
+        Some(r) => r.bounds(),
+        None => (surface.domain_u(), surface.domain_v()),
+    };
+    let (du, dv) = ((u1 - u0) / n as f64, (v1 - v0) / n as f64);
+    let mut area = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (u, v) = (u0 + du * (i as f64 + 0.5), v0 + dv * (j as f64 + 0.5));
+            if region.is_some_and(|r| !r.contains(u, v)) {
+                continue;
+            }
+            let d = surface.derivs(u, v);
+            area += d.su.cross(&d.sv).norm() * du * dv;
+        }
+    }
+    area
+}
+
 /// True when the edge `a–b` crosses the ray from `p` toward +u (half-open in v, so a ray
 /// through a vertex counts it once).
 fn crosses_right((a, b): ((f64, f64), (f64, f64)), p: (f64, f64)) -> bool {

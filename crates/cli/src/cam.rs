@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
 use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
+use tezgah_cam::region::FaceRegion;
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_DEXELS};
@@ -106,10 +107,6 @@ pub struct PlanRequest {
     pub direction: Option<FeedDirection>,
 }
 
-/// How close a face's loops must run to its surface's domain boundary for the face to count
-/// as the whole surface, mm.
-const UNTRIMMED_TOLERANCE_MM: f64 = 1e-3;
-
 /// The face of a STEP file to machine: the one `--face` names, or the file's only face.
 fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -> Result<Face> {
     let ids = || {
@@ -140,18 +137,12 @@ fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -
             }
         },
     };
-    // The strategies cover a surface's whole domain: cutting a trimmed face that way would
-    // run outside its loops, into whatever lies there.
-    if !face.is_untrimmed(UNTRIMMED_TOLERANCE_MM) {
-        return Err(miette!(
-            "{}: face #{} is trimmed by its loops; the strategies machine whole surfaces \
-             (faces bounded by their surface's domain) only",
-            path.display(),
-            face.id
-        ));
-    }
     Ok(face)
 }
+
+/// Samples per parameter for the face area in the report (a 0.3 % figure on the plate
+/// fixture: its trim's length times a cell's diagonal).
+const AREA_SAMPLES: usize = 400;
 
 /// Samples per parameter of each face for the part's box.
 const BOX_SAMPLES: usize = 64;
@@ -182,6 +173,8 @@ struct Planned {
     part: Option<PartBox>,
     /// The parameter the passes run along.
     direction: FeedDirection,
+    /// A trimmed face's region in (u, v) (`None`: the whole surface).
+    region: Option<FaceRegion>,
 }
 
 /// The face of the STEP file at `path` to machine (`--face`, or its only face) and a box
@@ -215,6 +208,11 @@ fn plan_surface(
         .direction
         .unwrap_or_else(|| FeedDirection::for_surface(&face.surface));
     settings.band = request.band;
+    // A trimmed face is machined within its loops, followed to a quarter of the chord
+    // tolerance.
+    settings.region = face
+        .uv_region(0.25 * request.tolerance_mm)
+        .map_err(|e| miette!("{}: {e}", path.display()))?;
     if request.band.is_some() {
         // The rear check accepts penetrations up to its depth tolerance: keep that within
         // issue 7's 1 µm.
@@ -222,12 +220,10 @@ fn plan_surface(
     }
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
-    let out_of_reach = plan
-        .refused
-        .iter()
-        .filter(|r| r.refusal == Refusal::OutOfReach)
-        .count();
-    let no_normal = plan.refused.len() - gouges - out_of_reach;
+    let count = |what: Refusal| plan.refused.iter().filter(|r| r.refusal == what).count();
+    let out_of_reach = count(Refusal::OutOfReach);
+    let outside = count(Refusal::OutsideFace);
+    let no_normal = plan.refused.len() - gouges - out_of_reach - outside;
     if gouges > 0 {
         eprintln!(
             "warning: {gouges} contact points would gouge and were left out (passes split \
@@ -240,6 +236,14 @@ fn plan_surface(
             "note: {out_of_reach} contact points face more than {}° away from +Z, beyond what \
              the machine reaches from above (--max-tilt), and were left out",
             request.max_tilt_deg
+        );
+    }
+    if let Some(region) = &settings.region {
+        eprintln!(
+            "note: face #{} is trimmed: machined within its {} loops, {outside} contact points \
+             beyond them left out and the passes ended on the trim",
+            face.id,
+            region.loops().len()
         );
     }
     if no_normal > 0 {
@@ -260,6 +264,7 @@ fn plan_surface(
         path: plan.path,
         part,
         direction: settings.direction,
+        region: settings.region,
     })
 }
 
@@ -374,6 +379,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         path,
         part,
         direction,
+        region: face_region,
     } = plan_surface(&args.surface, face, part, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
@@ -408,12 +414,24 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         &machine,
         &options,
         args.verify_cell_mm,
-        region,
+        Judged {
+            region,
+            face: face_region.as_ref(),
+        },
     )?;
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
     let mut json = report_json(&args, &machine, &path, &done, scallop, tool_number);
+    if face_region.is_some() {
+        json["machined_region"]["kind"] =
+            "trimmed face (inside its loops) within the tilt reach".into();
+    }
+    json["face"] = serde_json::json!({
+        "trimmed": face_region.is_some(),
+        "loops": face_region.as_ref().map_or(0, |r| r.loops().len()),
+        "area_mm2": tezgah_cam::region::surface_area(&surface, face_region.as_ref(), AREA_SAMPLES),
+    });
     json["feed_along"] = serde_json::json!(match direction {
         FeedDirection::AlongU => "u",
         FeedDirection::AlongV => "v",
@@ -452,6 +470,14 @@ impl Finished {
     }
 }
 
+/// What the verification judges: the machined region (reach) and, for a trimmed face, the
+/// face's (u, v) region within it.
+#[derive(Debug, Clone, Copy)]
+pub struct Judged<'a> {
+    pub region: MachinedRegion,
+    pub face: Option<&'a FaceRegion>,
+}
+
 /// Post `path` and simulate the cut along the program as the machine moves it over `region`:
 /// dexels every twentieth of the step-over (coarser where the grid would not fit in memory),
 /// poses close enough that the sweep error is a tenth of the tolerance.
@@ -461,7 +487,7 @@ pub fn finish(
     machine: &Machine,
     options: &PostOptions,
     cell_mm: Option<f64>,
-    region: MachinedRegion,
+    judged: Judged,
 ) -> Result<Finished> {
     let posted = post(path, machine, options).into_diagnostic()?;
     let step_over = verify::step_over(path).unwrap_or(2.0 * path.cutter.shape.radius());
@@ -489,7 +515,7 @@ pub fn finish(
     let mut verify_options = VerifyOptions {
         cell_mm: cell_mm.unwrap_or(step_over / 20.0),
         sweep_spacing_mm: spacing,
-        region,
+        region: judged.region,
     };
     let poses = posted.sweep(machine, spacing).into_diagnostic()?;
     // A surface whose parametric speed varies (STEP fits often run 5:1) needs its dexel grid
@@ -497,7 +523,7 @@ pub fn finish(
     // cell grows to fit under it (the grid bound, reported, grows with it).
     let mut tries = 0;
     let verification = loop {
-        match verify::simulate(surface, path, &poses, &verify_options) {
+        match verify::simulate_on(surface, path, &poses, &verify_options, judged.face) {
             Err(verify::VerifyError::TooFine(count)) if tries < 4 => {
                 tries += 1;
                 verify_options.cell_mm *= (count as f64 / (0.95 * MAX_DEXELS as f64)).sqrt();
@@ -680,7 +706,8 @@ mod tests {
         let region = MachinedRegion::Reachable {
             max_tilt_deg: 120.0,
         };
-        let done = finish(&surface, &path, &machine, &options, None, region).unwrap();
+        let judged = Judged { region, face: None };
+        let done = finish(&surface, &path, &machine, &options, None, judged).unwrap();
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.
         let h = 1.5 - (2.25_f64 - 0.25).sqrt();

@@ -461,3 +461,49 @@ fn a_surface_out_of_reach_from_above_is_refused_with_a_reason() {
     assert!(stderr.contains("more than 60° away from +Z"), "{stderr}");
     assert!(!ngc.exists());
 }
+
+#[test]
+fn trimmed_plate_is_machined_within_its_loops_verified_and_runs() {
+    // OpenCascade's 80 × 60 mm plane face at z = 5 with a round (r 10 at (25, 30)) and an
+    // elliptic (12 × 6 at (58, 30), turned 0.5 rad) hole: three loops.
+    let h = 0.2;
+    let (report, program, stderr) = cam(
+        "plate",
+        "plate_with_holes.stp",
+        &[
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.2",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_meets_issue_7(&report, h, true);
+    assert!(stderr.contains("is trimmed"), "{stderr}");
+    let face = &report["face"];
+    assert_eq!(face["trimmed"], true, "{report}");
+    assert_eq!(face["loops"], 3, "{report}");
+    // 4800 − π·10² − π·12·6 = 4259.65 mm²; the report's midpoint rule is within 0.1 %.
+    let exact = 4800.0 - std::f64::consts::PI * (100.0 + 72.0);
+    assert!(
+        (f(face, "area_mm2") - exact).abs() < 1e-3 * exact,
+        "{report}"
+    );
+    // No cut at the plate's level inside a hole (a ball's tip is its contact on a plane).
+    let (c, s) = (0.5f64.cos(), 0.5f64.sin());
+    let mut on_level = 0;
+    for p in feed_points(&program).into_iter().filter(|p| p[2] < 5.01) {
+        let r = (p[0] - 25.0).hypot(p[1] - 30.0);
+        assert!(r >= 10.0 - 0.01, "{p:?} in the round hole");
+        let (dx, dy) = (p[0] - 58.0, p[1] - 30.0);
+        let (x, y) = (dx * c + dy * s, -dx * s + dy * c);
+        assert!(
+            (x / 12.0).powi(2) + (y / 6.0).powi(2) >= 1.0 - 2e-3,
+            "{p:?} in the ellipse"
+        );
+        on_level += 1;
+    }
+    assert!(on_level > 200, "{on_level}");
+    check_and_run("plate", None);
+}
