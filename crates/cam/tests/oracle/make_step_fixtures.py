@@ -33,9 +33,13 @@ Fixtures:
                        without pcurves (quarter cylinders, a plane with a circular hole)
   swept_surfaces.stp   a B-spline S-curve extruded 30 mm (SURFACE_OF_LINEAR_EXTRUSION) and a
                        B-spline profile revolved 270 degrees about z (SURFACE_OF_REVOLUTION)
+  trimmed_freeform.stp the free-form patch's surface trimmed in its parameters by an ellipse
+                       (the outer loop) with a round hole: B-spline edges built from 2-D
+                       conics on the surface (SURFACE_CURVE with pcurves)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
-Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "samples":
+Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "area": mm²
+(fixtures generated since the area was added), "samples":
 [[u, v, x, y, z, dxdu, dydu, dzdu, dxdv, dydv, dzdv], ...]}, ...]} with faces in the order of the
 re-read shape; (u, v) ranges are the face's UV bounds (BRepTools::UVBounds), "reversed" its
 orientation in the shell.
@@ -84,6 +88,31 @@ def freeform_patch():
     vm = [4, 1, 1, 1, 1, 1, 4]
     surf = Geom_BSplineSurface(poles, arr(uk), arr(vk), iarr(um), iarr(vm), 3, 3)
     return BRepBuilderAPI_MakeFace(surf, 1e-7).Face()
+
+
+def trimmed_freeform():
+    """The free-form patch inside the (u, v) ellipse centred (0.5, 0.5), semi-axes 0.42 along u
+    and 0.34 along v, less the (u, v) disc of radius 0.1 about (0.62, 0.45)."""
+    from OCP.BRepLib import BRepLib
+    from OCP.Geom2d import Geom2d_Circle, Geom2d_Ellipse
+    from OCP.gp import gp_Ax2d, gp_Dir2d, gp_Pnt2d
+    surf = BRep_Tool.Surface_s(freeform_patch())
+
+    def loop(curve, reverse):
+        edge = BRepBuilderAPI_MakeEdge(curve, surf).Edge()
+        BRepLib.BuildCurves3d_s(edge, 1e-7)
+        wire = BRepBuilderAPI_MakeWire(edge).Wire()
+        if reverse:
+            wire.Reverse()
+        return wire
+
+    axis = gp_Ax2d(gp_Pnt2d(0.5, 0.5), gp_Dir2d(1.0, 0.0))
+    make = BRepBuilderAPI_MakeFace(surf, loop(Geom2d_Ellipse(axis, 0.42, 0.34), False), True)
+    make.Add(loop(Geom2d_Circle(gp_Ax2d(gp_Pnt2d(0.62, 0.45), gp_Dir2d(1.0, 0.0)), 0.1), True))
+    from OCP.ShapeFix import ShapeFix_Face
+    fix = ShapeFix_Face(make.Face())
+    fix.Perform()
+    return fix.Face()
 
 
 def rational_sphere():
@@ -250,7 +279,13 @@ def reference(path):
                 surf.D1(u, v, p, du, dv)
                 samples.append([u, v, p.X(), p.Y(), p.Z(), du.X(), du.Y(), du.Z(), dv.X(), dv.Y(), dv.Z()])
         reversed_ = face.Orientation() == TopAbs_REVERSED
-        faces.append({"u": [u0, u1], "v": [v0, v1], "reversed": reversed_, "samples": samples})
+        # The face's area within its bounds (OCCT's Gauss integration over the trimmed face).
+        from OCP.BRepGProp import BRepGProp
+        from OCP.GProp import GProp_GProps
+        props = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(face, props)
+        faces.append({"u": [u0, u1], "v": [v0, v1], "reversed": reversed_, "area": props.Mass(),
+                      "samples": samples})
         ex.Next()
     return {"generator": "make_step_fixtures.py, OCCT via cadquery-ocp-novtk", "faces": faces}
 
@@ -270,7 +305,11 @@ def main():
         ("analytic_solids_no_pcurves", analytic_solids(), "MM"),
         ("filleted_block", filleted_block(), "MM"),
         ("swept_surfaces", swept_surfaces(), "MM"),
+        ("trimmed_freeform", trimmed_freeform(), "MM"),
     ]
+    # Further arguments name the fixtures to (re)generate; none: all of them.
+    only = set(sys.argv[2:])
+    cases = [c for c in cases if not only or c[0] in only]
     for name, shape, unit in cases:
         stp = os.path.join(out, name + ".stp")
         write(shape, stp, unit, "AP203" if name.endswith("ap203") else "AP214IS",
