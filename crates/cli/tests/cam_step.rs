@@ -507,3 +507,33 @@ fn trimmed_plate_is_machined_within_its_loops_verified_and_runs() {
     assert!(on_level > 200, "{on_level}");
     check_and_run("plate", None);
 }
+
+#[test]
+fn trimmed_free_form_iso_scallop_is_verified_inside_its_loops_and_runs() {
+    // The free-form patch inside a (u, v) ellipse less a round hole (OpenCascade's fixture,
+    // its area computed by OpenCascade in the JSON beside it).
+    let h = 0.2;
+    let (report, _, _) = cam(
+        "trimmed-freeform",
+        "trimmed_freeform.stp",
+        &[
+            "--strategy",
+            "iso-scallop",
+            "--scallop",
+            "0.2",
+            "--verify-cell",
+            "0.5",
+        ],
+    );
+    assert_meets_issue_7(&report, h, true);
+    let face = &report["face"];
+    assert_eq!(face["loops"], 2, "{report}");
+    let occ = read_json(&fixture("trimmed_freeform.json"));
+    let area = f(&occ["faces"][0], "area");
+    assert!((f(face, "area_mm2") - area).abs() < 1e-3 * area, "{report}");
+    assert_eq!(
+        report["machined_region"]["kind"],
+        "trimmed face (inside its loops) within the tilt reach"
+    );
+    check_and_run("trimmed-freeform", None);
+}
