@@ -214,6 +214,30 @@ fn free_form_patch_ball_flat_and_bull_nose() {
 }
 
 #[test]
+fn flat_and_bull_nose_asked_for_zero_lead_keep_their_rim_contact() {
+    // Standing exactly along the normal, a flat bottom's contact may be anywhere on the rim,
+    // and the chord checks (axes interpolated, normals a hair different) saw it jump across:
+    // the bull-nose D10 r1 left 4.0 mm (tips lifted by R − r) at h 0.2 before the planner
+    // leaned such ends by at least half a degree.
+    let s = testing::freeform(0.0);
+    let z = StrategyKind::IsoScallop;
+    assert_within(
+        "free-form bull D10 r1, lead 0",
+        &s,
+        &bull(10.0, 1.0),
+        &banded(z, 0.4, 0.0),
+        0.8,
+    );
+    assert_within(
+        "free-form flat D6, lead 0",
+        &s,
+        &flat(6.0),
+        &banded(z, 0.4, 0.0),
+        0.8,
+    );
+}
+
+#[test]
 fn step_free_form_fixture_ball_flat_and_bull_nose() {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),

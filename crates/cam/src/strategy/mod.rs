@@ -472,6 +472,14 @@ const LIMIT_NUDGE: f64 = 1e-8;
 
 /// Curvature matching leaves this relative margin: `r_e ≤ (1 − margin)·ρ`.
 const MATCH_MARGIN: f64 = 0.05;
+/// The least lean of a flat or bull-nose end from the surface normal, degrees. Standing
+/// exactly along the normal its flat bottom lies in the tangent plane and the contact may be
+/// anywhere on the rim; a hair off the normal it is where the hair points. The chord checks
+/// interpolate axes between locations and meet normals a hair different, so at zero lean the
+/// contact (and the tip, by up to 2(R − r)) jumps across the rim between a location and its
+/// chord: the motion lifts off the cut. Half a degree keeps the rim contact on the feed side
+/// while the normal turns by far less between neighbouring checks (second order in the chord).
+const MIN_RIM_LEAN_DEG: f64 = 0.5;
 /// Bisections of a side step against the true silhouette (the bracket shrinks by 2⁻³⁰).
 const SILHOUETTE_BISECTIONS: usize = 30;
 /// A gouge's correction raises the lead by bisection to within this, degrees.
@@ -621,7 +629,13 @@ impl<'a> Context<'a> {
                         .unwrap_or(max_lead);
                     lead = lead.max(need.min(max_lead));
                 }
-                Some(LeadTilt::new(lead, tilt_deg.to_radians()))
+                let tilt = tilt_deg.to_radians();
+                let min_lean = MIN_RIM_LEAN_DEG.to_radians();
+                if !matches!(self.shape(), CutterShape::Ball { .. }) && lead.hypot(tilt) < min_lean
+                {
+                    lead = (min_lean * min_lean - tilt * tilt).sqrt().min(max_lead);
+                }
+                Some(LeadTilt::new(lead, tilt))
             }
         }
     }
