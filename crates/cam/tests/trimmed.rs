@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 
 use tezgah_cam::step::{self, Face};
-use tezgah_cam::verify::{path_poses, simulate_on, MachinedRegion, VerifyOptions};
+use tezgah_cam::verify::{path_poses, simulate_on, MachinedRegion, Verification, VerifyOptions};
 use tezgah_cam::{plan, Cutter, CutterShape, Settings, StrategyKind, ToleranceShares};
 
 fn fixture(name: &str) -> PathBuf {
@@ -135,20 +135,10 @@ fn the_plate_is_finished_within_its_bounds_and_verified() {
         "{on_circle} {on_ellipse}"
     );
     assert!(planned.refused.iter().all(|r| !r.refusal.is_gouge()));
-    let spacing = 0.2;
-    let poses = path_poses(&planned.path, spacing);
-    let options = VerifyOptions {
-        cell_mm: 0.4,
-        sweep_spacing_mm: spacing,
-        region: MachinedRegion::ContactBox,
-    };
-    let v = simulate_on(&face.surface, &planned.path, &poses, &options, Some(region)).unwrap();
-    assert_eq!(v.uncut, 0, "{v:?}");
-    assert!(v.max_scallop_mm <= h, "{v:?}");
-    assert!(v.gouge_depth_mm <= 1e-3, "{v:?}");
+    assert_verified(&face, &planned, 0.4, Some(region), h);
     // Judged over the whole plane instead, the holes' insides (where no pass runs) stand
     // uncut: the face's region is what keeps them out.
-    let whole = simulate_on(&face.surface, &planned.path, &poses, &options, None).unwrap();
+    let whole = measure(&face, &planned, 0.4, None);
     assert!(whole.uncut > 1000, "{whole:?}");
 }
 
@@ -214,16 +204,38 @@ fn the_trimmed_free_form_is_finished_iso_scallop_within_its_loops() {
     }
     assert!(on_trim > 100, "{on_trim}");
     assert!(planned.refused.iter().all(|r| !r.refusal.is_gouge()));
-    let spacing = 0.2;
-    let poses = path_poses(&planned.path, spacing);
-    let options = VerifyOptions {
-        cell_mm: 0.5,
-        sweep_spacing_mm: spacing,
-        region: MachinedRegion::ContactBox,
-    };
-    let region = settings.region.as_ref();
-    let v = simulate_on(&face.surface, &planned.path, &poses, &options, region).unwrap();
+    assert_verified(&face, &planned, 0.5, settings.region.as_ref(), h);
+}
+
+/// Simulates the plan's cut over `face` (judged inside `region`, or over the whole contact
+/// box) at `cell` mm and 0.2 mm poses, and asserts issue 7's check: nothing uncut, the scallop
+/// within `h`, no gouge deeper than 1 µm. Returns the measurement.
+fn assert_verified(
+    face: &Face,
+    planned: &tezgah_cam::Plan,
+    cell: f64,
+    region: Option<&tezgah_cam::region::FaceRegion>,
+    h: f64,
+) -> Verification {
+    let v = measure(face, planned, cell, region);
     assert_eq!(v.uncut, 0, "{v:?}");
     assert!(v.max_scallop_mm <= h, "{v:?}");
     assert!(v.gouge_depth_mm <= 1e-3, "{v:?}");
+    v
+}
+
+fn measure(
+    face: &Face,
+    planned: &tezgah_cam::Plan,
+    cell: f64,
+    region: Option<&tezgah_cam::region::FaceRegion>,
+) -> Verification {
+    let spacing = 0.2;
+    let poses = path_poses(&planned.path, spacing);
+    let options = VerifyOptions {
+        cell_mm: cell,
+        sweep_spacing_mm: spacing,
+        region: MachinedRegion::ContactBox,
+    };
+    simulate_on(&face.surface, &planned.path, &poses, &options, region).unwrap()
 }
