@@ -8,6 +8,7 @@ pub mod global;
 pub mod index;
 pub mod local;
 pub mod rear;
+pub mod sweep;
 
 use nalgebra::Unit;
 use tezgah_geom::{NurbsSurface, Vec3};
@@ -121,11 +122,17 @@ impl GougeChecker {
     /// Rear and global checks of the cutter standing at `tip` along `axis` (the local check
     /// needs the contact's curvature and lives in [`local`]).
     pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {
+        self.check_sweep(&sweep::Sweep::still(tip, axis))
+    }
+
+    /// Rear and global checks of the cutter moving along `sweep`: the rear check over every
+    /// pose of it ([`rear::RearIndex::first_penetration_along`]), the global check (shank and
+    /// holder, which keep a clearance of the global spacing) at its middle.
+    pub fn check_sweep(&self, sweep: &sweep::Sweep) -> Option<Gouge> {
         if let Some(index) = &self.fine {
-            if let Some(rear::Penetration { depth, point }) = index.first_penetration(
+            if let Some(rear::Penetration { depth, point, .. }) = index.first_penetration_along(
                 &self.cutter.shape,
-                tip,
-                axis,
+                sweep,
                 self.settings.depth_tolerance,
             ) {
                 return Some(Gouge::Interference {
@@ -136,9 +143,14 @@ impl GougeChecker {
             }
         }
         if let Some(grid) = &self.coarse {
-            if let Some(hit) =
-                global::collision(grid, &self.cutter, tip, axis, self.settings.global_spacing)
-            {
+            let (tip, axis) = sweep.pose(0.5);
+            if let Some(hit) = global::collision(
+                grid,
+                &self.cutter,
+                &tip,
+                &axis,
+                self.settings.global_spacing,
+            ) {
                 return Some(Gouge::Interference {
                     part: hit.part,
                     depth: hit.depth,

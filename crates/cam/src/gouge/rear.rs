@@ -20,6 +20,7 @@ use nalgebra::Unit;
 use tezgah_geom::{NurbsSurface, Vec3};
 
 use super::index::{PointGrid, Reach, SurfaceSamples};
+use super::sweep::Sweep;
 use crate::cutter::CutterShape;
 
 /// Height of the checked cutting end above the tip, in tool radii.
@@ -95,22 +96,86 @@ pub fn penetration(shape: &CutterShape, tip: &Vec3, axis: &Unit<Vec3>, p: &Vec3)
     depth(shape, tip, axis, p).depth
 }
 
-/// The largest depth any surface point of a cell can have: the cell reaches `reach` from
-/// its point `p` (depth `d`, normal `n`, zero if unknown) along the tangent plane and bends
-/// off it by at most `κc²/2` (`c` its cover, `kappa` bounding the surface's normal
-/// curvature). Two concave upper bounds, the smaller kept: the depth's own supergradient, and
-/// the tip plane's (the cutting end lies above it, so its depth is at most the height `z`
-/// above it, with gradient the axis): beside and below the tool that one is far tighter.
-pub fn bound(d: &Depth, z: f64, axis: &Vec3, n: &Vec3, reach: &Reach, kappa: f64) -> f64 {
+/// The largest depth any surface point of a cell can have over a span of the sweep: the
+/// cell reaches `reach` from its point `p` (depth `d` at the span's middle, height `z` above
+/// the tip plane there, normal `n`, zero if unknown) along the tangent plane and bends off it
+/// by at most `κc²/2` (`c` its cover, `kappa` bounding the surface's normal curvature); over
+/// the span the cutter moves relative to it by at most `spread` along each direction
+/// (`spread(g)`, [`Sweep::spread`]). Two concave upper bounds, the smaller kept: the depth's
+/// own supergradient, and the tip plane's (the cutting end lies above it, so its depth is at
+/// most the height above it, with gradient the axis): beside and below the tool that one is
+/// far tighter.
+pub fn bound(
+    d: &Depth,
+    z: f64,
+    axis: &Vec3,
+    n: &Vec3,
+    reach: &Reach,
+    kappa: f64,
+    spread: impl Fn(&Vec3) -> f64,
+) -> Bounds {
     let c = reach.cover();
     let sag = 0.5 * kappa * c * c;
-    let own = d.depth + reach.along(&d.gradient) + d.gradient.dot(n).abs() * sag;
-    let plane = z + reach.along(axis) + axis.dot(n).abs() * sag;
     // Without a normal the bend is not known: the whole cover, every way.
     if n.norm_squared() == 0.0 {
-        return d.depth + c;
+        let all = Bound::of(d.depth, c, spread(&Vec3::zeros()));
+        return Bounds {
+            own: all,
+            plane: all,
+        };
     }
-    own.min(plane)
+    let own = Bound::of(
+        d.depth,
+        reach.along(&d.gradient) + d.gradient.dot(n).abs() * sag,
+        spread(&d.gradient),
+    );
+    let plane = Bound::of(z, reach.along(axis) + axis.dot(n).abs() * sag, spread(axis));
+    Bounds { own, plane }
+}
+
+/// The two upper bounds of the depth over a cell and a span of the sweep ([`bound`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    pub own: Bound,
+    pub plane: Bound,
+}
+
+impl Bounds {
+    /// The tighter of the two, mm.
+    pub fn value(&self) -> f64 {
+        self.own.value.min(self.plane.value)
+    }
+
+    /// Whether halving the span promises more than quartering the cell: either term falls
+    /// about in half when its part is split (the motion's remainder even to a quarter).
+    pub fn split_span(&self) -> bool {
+        let after = |f: fn(&Bound) -> f64| {
+            let (own, plane) = (&self.own, &self.plane);
+            (own.value - 0.5 * f(own)).min(plane.value - 0.5 * f(plane))
+        };
+        after(|b| b.motion) <= after(|b| b.extent)
+    }
+}
+
+/// An upper bound of the depth over a cell and a span of the sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    /// The bound, mm.
+    pub value: f64,
+    /// What the cell's extent adds to the value at its point.
+    pub extent: f64,
+    /// What the cutter's motion over the span adds.
+    pub motion: f64,
+}
+
+impl Bound {
+    fn of(at_point: f64, extent: f64, motion: f64) -> Bound {
+        Bound {
+            value: at_point + extent + motion,
+            extent,
+            motion,
+        }
+    }
 }
 
 /// A surface point inside the cutting end.
@@ -119,6 +184,8 @@ pub struct Penetration {
     /// How deep, mm.
     pub depth: f64,
     pub point: Vec3,
+    /// Where along the sweep, `s ∈ [0, 1]` (a standing cutter: 0.5).
+    pub at: f64,
 }
 
 /// The surface indexed for the rear check: lattice samples in a spatial grid, the surface
@@ -177,42 +244,118 @@ impl RearIndex {
         axis: &Unit<Vec3>,
         tolerance: f64,
     ) -> Option<Penetration> {
+        self.first_penetration_along(shape, &Sweep::still(tip, axis), tolerance)
+    }
+
+    /// A surface point more than `tolerance` inside the cutting end at some pose of `sweep`,
+    /// if there is one. The branch and bound runs over cells and spans of the sweep at once:
+    /// a (cell, span) pair whose bound ([`bound`]) exceeds the tolerance is split where its
+    /// bound comes from, the span in halves when the motion dominates, the cell in quarters
+    /// otherwise. A standing cutter has no motion and splits cells only.
+    pub fn first_penetration_along(
+        &self,
+        shape: &CutterShape,
+        sweep: &Sweep,
+        tolerance: f64,
+    ) -> Option<Penetration> {
         let big_r = shape.radius();
-        let top = tip + axis.into_inner() * (CUTTING_END_RADII * big_r);
-        let (lo, hi) = (
-            tip.inf(&top) - Vec3::repeat(big_r),
-            tip.sup(&top) + Vec3::repeat(big_r),
-        );
+        let (lo, hi) = sweep.bounding_box(CUTTING_END_RADII * big_r, big_r);
+        let search = Search {
+            index: self,
+            shape,
+            sweep,
+            tolerance,
+        };
         let mut hit = None;
         self.grid.visit_box(&lo, &hi, |s| {
-            let d = depth(shape, tip, axis, &s.point);
-            if d.depth > tolerance {
-                hit = Some(Penetration {
-                    depth: d.depth,
-                    point: s.point,
-                });
-                return false;
-            }
-            let z = (s.point - tip).dot(axis);
-            if bound(&d, z, axis, &s.normal, &s.reach, self.kappa) <= tolerance {
-                return true;
-            }
-            hit = self.split(self.lines.cell(s.node), shape, tip, axis, tolerance, 1);
+            let patch = Patch {
+                point: s.point,
+                normal: s.normal,
+                reach: s.reach,
+                cell: None,
+                level: 0,
+            };
+            hit = search.examine(&patch, s.node, (0.0, 1.0), 0);
             hit.is_none()
         });
         hit
     }
+}
 
-    /// Branch and bound over the quarters of the parameter cell `[u0, u1, v0, v1]`.
-    fn split(
+/// Spans of the sweep are halved at most this often (2¹⁶ spans: 0.05 µm of a 3 mm chord).
+const MAX_SPAN_LEVELS: usize = 16;
+
+/// A piece of surface under test: a point of it, its normal (zero if unknown), how far the
+/// piece reaches from the point, and its parameter cell once known (a lattice sample's cell
+/// is looked up only when it must be split).
+#[derive(Debug, Clone, Copy)]
+struct Patch {
+    point: Vec3,
+    normal: Vec3,
+    reach: Reach,
+    cell: Option<[f64; 4]>,
+    level: usize,
+}
+
+/// One rear check under way: the index, the cutter and its motion.
+struct Search<'a> {
+    index: &'a RearIndex,
+    shape: &'a CutterShape,
+    sweep: &'a Sweep,
+    tolerance: f64,
+}
+
+impl Search<'_> {
+    /// Branch and bound over `patch` (lattice node `node`) and the span `[s0, s1]`.
+    fn examine(
         &self,
-        [u0, u1, v0, v1]: [f64; 4],
-        shape: &CutterShape,
-        tip: &Vec3,
-        axis: &Unit<Vec3>,
-        tolerance: f64,
-        level: usize,
+        patch: &Patch,
+        node: [u32; 2],
+        (s0, s1): (f64, f64),
+        span_level: usize,
     ) -> Option<Penetration> {
+        let (sm, h) = (0.5 * (s0 + s1), 0.5 * (s1 - s0));
+        let (tip, axis) = self.sweep.pose(sm);
+        let d = depth(self.shape, &tip, &axis, &patch.point);
+        if d.depth > self.tolerance {
+            return Some(Penetration {
+                depth: d.depth,
+                point: patch.point,
+                at: sm,
+            });
+        }
+        let z = (patch.point - tip).dot(&axis);
+        let cover = patch.reach.cover();
+        let spread = |g: &Vec3| {
+            if g.norm_squared() == 0.0 {
+                self.sweep.spread_any(&patch.point, &tip, cover, h)
+            } else {
+                self.sweep.spread(g, &patch.point, &tip, cover, h)
+            }
+        };
+        let b = bound(
+            &d,
+            z,
+            &axis,
+            &patch.normal,
+            &patch.reach,
+            self.index.kappa,
+            spread,
+        );
+        if b.value() <= self.tolerance {
+            return None;
+        }
+        let cell_can_split = patch.level < MAX_LEVELS && cover > FINEST_COVER * self.tolerance;
+        let span_can_split = span_level < MAX_SPAN_LEVELS && b.own.motion.max(b.plane.motion) > 0.0;
+        if span_can_split && (b.split_span() || !cell_can_split) {
+            return self
+                .examine(patch, node, (s0, sm), span_level + 1)
+                .or_else(|| self.examine(patch, node, (sm, s1), span_level + 1));
+        }
+        if !cell_can_split {
+            return None;
+        }
+        let [u0, u1, v0, v1] = patch.cell.unwrap_or_else(|| self.index.lines.cell(node));
         let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
         for quarter in [
             [u0, um, v0, vm],
@@ -224,24 +367,16 @@ impl RearIndex {
                 0.5 * (quarter[1] - quarter[0]),
                 0.5 * (quarter[3] - quarter[2]),
             );
-            let d = self.surface.derivs(quarter[0] + hu, quarter[2] + hv);
-            let e = depth(shape, tip, axis, &d.point);
-            if e.depth > tolerance {
-                return Some(Penetration {
-                    depth: e.depth,
-                    point: d.point,
-                });
-            }
-            let reach = Reach::of(&d, hu, hv);
-            let n = d.normal().map_or(Vec3::zeros(), |n| n.into_inner());
-            let z = (d.point - tip).dot(axis);
-            if level < MAX_LEVELS
-                && reach.cover() > FINEST_COVER * tolerance
-                && bound(&e, z, axis, &n, &reach, self.kappa) > tolerance
-            {
-                if let Some(p) = self.split(quarter, shape, tip, axis, tolerance, level + 1) {
-                    return Some(p);
-                }
+            let e = self.index.surface.derivs(quarter[0] + hu, quarter[2] + hv);
+            let part = Patch {
+                point: e.point,
+                normal: e.normal().map_or(Vec3::zeros(), |n| n.into_inner()),
+                reach: Reach::of(&e, hu, hv),
+                cell: Some(quarter),
+                level: patch.level + 1,
+            };
+            if let Some(p) = self.examine(&part, node, (s0, s1), span_level) {
+                return Some(p);
             }
         }
         None
@@ -375,6 +510,109 @@ mod tests {
         assert!(index
             .first_penetration(&flat, &tip, &axis, tolerance)
             .is_none());
+    }
+
+    /// A ridge along x, `z = −y²/200` for `|x|, |y| ≤ 10` (a quadratic Bézier in y).
+    fn ridge() -> NurbsSurface {
+        let mut points = Vec::new();
+        for x in [-10.0, 10.0] {
+            for (y, z) in [(-10.0, -0.5), (0.0, 0.5), (10.0, -0.5)] {
+                points.push(Vec3::new(x, y, z));
+            }
+        }
+        NurbsSurface::bspline(
+            1,
+            2,
+            &points,
+            vec![0.0, 0.0, 1.0, 1.0],
+            vec![0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap()
+    }
+
+    /// A flat end's heel travelling across the ridge's crest 3/4 of the way along a chord: the
+    /// ends and the middle are clear, the sweep is not (session 7's corner gouge in small).
+    #[test]
+    fn a_rim_sweeping_across_a_rise_between_the_checked_poses_is_found() {
+        let surface = ridge();
+        let index = RearIndex::new(&surface, sample_surface(&surface, 0.3).unwrap(), 6.0);
+        let flat = CutterShape::Flat { radius: 3.0 };
+        let tolerance = 0.0005;
+        let dip = 0.004;
+        let (tip_a, axis) = heel_pose(Vec3::new(0.0, -6.0, 0.0), dip);
+        let (tip_b, _) = heel_pose(Vec3::new(0.0, 1.6, 0.0), dip);
+        let sweep = Sweep::between((&tip_a, &axis), (&tip_b, &axis));
+        for s in [0.0, 0.5, 1.0] {
+            let (tip, axis) = sweep.pose(s);
+            assert!(
+                index
+                    .first_penetration(&flat, &tip, &axis, tolerance)
+                    .is_none(),
+                "pose {s} gouges"
+            );
+        }
+        let hit = index
+            .first_penetration_along(&flat, &sweep, tolerance)
+            .expect("the heel crossing the crest");
+        assert!(hit.depth > tolerance && hit.depth <= dip + 1e-6, "{hit:?}");
+        // On the crest, where the heel crosses it (s = 6/7.6), give or take the crescent.
+        assert!(
+            hit.point.y.abs() < 1.0 && hit.point.x.abs() < 0.5,
+            "{hit:?}"
+        );
+        assert!((hit.at - 6.0 / 7.6).abs() < 0.15, "{hit:?}");
+        // Lifted by the dip and the tolerance, the same sweep is clear.
+        let lift = Vec3::z() * (dip + tolerance);
+        let lifted = Sweep::between((&(tip_a + lift), &axis), (&(tip_b + lift), &axis));
+        assert!(index
+            .first_penetration_along(&flat, &lifted, tolerance)
+            .is_none());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(16))]
+
+        /// Over random chords with a turning axis above the free-form patch, every cutter, the
+        /// sweep misses nothing that 400 standing checks along it find (they are exact to the
+        /// tolerance each: a pose gouging by twice the tolerance must be reported), and what
+        /// it reports lies that deep inside the cutter at the pose it names.
+        #[test]
+        fn the_sweep_finds_what_dense_poses_find(
+            which in 0usize..3,
+            start in prop::array::uniform2(0.15f64..0.85),
+            travel in prop::array::uniform2(-0.1f64..0.1),
+            leans in prop::array::uniform4(-0.3f64..0.3),
+            sink in 0.0f64..0.05,
+        ) {
+            let surface = crate::testing::freeform(0.0);
+            let index = RearIndex::new(&surface, sample_surface(&surface, 0.3).unwrap(), 10.0);
+            let shape = shapes()[which];
+            let tolerance = 0.0005;
+            let pose = |uv: [f64; 2], lean: [f64; 2]| {
+                let d = surface.derivs(uv[0], uv[1]);
+                let n = d.normal().unwrap().into_inner();
+                let axis = Unit::new_normalize(n + Vec3::new(lean[0], lean[1], 0.0));
+                // Standing on the surface point, sunk a little so some chords gouge.
+                (d.point - n * sink, axis)
+            };
+            let end = [start[0] + travel[0], start[1] + travel[1]];
+            let (tip_a, axis_a) = pose(start, [leans[0], leans[1]]);
+            let (tip_b, axis_b) = pose(end, [leans[2], leans[3]]);
+            let sweep = Sweep::between((&tip_a, &axis_a), (&tip_b, &axis_b));
+            let found = index.first_penetration_along(&shape, &sweep, tolerance);
+            let dense = (0..=400).find_map(|k| {
+                let (tip, axis) = sweep.pose(k as f64 / 400.0);
+                index.first_penetration(&shape, &tip, &axis, 2.0 * tolerance)
+            });
+            if let Some(d) = dense {
+                prop_assert!(found.is_some(), "missed {d:?}");
+            }
+            if let Some(f) = found {
+                let (tip, axis) = sweep.pose(f.at);
+                let depth = penetration(&shape, &tip, &axis, &f.point);
+                prop_assert!(depth > tolerance && (depth - f.depth).abs() < 1e-12, "{f:?}");
+            }
+        }
     }
 
     #[test]

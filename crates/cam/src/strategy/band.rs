@@ -23,6 +23,7 @@ use tezgah_geom::Vec3;
 use super::{Context, Placed};
 use crate::error::CamError;
 use crate::forward_step::{SurfacePath, MAX_POINTS};
+use crate::gouge::sweep::Sweep;
 use crate::orientation::ContactFrame;
 use crate::toolpath::CutterLocation;
 
@@ -190,7 +191,7 @@ impl Context<'_> {
     }
 }
 
-/// Rounds of raising the leads at the ends of a chord whose middle gouges.
+/// Rounds of raising the leads at the ends of a chord whose sweep gouges.
 const CHORD_ROUNDS: usize = 4;
 /// Lead added per round at both ends of such a chord, degrees.
 const CHORD_LEAD_STEP_DEG: f64 = 1.0;
@@ -198,11 +199,14 @@ const CHORD_LEAD_STEP_DEG: f64 = 1.0;
 impl Context<'_> {
     /// The machine sweeps the cutter along a straight tip move with the axis turning on a
     /// great circle between two placed locations; the rear and global checks only saw the
-    /// ends. The pose half-way (lifted as the band will lift its ends, so the chord's own sag
-    /// near the contact, which the band removes, does not count) is checked too, and where it
-    /// gouges both ends are placed again
-    /// leaning further (by [`CHORD_LEAD_STEP_DEG`] a round); ends still gouging in the middle
-    /// after [`CHORD_ROUNDS`] are refused (reported, never emitted).
+    /// ends. The whole sweep is checked (lifted as the band will lift its ends, so the
+    /// chord's own sag near the contact, which the band removes, does not count; the rear
+    /// check bounds every pose of it, [`crate::gouge::rear::RearIndex::first_penetration_along`],
+    /// the shank and holder are checked half-way), and where it gouges both ends are placed
+    /// again leaning further (by [`CHORD_LEAD_STEP_DEG`] a round); ends whose chords still
+    /// gouge after [`CHORD_ROUNDS`] are refused (reported, never emitted). Checking the middle
+    /// alone let a flat end's rim sweep across a rise 30 % of the way along a chord (4 µm on
+    /// the free-form patch's corner).
     pub(super) fn clear_chords(
         &self,
         path: &impl SurfacePath,
@@ -217,14 +221,17 @@ impl Context<'_> {
             for i in 0..placed.len().saturating_sub(1) {
                 if let (Ok(a), Ok(b)) = (&placed[i], &placed[i + 1]) {
                     let (a, b) = (&a.location, &b.location);
-                    let axis = axis_between(&a.axis, &b.axis, 0.5);
-                    // Both ends will be lifted by at least the band's motion plus this chord's
-                    // inward sag (`shift_outward`): the middle as the machine will sweep it.
+                    // Both ends will be lifted along their normals by at least the band's
+                    // motion plus this chord's inward sag (`shift_outward`): the chord as
+                    // the machine will sweep it.
                     let sag = self.chord_sag(path, (ts[i], ts[i + 1]), a, b);
-                    let normal = (a.normal + b.normal).normalize();
-                    let lift = (band.motion + sag.inward) * normal.dot(&a.normal).min(1.0);
-                    let tip = 0.5 * (a.tip + b.tip) + normal * lift;
-                    if let Some(g) = self.checker.check(&tip, &axis) {
+                    let lift = band.motion + sag.inward;
+                    let (tip_a, tip_b) = (a.tip + a.normal * lift, b.tip + b.normal * lift);
+                    let sweep = Sweep::between(
+                        (&tip_a, &Unit::new_normalize(a.axis)),
+                        (&tip_b, &Unit::new_normalize(b.axis)),
+                    );
+                    if let Some(g) = self.checker.check_sweep(&sweep) {
                         gouging[i] = Some(g);
                         gouging[i + 1] = Some(g);
                     }

@@ -1,0 +1,163 @@
+//! The motion of the cutter between two placed locations, as the rear check sees it: the tip
+//! on the straight chord, the axis turning on the great circle between the two axes at a
+//! constant rate (`tip(s) = a + sΔ`, `axis(s) = slerp(a, b, s)`, `s ∈ [0, 1]`). A standing
+//! cutter is the sweep of length zero.
+//!
+//! The rear check bounds a point's depth over a span of `s` by its depth at the span's middle
+//! and how far the point can move relative to the cutter over the span ([`Sweep::spread`]).
+
+use nalgebra::{Rotation3, Unit};
+use tezgah_geom::Vec3;
+
+/// The cutter's motion along one chord.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sweep {
+    from: Vec3,
+    /// Tip travel over the chord, `Δ = b − a`, mm.
+    step: Vec3,
+    axis_from: Unit<Vec3>,
+    axis_to: Unit<Vec3>,
+    /// The axis's turn over the chord, rad.
+    turn: f64,
+    /// Angular velocity per unit `s`: the turn about `a × b`, rad.
+    spin: Vec3,
+}
+
+impl Sweep {
+    /// The cutter standing at `tip` along `axis`.
+    pub fn still(tip: &Vec3, axis: &Unit<Vec3>) -> Sweep {
+        Sweep::between((tip, axis), (tip, axis))
+    }
+
+    /// From `tip_a` along `axis_a` to `tip_b` along `axis_b`.
+    pub fn between(
+        (tip_a, axis_a): (&Vec3, &Unit<Vec3>),
+        (tip_b, axis_b): (&Vec3, &Unit<Vec3>),
+    ) -> Sweep {
+        let cross = axis_a.cross(axis_b);
+        let turn = cross.norm().atan2(axis_a.dot(axis_b));
+        let spin = if cross.norm() > 0.0 {
+            cross.normalize() * turn
+        } else {
+            Vec3::zeros()
+        };
+        Sweep {
+            from: *tip_a,
+            step: tip_b - tip_a,
+            axis_from: *axis_a,
+            axis_to: *axis_b,
+            turn,
+            spin,
+        }
+    }
+
+    /// Tip and axis at `s`.
+    pub fn pose(&self, s: f64) -> (Vec3, Unit<Vec3>) {
+        let turn = Rotation3::from_scaled_axis(self.spin * s);
+        (self.from + self.step * s, turn * self.axis_from)
+    }
+
+    /// A box holding every point within `margin` of the segment from the tip to `height`
+    /// up the axis, at every pose of the sweep: the ends' boxes, grown by how far the axis's
+    /// arc strays from its chord (at most the turn, per unit of height).
+    pub fn bounding_box(&self, height: f64, margin: f64) -> (Vec3, Vec3) {
+        let grow = Vec3::repeat(margin + height * self.turn);
+        let ends = [
+            self.from,
+            self.from + self.axis_from.into_inner() * height,
+            self.from + self.step,
+            self.from + self.step + self.axis_to.into_inner() * height,
+        ];
+        let (lo, hi) = ends[1..]
+            .iter()
+            .fold((ends[0], ends[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)));
+        (lo - grow, hi + grow)
+    }
+
+    /// The most `g·(q_x(s) − q_x(s_m))` can be, for `|s − s_m| ≤ h` and every point `x`
+    /// within `cover` of `p`, where `q_x(s)` is `x` in the frame of the cutter at `s` and `g`
+    /// a unit vector of that frame at `s_m` (expressed in the world; `tip` is the tip at
+    /// `s_m`). Taylor to first order with the remainder bounded: `q' = −Δ − ω × (x − tip)`,
+    /// which differs from its value at `p` by at most `θ·cover`, and
+    /// `|q''| ≤ θ²·|x − tip(s)| + 2θ·|Δ|` (a rotation at constant rate about a fixed axis).
+    /// Zero for a standing cutter.
+    pub fn spread(&self, g: &Vec3, p: &Vec3, tip: &Vec3, cover: f64, h: f64) -> f64 {
+        if h == 0.0 {
+            return 0.0;
+        }
+        let rel = p - tip;
+        let velocity = -self.step - self.spin.cross(&rel);
+        let (theta, travel) = (self.turn, self.step.norm());
+        let reach = rel.norm() + cover + h * travel;
+        let second = theta * theta * reach + 2.0 * theta * travel;
+        h * g.dot(&velocity).abs() + h * theta * cover + 0.5 * h * h * second
+    }
+
+    /// `spread` for every direction at once (`|q'|` in place of `|g·q'|`).
+    pub fn spread_any(&self, p: &Vec3, tip: &Vec3, cover: f64, h: f64) -> f64 {
+        if h == 0.0 {
+            return 0.0;
+        }
+        let rel = p - tip;
+        let velocity = -self.step - self.spin.cross(&rel);
+        let dir = velocity.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+        self.spread(&dir, p, tip, cover, h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn unit(v: [f64; 3]) -> Option<Unit<Vec3>> {
+        Unit::try_new(Vec3::from(v), 1e-3)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+
+        /// The bound holds against the motion itself: a point fixed in the world, seen from
+        /// the cutter, moves along `g` no more than `spread` says over the span.
+        #[test]
+        fn spread_bounds_the_relative_motion(
+            a in prop::array::uniform3(-1.0f64..1.0),
+            b in prop::array::uniform3(-1.0f64..1.0),
+            tip_b in prop::array::uniform3(-4.0f64..4.0),
+            p in prop::array::uniform3(-8.0f64..8.0),
+            off in prop::array::uniform3(-0.3f64..0.3),
+            g in prop::array::uniform3(-1.0f64..1.0),
+            sm in 0.0f64..1.0,
+            h in 0.0f64..0.5,
+            t in -1.0f64..1.0,
+        ) {
+            let (Some(a), Some(b), Some(g)) = (unit(a), unit(b), unit(g)) else {
+                return Ok(());
+            };
+            let tip_a = Vec3::new(0.5, -0.3, 0.2);
+            let sweep = Sweep::between((&tip_a, &a), (&Vec3::from(tip_b), &b));
+            let (tip_m, axis_m) = sweep.pose(sm);
+            let (p, x) = (Vec3::from(p), Vec3::from(p) + Vec3::from(off));
+            let cover = Vec3::from(off).norm();
+            let s = sm + t * h;
+            let (tip_s, axis_s) = sweep.pose(s);
+            // The frame of the cutter at s: the rotation taking axis_m to axis_s about the
+            // sweep's spin (the cutter is round, so only that turn matters).
+            let rot = nalgebra::Rotation3::rotation_between(&axis_m, &axis_s)
+                .unwrap_or_else(nalgebra::Rotation3::identity);
+            let q = |xw: &Vec3, tip: &Vec3, r: &nalgebra::Rotation3<f64>| r.inverse() * (xw - tip);
+            let moved = g.dot(&(q(&x, &tip_s, &rot) - q(&x, &tip_m, &nalgebra::Rotation3::identity())));
+            let bound = sweep.spread(&g, &p, &tip_m, cover, h);
+            prop_assert!(moved <= bound + 1e-9, "moved {moved} > spread {bound}");
+            prop_assert!(bound <= sweep.spread_any(&p, &tip_m, cover, h) + 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_standing_cutter_does_not_spread() {
+        let sweep = Sweep::still(&Vec3::new(1.0, 2.0, 3.0), &Vec3::z_axis());
+        let p = Vec3::new(4.0, 0.0, 1.0);
+        assert_eq!(sweep.spread_any(&p, &Vec3::zeros(), 0.5, 0.5), 0.5 * 0.0);
+        assert_eq!(sweep.pose(0.7).0, Vec3::new(1.0, 2.0, 3.0));
+    }
+}
