@@ -326,11 +326,13 @@ impl Search<'_> {
         }
         let z = (patch.point - tip).dot(&axis);
         let cover = patch.reach.cover();
+        // How far a point of the cell can lie from its sample: the cover, and the bend.
+        let near = cover * (1.0 + 0.5 * self.index.kappa * cover);
         let spread = |g: &Vec3| {
             if g.norm_squared() == 0.0 {
-                self.sweep.spread_any(&patch.point, &tip, cover, h)
+                self.sweep.spread_any(&patch.point, &tip, near, h)
             } else {
-                self.sweep.spread(g, &patch.point, &tip, cover, h)
+                self.sweep.spread(g, &patch.point, &tip, near, h)
             }
         };
         let b = bound(
