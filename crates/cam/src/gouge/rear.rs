@@ -76,7 +76,9 @@ pub fn depth(shape: &CutterShape, tip: &Vec3, axis: &Unit<Vec3>, p: &Vec3) -> De
         }
     } else {
         let (er, ez) = (dr.max(0.0), dz.max(0.0));
-        let dist = er.hypot(ez);
+        // Millimetre lengths: no overflow for `hypot` to guard against, and its care cost the
+        // iso-scallop bench 16 %.
+        let dist = (er * er + ez * ez).sqrt();
         (dist, (radial * er - a * ez) / dist)
     };
     let (depth, gradient) = (r - sd, -grad_sd);

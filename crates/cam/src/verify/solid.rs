@@ -65,7 +65,9 @@ impl CutterSolid {
             0.0
         };
         let dr = (rho - self.core_radius).max(0.0);
-        let d = dz.hypot(dr);
+        // Millimetre lengths: no overflow for `hypot` to guard against, and its care was 15 %
+        // of a verification's time.
+        let d = (dz * dz + dr * dr).sqrt();
         if d == 0.0 {
             return (0.0, Vec3::zeros());
         }
