@@ -12,7 +12,9 @@
 //! against the cutter's true silhouette (`silhouette`): its 3.7 mm step put the cusp where the
 //! torus has risen 0.151 mm against its osculating circle's 0.130.
 
-use tezgah_cam::verify::{path_poses, simulate, step_over, Verification, VerifyOptions};
+use tezgah_cam::verify::{
+    path_poses, simulate, step_over, MachinedRegion, Verification, VerifyOptions,
+};
 use tezgah_cam::{
     plan, testing, Band, Cutter, CutterShape, FeedDirection, Settings, StrategyKind,
     ToleranceShares, ToolAxis,
@@ -87,7 +89,12 @@ fn assert_within(
     let options = VerifyOptions {
         cell_mm: cell,
         sweep_spacing_mm: spacing,
-        region: tezgah_cam::verify::MachinedRegion::ContactBox,
+        // With a tilt limit, all the face the cutter reaches is judged (out to its reach
+        // edge), not only what the contacts span.
+        region: match settings.reach_normal_tilt_deg(&cutter.shape) {
+            Some(max_tilt_deg) => MachinedRegion::Reachable { max_tilt_deg },
+            None => MachinedRegion::ContactBox,
+        },
     };
     let poses = path_poses(&p.path, spacing);
     let v = simulate(surface, &p.path, &poses, &options).unwrap();
@@ -170,6 +177,41 @@ fn sphere_patch_ball_flat_and_bull_nose() {
         &banded(z, 0.1, 5.0),
         0.2,
     );
+}
+
+#[test]
+fn sphere_patch_cut_to_the_reach_edge_at_a_lead() {
+    // A table that tilts 50°: the patch's lower latitudes lie beyond it. Leaning 5° the
+    // cutter reaches the face out to where the normal leans 45° whichever way it feeds; the
+    // reach edge is cut there and the face judged out to it. Traced where the normal leans
+    // 50°, the edge pass was refused wherever its axis leaned past the limit.
+    let s = testing::sphere(15.0);
+    let mut settings = banded(StrategyKind::ZigZag, 0.1, 5.0);
+    settings.max_axis_tilt_deg = Some(50.0);
+    // Along the parallels: the edge is one, and the passes below it are out of reach whole.
+    settings.direction = FeedDirection::AlongU;
+    let cutter = bull(8.0, 2.0);
+    let edge = settings.reach_normal_tilt_deg(&cutter.shape).unwrap();
+    assert_eq!(edge, 45.0);
+    // The edge pass is cut whole: contacts where the normal leans the edge's angle span the
+    // patch's 90° of longitude (the normal of the sphere about the origin is `p/|p|`).
+    let p = plan(&s, &cutter, &settings).unwrap();
+    let longitudes: Vec<f64> = p
+        .path
+        .passes
+        .iter()
+        .flat_map(|pass| &pass.points)
+        .filter(|l| (l.contact.z / l.contact.norm()).acos().to_degrees() - edge < 0.01)
+        .filter(|l| (l.contact.z / l.contact.norm()).acos().to_degrees() - edge > -0.01)
+        .map(|l| l.contact.y.atan2(l.contact.x).to_degrees())
+        .collect();
+    let (lo, hi) = longitudes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
+    assert!(lo < 0.01 && hi > 89.99, "edge contacts span {lo}..{hi}°");
+    assert_within("sphere bull D8 r2 within 50°", &s, &cutter, &settings, 0.2);
 }
 
 #[test]

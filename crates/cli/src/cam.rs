@@ -175,6 +175,9 @@ struct Planned {
     direction: FeedDirection,
     /// A trimmed face's region in (u, v) (`None`: the whole surface).
     region: Option<FaceRegion>,
+    /// How far the normal may lean from +Z where the path machines the face: the tilt limit
+    /// less the cutter's nominal lean (`Settings::reach_normal_tilt_deg`).
+    reach_normal_tilt_deg: f64,
 }
 
 /// The face of the STEP file at `path` to machine (`--face`, or its only face) and a box
@@ -264,6 +267,9 @@ fn plan_surface(
         path: plan.path,
         part,
         direction: settings.direction,
+        reach_normal_tilt_deg: settings
+            .reach_normal_tilt_deg(&cutter.shape)
+            .unwrap_or(request.max_tilt_deg),
         region: settings.region,
     })
 }
@@ -380,6 +386,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         part,
         direction,
         region: face_region,
+        reach_normal_tilt_deg,
     } = plan_surface(&args.surface, face, part, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
@@ -406,8 +413,10 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         ..PostOptions::new(feed, shares.linearisation)
     };
     // The program is judged on everything it is meant to machine: the whole face, less what
-    // leans beyond the machine's reach (the same limit the planner left out).
-    let region = MachinedRegion::Reachable { max_tilt_deg };
+    // leans beyond the machine's reach (out to the planner's reach edge).
+    let region = MachinedRegion::Reachable {
+        max_tilt_deg: reach_normal_tilt_deg,
+    };
     let done = finish(
         &surface,
         &path,

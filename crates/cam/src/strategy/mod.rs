@@ -181,6 +181,34 @@ pub struct Settings {
 }
 
 impl Settings {
+    /// How far the outward normal may lean from +Z where the path still machines the face,
+    /// degrees: [`Settings::max_axis_tilt_deg`] less the cutter's nominal lean from the
+    /// normal (its lead and tilt, at least [`MIN_RIM_LEAN_DEG`] for flat and bull-nose ends).
+    /// Inside it the cutter at its nominal stance leans at most the limit whichever way it
+    /// feeds, so the reach edge is traced there and the face is judged out to it. Traced
+    /// where the normal itself reaches the limit, the edge pass lost every point whose axis
+    /// leaned past it (on the sphere patch at 5° lead along the parallels: all of them), and
+    /// the strip beside it was left to the last regular pass.
+    /// Curvature matching and gouge corrections lean further where they must; a point they
+    /// take past the limit is refused as out of reach. `None` without a limit.
+    pub fn reach_normal_tilt_deg(&self, shape: &CutterShape) -> Option<f64> {
+        let limit = self.max_axis_tilt_deg?;
+        let lean = match self.axis {
+            ToolAxis::Fixed(_) => 0.0,
+            ToolAxis::Surface {
+                lead_deg, tilt_deg, ..
+            } => {
+                let nominal =
+                    LeadTilt::new(lead_deg.to_radians(), tilt_deg.to_radians()).inclination();
+                match shape {
+                    CutterShape::Ball { .. } => nominal,
+                    _ => nominal.max(MIN_RIM_LEAN_DEG.to_radians()),
+                }
+            }
+        };
+        Some((limit - lean.to_degrees()).max(0.0))
+    }
+
     pub fn new(strategy: StrategyKind, scallop: f64, tolerance: f64) -> Settings {
         Settings {
             strategy,

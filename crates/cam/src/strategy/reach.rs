@@ -1,5 +1,6 @@
 //! The edge of the machine's reach on the surface (with `Settings::max_axis_tilt_deg`): the
-//! curve where the outward normal leans exactly the tilt limit from +Z. Runs after a strategy's
+//! curve where the outward normal leans from +Z the tilt limit less the cutter's nominal lean
+//! (`Settings::reach_normal_tilt_deg`), so the cutter reaches all of it. Runs after a strategy's
 //! passes are placed: a pass that crosses the edge is ended on it (not a forward step short of
 //! it), and the edge itself is cut as passes of its own, so the strip between the last
 //! reachable pass and the edge — up to a side step wide — is machined like the rest.
@@ -44,7 +45,7 @@ impl Context<'_> {
     /// The reach edges as parameter polylines (empty without a tilt limit or where the whole
     /// domain lies on one side of it).
     pub(super) fn reach_edges(&self) -> Vec<UvPolyline> {
-        let Some(limit) = self.settings.max_axis_tilt_deg else {
+        let Some(limit) = self.settings.reach_normal_tilt_deg(self.shape()) else {
             return Vec::new();
         };
         let cos_limit = limit.to_radians().cos();
