@@ -145,7 +145,7 @@ pub struct Bounds {
 impl Bounds {
     /// The tighter of the two, mm.
     pub fn value(&self) -> f64 {
-        self.own.value.min(self.plane.value)
+        self.own.value().min(self.plane.value())
     }
 
     /// Whether halving the span serves better than quartering the cell. The bound nearer to
@@ -169,9 +169,7 @@ impl Bounds {
 /// An upper bound of the depth over a cell and a span of the sweep.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Bound {
-    /// The bound, mm.
-    pub value: f64,
-    /// Its value at the cell's point and the span's middle.
+    /// Its value at the cell's point and the span's middle, mm.
     pub at_point: f64,
     /// What the cell's extent adds to the value at its point.
     pub extent: f64,
@@ -182,11 +180,15 @@ pub struct Bound {
 impl Bound {
     fn of(at_point: f64, extent: f64, motion: f64) -> Bound {
         Bound {
-            value: at_point + extent + motion,
             at_point,
             extent,
             motion,
         }
+    }
+
+    /// The bound, mm.
+    pub fn value(&self) -> f64 {
+        self.at_point + self.extent + self.motion
     }
 }
 
@@ -278,6 +280,7 @@ impl RearIndex {
             sweep,
             tolerance,
         };
+        let whole = Span::new(sweep, 0.0, 1.0, 0);
         let mut hit = None;
         self.grid.visit_box(&lo, &hi, |s| {
             let patch = Patch {
@@ -287,7 +290,7 @@ impl RearIndex {
                 cell: None,
                 level: 0,
             };
-            hit = search.examine(&patch, s.node, (0.0, 1.0), 0);
+            hit = search.examine(&patch, s.node, &whole);
             hit.is_none()
         });
         hit
@@ -309,6 +312,43 @@ struct Patch {
     level: usize,
 }
 
+/// A span `[s0, s1]` of the sweep and the cutter's pose at its middle (computed once, for
+/// every cell examined over the span).
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    s0: f64,
+    s1: f64,
+    level: usize,
+    tip: Vec3,
+    axis: Unit<Vec3>,
+}
+
+impl Span {
+    fn new(sweep: &Sweep, s0: f64, s1: f64, level: usize) -> Span {
+        let (tip, axis) = sweep.pose(0.5 * (s0 + s1));
+        Span {
+            s0,
+            s1,
+            level,
+            tip,
+            axis,
+        }
+    }
+
+    fn middle(&self) -> f64 {
+        0.5 * (self.s0 + self.s1)
+    }
+
+    /// Its halves.
+    fn halves(&self, sweep: &Sweep) -> [Span; 2] {
+        let sm = self.middle();
+        [
+            Span::new(sweep, self.s0, sm, self.level + 1),
+            Span::new(sweep, sm, self.s1, self.level + 1),
+        ]
+    }
+}
+
 /// One rear check under way: the index, the cutter and its motion.
 struct Search<'a> {
     index: &'a RearIndex,
@@ -318,22 +358,15 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
-    /// Branch and bound over `patch` (lattice node `node`) and the span `[s0, s1]`.
-    fn examine(
-        &self,
-        patch: &Patch,
-        node: [u32; 2],
-        (s0, s1): (f64, f64),
-        span_level: usize,
-    ) -> Option<Penetration> {
-        let (sm, h) = (0.5 * (s0 + s1), 0.5 * (s1 - s0));
-        let (tip, axis) = self.sweep.pose(sm);
+    /// Branch and bound over `patch` (lattice node `node`) and `span`.
+    fn examine(&self, patch: &Patch, node: [u32; 2], span: &Span) -> Option<Penetration> {
+        let (tip, axis, h) = (span.tip, span.axis, 0.5 * (span.s1 - span.s0));
         let d = depth(self.shape, &tip, &axis, &patch.point);
         if d.depth > self.tolerance {
             return Some(Penetration {
                 depth: d.depth,
                 point: patch.point,
-                at: sm,
+                at: span.middle(),
             });
         }
         let z = (patch.point - tip).dot(&axis);
@@ -360,11 +393,12 @@ impl Search<'_> {
             return None;
         }
         let cell_can_split = patch.level < MAX_LEVELS && cover > FINEST_COVER * self.tolerance;
-        let span_can_split = span_level < MAX_SPAN_LEVELS && b.own.motion.max(b.plane.motion) > 0.0;
+        let span_can_split = span.level < MAX_SPAN_LEVELS && b.own.motion.max(b.plane.motion) > 0.0;
         if span_can_split && (b.split_span(self.tolerance) || !cell_can_split) {
+            let [first, second] = span.halves(self.sweep);
             return self
-                .examine(patch, node, (s0, sm), span_level + 1)
-                .or_else(|| self.examine(patch, node, (sm, s1), span_level + 1));
+                .examine(patch, node, &first)
+                .or_else(|| self.examine(patch, node, &second));
         }
         if !cell_can_split {
             return None;
@@ -389,7 +423,7 @@ impl Search<'_> {
                 cell: Some(quarter),
                 level: patch.level + 1,
             };
-            if let Some(p) = self.examine(&part, node, (s0, s1), span_level) {
+            if let Some(p) = self.examine(&part, node, span) {
                 return Some(p);
             }
         }

@@ -29,7 +29,8 @@ impl Sweep {
         Sweep::between((tip, axis), (tip, axis))
     }
 
-    /// From `tip_a` along `axis_a` to `tip_b` along `axis_b`.
+    /// From `tip_a` along `axis_a` to `tip_b` along `axis_b`. Opposite axes have no one great
+    /// circle: the axis then stays at `axis_a` (neighbouring locations never turn that far).
     pub fn between(
         (tip_a, axis_a): (&Vec3, &Unit<Vec3>),
         (tip_b, axis_b): (&Vec3, &Unit<Vec3>),

@@ -18,7 +18,6 @@
 
 use nalgebra::Unit;
 use tezgah_geom::deviation::maximise;
-use tezgah_geom::Vec3;
 
 use super::{Context, Placed};
 use crate::error::CamError;
@@ -72,14 +71,6 @@ pub struct ChordSag {
     pub outward: f64,
 }
 
-/// The unit axis a fraction `s` of the way from `a` to `b` on their great circle (the motion
-/// the post holds the machine to), or the normalised blend where they are opposite.
-fn axis_between(a: &Vec3, b: &Vec3, s: f64) -> Unit<Vec3> {
-    let (ua, ub) = (Unit::new_normalize(*a), Unit::new_normalize(*b));
-    ua.try_slerp(&ub, s, 1e-9)
-        .unwrap_or_else(|| Unit::new_normalize(a * (1.0 - s) + b * s))
-}
-
 impl Context<'_> {
     /// The sag of the move from `a` (contact at `ta` on `path`) to `b` (at `tb`) against the
     /// exact CL surface (module comment).
@@ -95,6 +86,11 @@ impl Context<'_> {
         if !(len2 > 0.0 && len2.is_finite()) {
             return ChordSag::default();
         }
+        // The axis the post holds the machine to: on the great circle between the two.
+        let motion = Sweep::between(
+            (&a.tip, &Unit::new_normalize(a.axis)),
+            (&b.tip, &Unit::new_normalize(b.axis)),
+        );
         let depth = |s: f64| -> f64 {
             let (u, v) = path.uv(ta + (tb - ta) * s);
             let d = self.surface.derivs(u, v);
@@ -108,7 +104,7 @@ impl Context<'_> {
             let mut sigma = s;
             let mut tip = a.tip;
             for _ in 0..2 {
-                let axis = axis_between(&a.axis, &b.axis, sigma);
+                let (_, axis) = motion.pose(sigma);
                 tip = self.shape().tip_for_contact(&d.point, &frame, &axis);
                 sigma = ((tip - a.tip).dot(&chord) / len2).clamp(0.0, 1.0);
             }
