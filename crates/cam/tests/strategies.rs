@@ -766,3 +766,64 @@ fn a_strip_left_uncut_at_the_rim_of_the_sphere_cap_fails_verification() {
         "{boxed:?}"
     );
 }
+
+#[test]
+fn a_bull_nose_turns_about_the_sphere_pole_under_a_lead() {
+    // Along u the pass at the pole has no length. A bull nose leaning 5° one way covers only
+    // the side it leans toward, so the pole cut as one location left 0.42 mm against 0.3 mm
+    // 1.4 mm from the pole; turned about the pole, its lean following each parameter's feed
+    // direction, it leaves what the passes beside it model (0.15 mm).
+    let (h, lead, limit) = (0.3, 5.0, 20.0);
+    let s = step_sphere();
+    let mut settings = sphere_cap_settings(StrategyKind::ZigZag, h, FeedDirection::AlongU);
+    settings.max_axis_tilt_deg = Some(limit);
+    if let ToolAxis::Surface { lead_deg, .. } = &mut settings.axis {
+        *lead_deg = lead;
+    }
+    let bull = Cutter::standard(CutterShape::BullNose {
+        radius: 5.0,
+        corner_radius: 2.0,
+    });
+    let p = plan(&s, &bull, &settings).unwrap();
+    let pole = Vec3::new(0.0, 0.0, 40.0);
+    let at_pole: Vec<_> = p
+        .path
+        .passes
+        .iter()
+        .filter(|q| q.points.iter().all(|c| (c.contact - pole).norm() < 1e-6))
+        .collect();
+    assert_eq!(at_pole.len(), 1, "one pass at the pole");
+    let turn = &at_pole[0].points;
+    let azimuths: Vec<f64> = turn.iter().map(|c| c.axis.y.atan2(c.axis.x)).collect();
+    for c in turn {
+        let leaned = c.axis.dot(&c.normal).acos().to_degrees();
+        assert!((leaned - lead).abs() < 1e-6, "lean {leaned}");
+    }
+    // The lean turns all the way round, the tip following its circle about the pole in
+    // chords whose sagitta is within the tolerance.
+    let mut turned = 0.0;
+    for w in azimuths.windows(2) {
+        turned += (w[1] - w[0] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+    }
+    for w in turn.windows(2) {
+        let (a, b) = (w[0].tip - pole, w[1].tip - pole);
+        let sagitta = a.norm() * (1.0 - (a.angle(&b) / 2.0).cos());
+        assert!(sagitta <= settings.tolerance + 1e-9, "{sagitta}");
+    }
+    assert!(
+        (turned.abs() - std::f64::consts::TAU).abs() < 1e-6,
+        "{turned}"
+    );
+    let v = simulate_cap(
+        &s,
+        &p.path,
+        tezgah_cam::verify::MachinedRegion::Reachable {
+            max_tilt_deg: limit - lead,
+        },
+    );
+    eprintln!("{v:?}");
+    assert_eq!(v.uncut, 0, "{v:?}");
+    assert!(v.max_scallop_mm - v.sweep_bound_mm <= h, "{v:?}");
+    assert!(v.gouge_depth_mm <= 0.001, "{v:?}");
+}

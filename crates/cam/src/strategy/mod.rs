@@ -10,6 +10,7 @@
 mod band;
 mod iso_parametric;
 mod iso_scallop;
+mod pole;
 mod reach;
 mod true_cusp;
 
@@ -826,23 +827,8 @@ impl<'a> Context<'a> {
     /// Steps along `path` by the chord error and places the cutter at every contact point;
     /// `reverse` cuts it from its end to its start. Refused points split the pass.
     fn run_pass(&self, path: &impl SurfacePath, reverse: bool) -> Result<PassResult, CamError> {
-        let mut ts = forward_steps(
-            self.surface,
-            path,
-            self.settings.tolerance,
-            self.settings.max_step,
-            None,
-        )?;
-        if reverse {
-            ts.reverse();
-        }
         let (t0, t1) = path.range();
         let h = (t1 - t0) * 1e-6;
-        let mut out = PassResult {
-            passes: Vec::new(),
-            refused: Vec::new(),
-            corrected: 0,
-        };
         let sign = if reverse { -1.0 } else { 1.0 };
         let contact_at = |t: f64| {
             let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
@@ -850,6 +836,24 @@ impl<'a> Context<'a> {
                 uv: path.uv(t),
                 tangent: (sign * (b.0 - a.0), sign * (b.1 - a.1)),
             }
+        };
+        let mut ts = match self.turn_about_pole(path, |t| contact_at(t).tangent) {
+            Some(turn) => turn,
+            None => forward_steps(
+                self.surface,
+                path,
+                self.settings.tolerance,
+                self.settings.max_step,
+                None,
+            )?,
+        };
+        if reverse {
+            ts.reverse();
+        }
+        let mut out = PassResult {
+            passes: Vec::new(),
+            refused: Vec::new(),
+            corrected: 0,
         };
         let mut placed: Vec<Result<Placed, GougeReport>> = ts
             .iter()
@@ -932,10 +936,20 @@ impl<'a> Context<'a> {
         *placed = new_placed;
     }
 
-    /// Keeps a pass of two or more locations, with its run-out when the band is on.
+    /// Keeps a pass of two or more locations, with its run-out when the band is on: along
+    /// the feed into the last contact from the latest one apart from it (none for a turn
+    /// about a pole, whose contacts are all one point).
     fn close_pass(&self, passes: &mut Vec<Pass>, mut pass: Pass) {
-        if let [.., prev, last] = pass.points.as_slice() {
-            if self.settings.band.is_some() {
+        if let [.., last] = pass.points.as_slice() {
+            if pass.points.len() < 2 {
+                return;
+            }
+            let prev = pass
+                .points
+                .iter()
+                .rev()
+                .find(|p| (p.contact - last.contact).norm() > pole::SAME_POINT);
+            if let (Some(prev), Some(_)) = (prev, self.settings.band) {
                 if let Some(extra) = self.run_out(prev, last) {
                     pass.points.push(extra);
                 }

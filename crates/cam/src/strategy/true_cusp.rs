@@ -31,13 +31,13 @@ pub(super) const STEP_BISECTIONS: usize = 14;
 const CUSP_SLACK: f64 = 1e-6;
 
 /// One pass's cutter at a contact: tip and unit axis at the nominal orientation.
-struct Standing {
-    tip: Vec3,
-    axis: Vec3,
+pub(super) struct Standing {
+    pub(super) tip: Vec3,
+    pub(super) axis: Vec3,
 }
 
 impl Context<'_> {
-    fn standing(&self, local: &Local) -> Option<Standing> {
+    pub(super) fn standing(&self, local: &Local) -> Option<Standing> {
         let angles = self.nominal_angles(local)?;
         let axis = self.axis_for(&local.frame, angles);
         Some(Standing {
