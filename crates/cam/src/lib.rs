@@ -28,6 +28,7 @@ pub mod verify;
 pub use cutter::{Cutter, CutterShape, CutterSpecError, Cylinder};
 pub use effective_radius::LeadTilt;
 pub use error::CamError;
+pub use gouge::CheckFace;
 pub use strategy::{
     plan, Band, FeedDirection, Plan, Settings, StrategyKind, ToleranceShares, ToolAxis,
 };

@@ -29,6 +29,15 @@ pub struct FaceRegion {
     slack: f64,
 }
 
+/// Where a parameter rectangle lies against a region ([`FaceRegion::classify`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RectSide {
+    Inside,
+    Outside,
+    /// A loop crosses it: part in, part out.
+    Across,
+}
+
 /// Why loops do not make a region.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RegionError {
@@ -130,6 +139,35 @@ impl FaceRegion {
         crossings % 2 == 1
     }
 
+    /// Where the parameter rectangle `[u0, u1] × [v0, v1]` lies: wholly in the region, wholly
+    /// out of it, or across its boundary (a loop edge meets the rectangle, grown by the
+    /// boundary slack). The gouge checks use it to skip the parts of a trimmed face's surface
+    /// that are not the face.
+    pub fn classify(&self, [u0, u1, v0, v1]: [f64; 4]) -> RectSide {
+        let s = self.slack;
+        let (lo, hi) = (u0 - s, u1 + s);
+        let (blo, bhi) = (v0 - s, v1 + s);
+        if hi < self.u_range.0
+            || lo > self.u_range.1
+            || bhi < self.v_range.0
+            || blo > self.v_range.1
+        {
+            return RectSide::Outside;
+        }
+        let (first, last) = self.band_span(blo, bhi);
+        let crossed = self.bands[first..=last].iter().any(|band| {
+            band.iter()
+                .any(|&(l, i)| segment_meets_rect(self.edge(l, i), [lo, hi, blo, bhi]))
+        });
+        if crossed {
+            RectSide::Across
+        } else if self.contains(0.5 * (u0 + u1), 0.5 * (v0 + v1)) {
+            RectSide::Inside
+        } else {
+            RectSide::Outside
+        }
+    }
+
     /// The region's area in the parameter plane: each loop's shoelace area, added for a loop
     /// nested in an even number of others (an outer boundary or an island) and taken away for
     /// an odd number (a hole).
@@ -225,6 +263,27 @@ fn shoelace(poly: &[(f64, f64)]) -> f64 {
         .sum::<f64>()
 }
 
+/// True when the segment `a–b` meets the rectangle `[u0, u1] × [v0, v1]`: the segment
+/// clipped to the rectangle's slabs in u and then in v (Liang & Barsky 1984) is not empty.
+fn segment_meets_rect((a, b): ((f64, f64), (f64, f64)), [u0, u1, v0, v1]: [f64; 4]) -> bool {
+    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+    for (p, d, lo, hi) in [(a.0, b.0 - a.0, u0, u1), (a.1, b.1 - a.1, v0, v1)] {
+        if d == 0.0 {
+            if p < lo || p > hi {
+                return false;
+            }
+            continue;
+        }
+        let (ta, tb) = ((lo - p) / d, (hi - p) / d);
+        t0 = t0.max(ta.min(tb));
+        t1 = t1.min(ta.max(tb));
+        if t0 > t1 {
+            return false;
+        }
+    }
+    true
+}
+
 /// Distance from `p` to the segment `a–b`.
 fn segment_distance((a, b): ((f64, f64), (f64, f64)), p: (f64, f64)) -> f64 {
     let (dx, dy) = (b.0 - a.0, b.1 - a.1);
@@ -278,6 +337,53 @@ mod tests {
             }
         }
         assert!(checked > 19_000);
+    }
+
+    #[test]
+    fn rectangles_are_classified_as_their_points_are() {
+        // Random rectangles against a square with a round hole: `Inside` and `Outside` agree
+        // with every point of a lattice over the rectangle, and `Across` has points of both
+        // sides unless the boundary only grazes it.
+        let region = FaceRegion::new(vec![
+            vec![(0.0, 0.0), (80.0, 0.0), (80.0, 60.0), (0.0, 60.0)],
+            circle((25.0, 30.0), 10.0, 400),
+        ])
+        .unwrap();
+        let mut seed = 7_u64;
+        let mut next = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut counts = [0; 3];
+        for _ in 0..2000 {
+            let (u, v) = (-10.0 + 100.0 * next(), -10.0 + 80.0 * next());
+            let (w, h) = (0.01 + 8.0 * next(), 0.01 + 8.0 * next());
+            let rect = [u, u + w, v, v + h];
+            let side = region.classify(rect);
+            let (mut ins, mut outs) = (0, 0);
+            for i in 0..=12 {
+                for j in 0..=12 {
+                    let p = (u + w * i as f64 / 12.0, v + h * j as f64 / 12.0);
+                    if region.contains(p.0, p.1) {
+                        ins += 1;
+                    } else {
+                        outs += 1;
+                    }
+                }
+            }
+            match side {
+                RectSide::Inside => assert_eq!(outs, 0, "{rect:?}"),
+                RectSide::Outside => assert_eq!(ins, 0, "{rect:?}"),
+                RectSide::Across => {}
+            }
+            if ins > 0 && outs > 0 {
+                assert_eq!(side, RectSide::Across, "{rect:?}");
+            }
+            counts[side as usize] += 1;
+        }
+        assert!(counts.iter().all(|&c| c > 100), "{counts:?}");
     }
 
     #[test]

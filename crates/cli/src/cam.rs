@@ -11,7 +11,9 @@ use tezgah_cam::region::FaceRegion;
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_DEXELS};
-use tezgah_cam::{Band, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath};
+use tezgah_cam::{
+    Band, CheckFace, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
+};
 use tezgah_geom::NurbsSurface;
 use tezgah_kinematics::{Kinematics, Machine};
 
@@ -108,7 +110,7 @@ pub struct PlanRequest {
 }
 
 /// The face of a STEP file to machine: the one `--face` names, or the file's only face.
-fn pick_face(path: &Path, model: tezgah_cam::step::StepModel, id: Option<u64>) -> Result<Face> {
+fn pick_face(path: &Path, model: &tezgah_cam::step::StepModel, id: Option<u64>) -> Result<Face> {
     let ids = || {
         model
             .faces
@@ -180,20 +182,57 @@ struct Planned {
     reach_normal_tilt_deg: f64,
 }
 
-/// The face of the STEP file at `path` to machine (`--face`, or its only face) and a box
-/// around every face of the file (the part the links keep clear of).
-fn read_face(path: &Path, id: Option<u64>) -> Result<(Face, Option<PartBox>)> {
+/// The face of a STEP file to machine, the part's other faces (kept out of the cutter's way)
+/// and a box around every face (the part the links keep clear of).
+struct PartFaces {
+    face: Face,
+    others: Vec<Face>,
+    part: Option<PartBox>,
+}
+
+/// The face of the STEP file at `path` to machine (`--face`, or its only face), its other
+/// faces and the part's box.
+fn read_face(path: &Path, id: Option<u64>) -> Result<PartFaces> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
     let part = part_box(&model);
-    Ok((pick_face(path, model, id)?, part))
+    let face = pick_face(path, &model, id)?;
+    let others = model
+        .faces
+        .into_iter()
+        .filter(|f| f.id != face.id)
+        .collect();
+    Ok(PartFaces { face, others, part })
+}
+
+/// The part's other faces as the gouge checks see them: each surface within its trim. A face
+/// whose trim cannot be followed is checked whole (more than the face: it can only refuse
+/// more), with a note.
+fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<CheckFace> {
+    others
+        .into_iter()
+        .map(|f| {
+            let region = f.uv_region(0.25 * tolerance_mm).unwrap_or_else(|e| {
+                eprintln!(
+                    "note: {}: face #{}'s trim cannot be followed ({e}); the gouge checks keep \
+                     the tool off its whole surface",
+                    path.display(),
+                    f.id
+                );
+                None
+            });
+            CheckFace {
+                surface: f.surface,
+                region,
+            }
+        })
+        .collect()
 }
 
 /// The face's surface and the tool path the strategy plans on it. Gouging contact points the
 /// strategy could not correct are left out of the path and listed here.
 fn plan_surface(
     path: &Path,
-    face: Face,
-    part: Option<PartBox>,
+    PartFaces { face, others, part }: PartFaces,
     cutter: Cutter,
     request: &PlanRequest,
 ) -> Result<Planned> {
@@ -216,6 +255,13 @@ fn plan_surface(
     settings.region = face
         .uv_region(0.25 * request.tolerance_mm)
         .map_err(|e| miette!("{}: {e}", path.display()))?;
+    settings.neighbours = neighbours(path, others, request.tolerance_mm);
+    if !settings.neighbours.is_empty() {
+        eprintln!(
+            "note: the tool is kept out of the part's {} other faces too",
+            settings.neighbours.len()
+        );
+    }
     if request.band.is_some() {
         // The rear check accepts penetrations up to its depth tolerance: keep that within
         // issue 7's 1 µm.
@@ -351,7 +397,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
     }
-    let (face, part) = read_face(&args.surface, args.face)?;
+    let faces = read_face(&args.surface, args.face)?;
     let (shape, tool_number) = match spec {
         ToolSpec::Given(shape) => (shape, args.tool_number.unwrap_or(1)),
         ToolSpec::Auto => {
@@ -359,7 +405,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
                 Some(p) => Some((p, crate::library::load_tool_table(Some(p))?)),
                 None => None,
             };
-            let pick = cam_tool::choose(&face, table.as_ref().map(|(p, t)| (*p, t)))?;
+            let pick = cam_tool::choose(&faces.face, table.as_ref().map(|(p, t)| (*p, t)))?;
             println!("tool auto: {} — {}", pick.shape, pick.why);
             (pick.shape, args.tool_number.or(pick.number).unwrap_or(1))
         }
@@ -387,7 +433,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         direction,
         region: face_region,
         reach_normal_tilt_deg,
-    } = plan_surface(&args.surface, face, part, cutter, &request)?;
+    } = plan_surface(&args.surface, faces, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
             OutputForm::Joints

@@ -537,3 +537,30 @@ fn trimmed_free_form_iso_scallop_is_verified_inside_its_loops_and_runs() {
     );
     check_and_run("trimmed-freeform", None);
 }
+
+#[test]
+fn a_fillet_of_a_block_is_machined_beside_its_neighbours_within_their_trims() {
+    // The block's rounded vertical edge (#135, a quarter cylinder r 6) with the tool kept out
+    // of the ten other faces. Each is checked only inside its trim: the top and bottom
+    // planes' surfaces run on past the rounded corner, where the ball cutting the fillet
+    // stands, and checked whole they refused 23 contacts and left 2.55 mm.
+    let h = 0.1;
+    let (report, _, stderr) = cam(
+        "fillet",
+        "filleted_block.stp",
+        &[
+            "--face",
+            "135",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.1",
+            "--verify-cell",
+            "0.3",
+        ],
+    );
+    assert!(stderr.contains("part's 10 other faces"), "{stderr}");
+    assert!(!stderr.contains("would gouge"), "{stderr}");
+    assert_meets_issue_7(&report, h, false);
+    check_and_run("fillet", None);
+}

@@ -2,7 +2,9 @@
 //! (the whole cutting end against the surface, through a spatial index of surface samples)
 //! and global (flutes above the cutting end, shank and holder against the surface). The
 //! strategies call [`GougeChecker::check`] for every cutter location and correct the tool
-//! axis or report the point; nothing gouging is emitted silently.
+//! axis or report the point; nothing gouging is emitted silently. The checks run against the
+//! machined face and any other faces of the part given ([`CheckFace`]), each only inside its
+//! trim.
 
 pub mod global;
 pub mod index;
@@ -15,7 +17,16 @@ use tezgah_geom::{NurbsSurface, Vec3};
 
 use crate::cutter::Cutter;
 use crate::error::{positive, CamError};
+use crate::region::FaceRegion;
 use index::PointGrid;
+
+/// A face the tool must not cut into: its surface and, for a trimmed face, its region in
+/// (u, v) (`None`: the whole surface).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CheckFace {
+    pub surface: NurbsSurface,
+    pub region: Option<FaceRegion>,
+}
 
 /// Which part of the tool meets the surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -68,19 +79,30 @@ impl Default for GougeSettings {
     }
 }
 
-/// The surface indexed for the checks of one cutter.
+/// The faces indexed for the checks of one cutter.
 #[derive(Debug, Clone)]
 pub struct GougeChecker {
     cutter: Cutter,
     settings: GougeSettings,
-    fine: Option<rear::RearIndex>,
+    /// One rear index per face.
+    fine: Vec<rear::RearIndex>,
+    /// The samples of every face inside its trim, together.
     coarse: Option<PointGrid>,
 }
 
 impl GougeChecker {
-    /// Samples and indexes `surface` for `cutter`.
+    /// Samples and indexes the whole of `surface` for `cutter`.
     pub fn new(
         surface: &NurbsSurface,
+        cutter: &Cutter,
+        settings: GougeSettings,
+    ) -> Result<GougeChecker, CamError> {
+        GougeChecker::of_faces(&[(surface, None)], cutter, settings)
+    }
+
+    /// Samples and indexes `faces` (each a surface and its trim, if any) for `cutter`.
+    pub fn of_faces(
+        faces: &[(&NurbsSurface, Option<&FaceRegion>)],
         cutter: &Cutter,
         settings: GougeSettings,
     ) -> Result<GougeChecker, CamError> {
@@ -88,24 +110,38 @@ impl GougeChecker {
         positive("gouge global_spacing", settings.global_spacing)?;
         positive("gouge depth_tolerance", settings.depth_tolerance)?;
         let r = cutter.shape.radius();
-        let sample = |spacing| {
+        let sample = |surface, spacing| {
             index::sample_surface(surface, spacing).ok_or(CamError::TooLarge {
                 what: "gouge-check samples (raise the gouge spacing)",
                 limit: index::MAX_SAMPLES,
             })
         };
-        let fine = if settings.rear {
-            Some(rear::RearIndex::new(
-                surface,
-                sample(settings.rear_spacing)?,
-                2.0 * r,
-            ))
-        } else {
-            None
-        };
+        let mut fine = Vec::new();
+        if settings.rear {
+            for &(surface, region) in faces {
+                let samples = sample(surface, settings.rear_spacing)?;
+                fine.push(rear::RearIndex::within(surface, region, samples, 2.0 * r));
+            }
+        }
         let coarse = if settings.global {
+            let mut points = Vec::new();
+            for &(surface, region) in faces {
+                let lattice = sample(surface, settings.global_spacing)?;
+                // The shank and holder keep a clearance of the spacing, so the face between
+                // its last sample and its trim cannot reach them unseen.
+                points.extend(lattice.samples.iter().filter(|s| {
+                    let (u, v) = (lattice.u[s.node[0] as usize], lattice.v[s.node[1] as usize]);
+                    region.is_none_or(|r| r.contains(u, v))
+                }));
+            }
+            if points.len() > index::MAX_SAMPLES {
+                return Err(CamError::TooLarge {
+                    what: "gouge-check samples (raise the gouge spacing)",
+                    limit: index::MAX_SAMPLES,
+                });
+            }
             Some(PointGrid::new(
-                sample(settings.global_spacing)?.samples,
+                points,
                 (2.0 * r).max(4.0 * settings.global_spacing),
             ))
         } else {
@@ -129,7 +165,7 @@ impl GougeChecker {
     /// pose of it ([`rear::RearIndex::first_penetration_along`]), the global check (shank and
     /// holder, which keep a clearance of the global spacing) at its middle.
     pub fn check_sweep(&self, sweep: &sweep::Sweep) -> Option<Gouge> {
-        if let Some(index) = &self.fine {
+        for index in &self.fine {
             if let Some(rear::Penetration { depth, point, .. }) = index.first_penetration_along(
                 &self.cutter.shape,
                 sweep,

@@ -15,6 +15,10 @@
 //! form (the point's axial plane, then the corner circle: Lee & Chang 1995 / 001 §3.4.3).
 //! Session 5's scan of the samples alone missed heel contacts of 4–5 µm between its 0.3 mm
 //! samples: the torus's tube curves by 1/r, the flat's rim is a corner.
+//!
+//! A trimmed face is only the part of its surface inside its loops ([`FaceRegion`]): cells
+//! outside are skipped, cells across the trim are split like the others, and a point of one
+//! outside the face counts only when even the nearest point of the cell could be that deep.
 
 use nalgebra::Unit;
 use tezgah_geom::{NurbsSurface, Vec3};
@@ -22,6 +26,7 @@ use tezgah_geom::{NurbsSurface, Vec3};
 use super::index::{PointGrid, Reach, SurfaceSamples};
 use super::sweep::Sweep;
 use crate::cutter::CutterShape;
+use crate::region::{FaceRegion, RectSide};
 
 /// Height of the checked cutting end above the tip, in tool radii.
 pub const CUTTING_END_RADII: f64 = 2.0;
@@ -207,6 +212,8 @@ pub struct Penetration {
 #[derive(Debug, Clone)]
 pub struct RearIndex {
     surface: NurbsSurface,
+    /// The face's region on the surface (`None`: the whole surface).
+    region: Option<FaceRegion>,
     /// The lattice's parameter lines (its samples live in `grid`).
     lines: SurfaceSamples,
     grid: PointGrid,
@@ -220,7 +227,27 @@ const CURVATURE_SAMPLES: usize = 65;
 const CURVATURE_MARGIN: f64 = 1.5;
 
 impl RearIndex {
-    pub fn new(surface: &NurbsSurface, mut samples: SurfaceSamples, bucket: f64) -> RearIndex {
+    pub fn new(surface: &NurbsSurface, samples: SurfaceSamples, bucket: f64) -> RearIndex {
+        RearIndex::within(surface, None, samples, bucket)
+    }
+
+    /// The index of the face on `surface` inside `region` (the whole surface for `None`):
+    /// samples whose cell lies wholly outside it are left out.
+    pub fn within(
+        surface: &NurbsSurface,
+        region: Option<&FaceRegion>,
+        mut samples: SurfaceSamples,
+        bucket: f64,
+    ) -> RearIndex {
+        if let Some(r) = region {
+            let keep: Vec<bool> = samples
+                .samples
+                .iter()
+                .map(|s| r.classify(samples.cell(s.node)) != RectSide::Outside)
+                .collect();
+            let mut k = keep.iter();
+            samples.samples.retain(|_| *k.next().unwrap_or(&false));
+        }
         let (du, dv) = (surface.domain_u(), surface.domain_v());
         let at = |(lo, hi): (f64, f64), k: usize| {
             lo + (hi - lo) * k as f64 / (CURVATURE_SAMPLES - 1) as f64
@@ -235,6 +262,7 @@ impl RearIndex {
         }
         RearIndex {
             surface: surface.clone(),
+            region: region.cloned(),
             kappa: kappa * CURVATURE_MARGIN,
             grid: PointGrid::new(std::mem::take(&mut samples.samples), bucket),
             lines: samples,
@@ -283,12 +311,24 @@ impl RearIndex {
         let whole = Span::new(sweep, 0.0, 1.0, 0);
         let mut hit = None;
         self.grid.visit_box(&lo, &hi, |s| {
+            let (uv, side) = match &self.region {
+                None => (None, RectSide::Inside),
+                Some(r) => (
+                    Some((
+                        self.lines.u[s.node[0] as usize],
+                        self.lines.v[s.node[1] as usize],
+                    )),
+                    r.classify(self.lines.cell(s.node)),
+                ),
+            };
             let patch = Patch {
                 point: s.point,
                 normal: s.normal,
                 reach: s.reach,
                 cell: None,
                 level: 0,
+                uv,
+                side,
             };
             hit = search.examine(&patch, s.node, &whole);
             hit.is_none()
@@ -310,6 +350,10 @@ struct Patch {
     reach: Reach,
     cell: Option<[f64; 4]>,
     level: usize,
+    /// The point's parameters (needed only on a trimmed face).
+    uv: Option<(f64, f64)>,
+    /// Where the cell lies against the face's region (`Inside` on an untrimmed face).
+    side: RectSide,
 }
 
 /// A span `[s0, s1]` of the sweep and the cutter's pose at its middle (computed once, for
@@ -360,9 +404,20 @@ struct Search<'a> {
 impl Search<'_> {
     /// Branch and bound over `patch` (lattice node `node`) and `span`.
     fn examine(&self, patch: &Patch, node: [u32; 2], span: &Span) -> Option<Penetration> {
+        if patch.side == RectSide::Outside {
+            return None;
+        }
         let (tip, axis, h) = (span.tip, span.axis, 0.5 * (span.s1 - span.s0));
         let d = depth(self.shape, &tip, &axis, &patch.point);
-        if d.depth > self.tolerance {
+        let cover = patch.reach.cover();
+        // A point outside the face, in a cell across its trim: the face's part of the cell
+        // lies within the cover of it, and the depth changes by at most the distance.
+        let outside = match (patch.side, &self.index.region, patch.uv) {
+            (RectSide::Across, Some(r), Some((u, v))) => !r.contains(u, v),
+            _ => false,
+        };
+        let counted = if outside { d.depth - cover } else { d.depth };
+        if counted > self.tolerance {
             return Some(Penetration {
                 depth: d.depth,
                 point: patch.point,
@@ -370,7 +425,6 @@ impl Search<'_> {
             });
         }
         let z = (patch.point - tip).dot(&axis);
-        let cover = patch.reach.cover();
         // How far a point of the cell can lie from its sample: the cover, and the bend.
         let near = cover * (1.0 + 0.5 * self.index.kappa * cover);
         let spread = |g: &Vec3| {
@@ -416,12 +470,18 @@ impl Search<'_> {
                 0.5 * (quarter[3] - quarter[2]),
             );
             let e = self.index.surface.derivs(quarter[0] + hu, quarter[2] + hv);
+            let side = match (&self.index.region, patch.side) {
+                (Some(r), RectSide::Across) => r.classify(quarter),
+                (_, side) => side,
+            };
             let part = Patch {
                 point: e.point,
                 normal: e.normal().map_or(Vec3::zeros(), |n| n.into_inner()),
                 reach: Reach::of(&e, hu, hv),
                 cell: Some(quarter),
                 level: patch.level + 1,
+                uv: Some((quarter[0] + hu, quarter[2] + hv)),
+                side,
             };
             if let Some(p) = self.examine(&part, node, span) {
                 return Some(p);

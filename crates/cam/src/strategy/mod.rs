@@ -26,7 +26,7 @@ use crate::effective_radius::LeadTilt;
 use crate::error::{positive, CamError};
 use crate::forward_step::{forward_steps, IsoLine, SurfacePath, UvPolyline};
 use crate::gouge::local::{local_margin, surface_curvature, Curvature2};
-use crate::gouge::{Gouge, GougeChecker, GougeSettings};
+use crate::gouge::{CheckFace, Gouge, GougeChecker, GougeSettings};
 use crate::orientation::ContactFrame;
 use crate::region::FaceRegion;
 use crate::scallop::stepover_exact;
@@ -178,7 +178,13 @@ pub struct Settings {
     /// A trimmed face's region in (u, v): contact points outside it are left out as
     /// [`Refusal::OutsideFace`], passes that cross its boundary end on it, and its loops are
     /// cut as passes of their own (the strip along the trim). `None`: the whole domain.
+    /// The gouge checks see the face only inside it: beyond the trim the surface is not
+    /// the part.
     pub region: Option<FaceRegion>,
+    /// The part's other faces (a wall beside the floor, the faces round a hole): the rear and
+    /// global gouge checks keep the cutter, shank and holder out of them as out of the face
+    /// itself, so a contact whose cutter would cut into one is corrected or refused.
+    pub neighbours: Vec<CheckFace>,
 }
 
 impl Settings {
@@ -229,6 +235,7 @@ impl Settings {
             gouge: GougeSettings::default(),
             band: None,
             region: None,
+            neighbours: Vec::new(),
         }
     }
 
@@ -317,6 +324,12 @@ impl Refusal {
     /// passes end on that region's edge.
     pub fn is_beyond(&self) -> bool {
         matches!(self, Refusal::OutOfReach | Refusal::OutsideFace)
+    }
+
+    /// True for a gouge where the tool meets the part away from the contact (rear or global:
+    /// a wall beside the face, the surface behind the heel).
+    pub fn is_interference(&self) -> bool {
+        matches!(self, Refusal::Gouge(Gouge::Interference { .. }))
     }
 
     /// True for a gouge (the cutter would cut into the part here), false for a point the
@@ -568,12 +581,20 @@ impl<'a> Context<'a> {
             ToolAxis::Fixed(a) => Some(Unit::new_normalize(a)),
             ToolAxis::Surface { .. } => None,
         };
+        let faces: Vec<_> = std::iter::once((surface, settings.region.as_ref()))
+            .chain(
+                settings
+                    .neighbours
+                    .iter()
+                    .map(|f| (&f.surface, f.region.as_ref())),
+            )
+            .collect();
         Ok(Context {
             surface,
             cutter,
             settings,
             axes,
-            checker: GougeChecker::new(surface, cutter, settings.gouge)?,
+            checker: GougeChecker::of_faces(&faces, cutter, settings.gouge)?,
             fixed_axis,
         })
     }
@@ -862,9 +883,7 @@ impl<'a> Context<'a> {
                 self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
             })
             .collect();
-        if self.settings.max_axis_tilt_deg.is_some() || self.settings.region.is_some() {
-            self.end_on_reach(&mut ts, &mut placed, &contact_at);
-        }
+        self.end_on_reach(&mut ts, &mut placed, &contact_at);
         if self.settings.band.is_some() {
             self.refine_chords(path, &mut ts, &mut placed, contact_at);
         }
@@ -893,22 +912,28 @@ impl<'a> Context<'a> {
         Ok(out)
     }
 
-    /// Ends the pieces of a pass on the edge of the reach or of the face: between a placed
-    /// contact and a neighbour refused as beyond it ([`Refusal::is_beyond`]), the last
-    /// placeable contact is added.
+    /// Ends the pieces of a pass on the edge of the reach or of the face, or where the cutter
+    /// would begin to cut into the part (a wall beside the face): between a placed contact
+    /// and a neighbour refused as beyond it ([`Refusal::is_beyond`]) or as an interference
+    /// gouge, the last placeable contact is added.
     fn end_on_reach(
         &self,
         ts: &mut Vec<f64>,
         placed: &mut Vec<Result<Placed, GougeReport>>,
         contact_at: &impl Fn(f64) -> Contact,
     ) {
-        let out_of_reach =
-            |p: &Result<Placed, GougeReport>| matches!(p, Err(r) if r.refusal.is_beyond());
-        let ok: Vec<bool> = placed.iter().map(|p| p.is_ok()).collect();
-        let away: Vec<bool> = placed.iter().map(out_of_reach).collect();
-        if !away.contains(&true) {
+        // The refusal of each contact refused as beyond the edge or as an interference.
+        let away: Vec<Option<Refusal>> = placed
+            .iter()
+            .map(|p| match p {
+                Err(r) if r.refusal.is_beyond() || r.refusal.is_interference() => Some(r.refusal),
+                _ => None,
+            })
+            .collect();
+        if away.iter().all(Option::is_none) {
             return;
         }
+        let ok: Vec<bool> = placed.iter().map(|p| p.is_ok()).collect();
         let place_at = |t: f64| {
             let c = contact_at(t);
             self.place(c.uv.0, c.uv.1, c.tangent, 0.0)
@@ -916,17 +941,18 @@ impl<'a> Context<'a> {
         let n = ts.len();
         let mut new_ts = Vec::with_capacity(n + 4);
         let mut new_placed = Vec::with_capacity(n + 4);
+        let toward = |j: usize| away[j].as_ref().map(|r| (ts[j], r));
         for (i, item) in std::mem::take(placed).into_iter().enumerate() {
-            if i > 0 && away[i - 1] && ok[i] {
-                if let Some((t, p)) = self.reach_end(ts[i], ts[i - 1], place_at) {
+            if let (true, Some(out)) = (ok[i], i.checked_sub(1).and_then(toward)) {
+                if let Some((t, p)) = self.reach_end(ts[i], out, place_at) {
                     new_ts.push(t);
                     new_placed.push(Ok(p));
                 }
             }
             new_ts.push(ts[i]);
             new_placed.push(item);
-            if i + 1 < n && ok[i] && away[i + 1] {
-                if let Some((t, p)) = self.reach_end(ts[i], ts[i + 1], place_at) {
+            if let (true, Some(out)) = (ok[i], (i + 1 < n).then(|| toward(i + 1)).flatten()) {
+                if let Some((t, p)) = self.reach_end(ts[i], out, place_at) {
                     new_ts.push(t);
                     new_placed.push(Ok(p));
                 }

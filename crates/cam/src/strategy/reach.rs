@@ -12,7 +12,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{Context, GougeReport, Placed};
+use super::{Context, GougeReport, Placed, Refusal};
 use crate::forward_step::UvPolyline;
 
 /// Grid cells per parameter for tracing the edge (its topology; the points are exact).
@@ -178,13 +178,17 @@ impl Context<'_> {
     }
 
     /// Where a pass crosses out of reach between the contacts at `t_in` (placed) and `t_out`
-    /// (refused as out of reach), the last contact that is placed: bisection on the pass.
+    /// (refused as out of reach, or as an interference gouge), the last contact that is
+    /// placed: bisection on the pass. Toward the reach edge a gouge on the way leaves the pass
+    /// as it is; toward a gouge every refusal bounds the bisection, so the end found is a
+    /// placed contact short of the first one.
     pub(super) fn reach_end(
         &self,
         t_in: f64,
-        t_out: f64,
+        (t_out, out): (f64, &Refusal),
         place_at: impl Fn(f64) -> Result<Placed, GougeReport>,
     ) -> Option<(f64, Placed)> {
+        let toward_gouge = out.is_interference();
         let (mut lo, mut hi) = (t_in, t_out);
         let mut best = None;
         for _ in 0..END_BISECTIONS {
@@ -194,7 +198,7 @@ impl Context<'_> {
                     lo = mid;
                     best = Some((mid, p));
                 }
-                Err(r) if r.refusal.is_beyond() => hi = mid,
+                Err(r) if r.refusal.is_beyond() || toward_gouge => hi = mid,
                 // Something else refuses the way to the edge (a gouge): leave the pass as is.
                 Err(_) => return None,
             }

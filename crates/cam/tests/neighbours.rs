@@ -1,0 +1,147 @@
+//! The part's other faces in the gouge checks (`Settings::neighbours`): a floor cut up to the
+//! shoulder that stands on its edge, and the trim of a neighbouring face (its surface beyond
+//! the trim is not the part and must not refuse anything). The shoulder is 5 mm high, within
+//! the two tool radii the rear check covers exactly; above them the flutes, shank and holder
+//! keep the global check's clearance.
+
+use nalgebra::Unit;
+use tezgah_cam::gouge::rear::penetration;
+use tezgah_cam::region::FaceRegion;
+use tezgah_cam::strategy::Refusal;
+use tezgah_cam::{
+    plan, CheckFace, Cutter, CutterShape, FeedDirection, Plan, Settings, StrategyKind, ToolAxis,
+};
+use tezgah_geom::{NurbsSurface, Vec3};
+
+/// The bilinear patch through four corners: `S(0,0) = a`, `S(0,1) = b`, `S(1,0) = c`,
+/// `S(1,1) = d`.
+fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> NurbsSurface {
+    let knots = vec![0.0, 0.0, 1.0, 1.0];
+    NurbsSurface::bspline(1, 1, &[a, b, c, d], knots.clone(), knots).unwrap()
+}
+
+/// The floor `[0, 50]² × {0}` (normal +z) and the shoulder's wall `x = 50`, 5 mm high, on
+/// its edge.
+fn floor_and_wall() -> (NurbsSurface, NurbsSurface) {
+    let floor = quad(
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.0, 50.0, 0.0),
+        Vec3::new(50.0, 0.0, 0.0),
+        Vec3::new(50.0, 50.0, 0.0),
+    );
+    let wall = quad(
+        Vec3::new(50.0, 0.0, 0.0),
+        Vec3::new(50.0, 50.0, 0.0),
+        Vec3::new(50.0, 0.0, 5.0),
+        Vec3::new(50.0, 50.0, 5.0),
+    );
+    (floor, wall)
+}
+
+/// The deepest any point of `face` (for `v` within `v_range`, if given) on a lattice of 400
+/// steps each way lies in the cutting end at any location of the plan.
+fn deepest_in(face: &NurbsSurface, cutter: &Cutter, p: &Plan, v_range: Option<(f64, f64)>) -> f64 {
+    let n = 400;
+    let (v0, v1) = v_range.unwrap_or((0.0, 1.0));
+    let points: Vec<Vec3> = (0..=n)
+        .flat_map(|i| (0..=n).map(move |j| (i, j)))
+        .map(|(i, j)| face.point(i as f64 / n as f64, v0 + (v1 - v0) * j as f64 / n as f64))
+        .collect();
+    let mut worst = f64::NEG_INFINITY;
+    for c in p.path.passes.iter().flat_map(|q| &q.points) {
+        let axis = Unit::new_normalize(c.axis);
+        for q in points.iter().filter(|q| (*q - c.tip).norm() < 10.0) {
+            worst = worst.max(penetration(&cutter.shape, &c.tip, &axis, q));
+        }
+    }
+    worst
+}
+
+#[test]
+fn a_floor_is_cut_up_to_the_wall_on_its_edge_and_no_further() {
+    // Ball D6 along x toward the wall at x = 50, the axis along the floor's normal: at the
+    // floor's edge the ball would stand 3 mm into the wall. With the wall as a neighbour the
+    // passes end where the ball touches it (contact x = 47, found by bisection) and the
+    // contacts beyond are refused as interference with the wall.
+    let (floor, wall) = floor_and_wall();
+    let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
+        *max_lead_deg = 0.0;
+    }
+    let alone = plan(&floor, &cutter, &settings).unwrap();
+    assert!(alone.refused.is_empty());
+    assert!(deepest_in(&wall, &cutter, &alone, None) > 2.9);
+
+    settings.neighbours = vec![CheckFace {
+        surface: wall.clone(),
+        region: None,
+    }];
+    let p = plan(&floor, &cutter, &settings).unwrap();
+    let deepest = deepest_in(&wall, &cutter, &p, None);
+    assert!(deepest <= settings.gouge.depth_tolerance, "{deepest}");
+    assert!(!p.refused.is_empty());
+    assert!(p
+        .refused
+        .iter()
+        .all(|r| r.refusal.is_interference() && r.contact.x > 47.0 - 1e-3));
+    // Every pass (one per side step) ends at the wall's touch: contact x = 47.
+    let ends: Vec<f64> = p
+        .path
+        .passes
+        .iter()
+        .map(|q| q.points.iter().map(|c| c.contact.x).fold(0.0, f64::max))
+        .collect();
+    assert_eq!(p.path.passes.len(), alone.path.passes.len());
+    for x in &ends {
+        assert!((x - 47.0).abs() < 3e-3, "{ends:?}");
+    }
+}
+
+#[test]
+fn a_neighbour_counts_only_inside_its_trim() {
+    // The same wall, trimmed to y ∈ [0, 20] (a door from y 20 to 50): the passes with the
+    // ball clear of it (y ≥ 23) run to the floor's edge, the others stop where the ball
+    // touches the wall or its end edge.
+    let (floor, wall) = floor_and_wall();
+    let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
+        *max_lead_deg = 0.0;
+    }
+    // The wall's (u, v): u up the wall (z / 5), v along it (y / 50).
+    let region =
+        FaceRegion::new(vec![vec![(0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.0, 0.4)]]).unwrap();
+    settings.neighbours = vec![CheckFace {
+        surface: wall.clone(),
+        region: Some(region),
+    }];
+    let p = plan(&floor, &cutter, &settings).unwrap();
+    let mut stopped = 0;
+    for q in &p.path.passes {
+        let y = q.points[0].contact.y;
+        let end = q.points.iter().map(|c| c.contact.x).fold(0.0, f64::max);
+        // The ball's centre (x, y, 3) stops 3 mm from the wall, or from its end edge
+        // (x = 50, y = 20) beside it.
+        let want = if y <= 20.0 {
+            47.0
+        } else if y < 23.0 {
+            50.0 - (9.0 - (y - 20.0).powi(2)).sqrt()
+        } else {
+            50.0
+        };
+        // Not short of it; past it only as far as the depth tolerance lets the ball into
+        // the wall (checked below on the wall itself).
+        assert!(
+            end >= want - 3e-3 && end <= want + 0.01,
+            "y {y}: {end}, want {want}"
+        );
+        stopped += usize::from(want < 50.0);
+    }
+    let deepest = deepest_in(&wall, &cutter, &p, Some((0.0, 0.4)));
+    assert!(deepest <= settings.gouge.depth_tolerance, "{deepest}");
+    assert!(stopped > 0 && stopped < p.path.passes.len());
+    assert!(p.refused.iter().all(|r| r.refusal != Refusal::OutsideFace));
+}
