@@ -70,6 +70,11 @@ pub struct CamArgs {
     /// table, else 1).
     #[arg(long)]
     pub tool_number: Option<u32>,
+    /// How far the tool may reach into the file's other faces, mm (default: --tolerance).
+    /// Faces that meet at a crease leave material the tool cannot reach without cutting into
+    /// the face beside; this is how deep it may.
+    #[arg(long = "check-tolerance", value_name = "MM")]
+    pub check_tolerance: Option<f64>,
     /// The STEP `#id` of the face to machine (needed when the file has several faces).
     #[arg(long)]
     pub face: Option<u64>,
@@ -99,6 +104,8 @@ pub struct PlanRequest {
     pub scallop_mm: f64,
     /// The strategy's chord tolerance, mm.
     pub tolerance_mm: f64,
+    /// How far the tool may reach into the part's other faces, mm (`--tolerance`).
+    pub neighbour_tolerance_mm: f64,
     /// The one-sided band (`None`: chords straddle the exact CL surface).
     pub band: Option<Band>,
     pub lead_deg: f64,
@@ -267,6 +274,10 @@ fn plan_surface(
         // issue 7's 1 µm.
         settings.gouge.depth_tolerance = 0.5 * GOUGE_LIMIT_MM;
     }
+    // The other faces are kept clear to within the tolerance the motion runs at: where they
+    // meet the face at a crease a few µm deep (the lofted blade's), cutting the face to its
+    // edge reaches that far into them.
+    settings.gouge.neighbour_depth_tolerance = request.neighbour_tolerance_mm;
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
     let count = |what: Refusal| plan.refused.iter().filter(|r| r.refusal == what).count();
@@ -420,6 +431,10 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         strategy,
         scallop_mm: scallop,
         tolerance_mm: shares.chord,
+        neighbour_tolerance_mm: match args.check_tolerance {
+            Some(t) => positive("--check-tolerance", t)?,
+            None => tolerance,
+        },
         band: Some(shares.band()),
         lead_deg: args.lead_deg,
         tilt_deg: args.tilt_deg,

@@ -63,6 +63,11 @@ pub struct GougeSettings {
     pub global_spacing: f64,
     /// Penetration below which a surface point does not count as a rear gouge (mm).
     pub depth_tolerance: f64,
+    /// The same for the part's other faces ([`CheckFace`]): a CAD model's faces meet only to
+    /// within its modelling accuracy (the lofted blade's pieces overlap by up to 2.6 µm along
+    /// their shared edges), so a cutter at the machined face's edge may reach that far into
+    /// the face beside it without cutting anything the model means.
+    pub neighbour_depth_tolerance: f64,
     pub rear: bool,
     pub global: bool,
 }
@@ -73,6 +78,7 @@ impl Default for GougeSettings {
             rear_spacing: 0.3,
             global_spacing: 1.0,
             depth_tolerance: 0.002,
+            neighbour_depth_tolerance: 0.002,
             rear: true,
             global: true,
         }
@@ -84,8 +90,8 @@ impl Default for GougeSettings {
 pub struct GougeChecker {
     cutter: Cutter,
     settings: GougeSettings,
-    /// One rear index per face.
-    fine: Vec<rear::RearIndex>,
+    /// One rear index per face, with its depth tolerance.
+    fine: Vec<(rear::RearIndex, f64)>,
     /// The samples of every face inside its trim, together.
     coarse: Option<PointGrid>,
 }
@@ -100,7 +106,8 @@ impl GougeChecker {
         GougeChecker::of_faces(&[(surface, None)], cutter, settings)
     }
 
-    /// Samples and indexes `faces` (each a surface and its trim, if any) for `cutter`.
+    /// Samples and indexes `faces` (each a surface and its trim, if any) for `cutter`: the
+    /// machined face first, then the part's other faces.
     pub fn of_faces(
         faces: &[(&NurbsSurface, Option<&FaceRegion>)],
         cutter: &Cutter,
@@ -109,6 +116,10 @@ impl GougeChecker {
         positive("gouge rear_spacing", settings.rear_spacing)?;
         positive("gouge global_spacing", settings.global_spacing)?;
         positive("gouge depth_tolerance", settings.depth_tolerance)?;
+        positive(
+            "gouge neighbour_depth_tolerance",
+            settings.neighbour_depth_tolerance,
+        )?;
         let r = cutter.shape.radius();
         let sample = |surface, spacing| {
             index::sample_surface(surface, spacing).ok_or(CamError::TooLarge {
@@ -118,9 +129,17 @@ impl GougeChecker {
         };
         let mut fine = Vec::new();
         if settings.rear {
-            for &(surface, region) in faces {
+            for (k, &(surface, region)) in faces.iter().enumerate() {
                 let samples = sample(surface, settings.rear_spacing)?;
-                fine.push(rear::RearIndex::within(surface, region, samples, 2.0 * r));
+                let tolerance = if k == 0 {
+                    settings.depth_tolerance
+                } else {
+                    settings.neighbour_depth_tolerance
+                };
+                fine.push((
+                    rear::RearIndex::within(surface, region, samples, 2.0 * r),
+                    tolerance,
+                ));
             }
         }
         let coarse = if settings.global {
@@ -165,12 +184,10 @@ impl GougeChecker {
     /// pose of it ([`rear::RearIndex::first_penetration_along`]), the global check (shank and
     /// holder, which keep a clearance of the global spacing) at its middle.
     pub fn check_sweep(&self, sweep: &sweep::Sweep) -> Option<Gouge> {
-        for index in &self.fine {
-            if let Some(rear::Penetration { depth, point, .. }) = index.first_penetration_along(
-                &self.cutter.shape,
-                sweep,
-                self.settings.depth_tolerance,
-            ) {
+        for (index, tolerance) in &self.fine {
+            if let Some(rear::Penetration { depth, point, .. }) =
+                index.first_penetration_along(&self.cutter.shape, sweep, *tolerance)
+            {
                 return Some(Gouge::Interference {
                     part: ToolPart::CuttingEnd,
                     depth,
