@@ -7,6 +7,8 @@
 
 use tezgah_geom::NurbsSurface;
 
+use crate::region::FaceRegion;
+
 use crate::error::CamError;
 
 /// Metric end-mill diameters (mm) offered by default.
@@ -31,20 +33,31 @@ pub struct Proposal {
 
 /// The smallest concave radius (mm) of the surface seen from the side its normal points to
 /// (reversed with `reverse_normal`): `1/κ₁` maximised over a `lattice × lattice` grid of
-/// parameters. `None` where the surface is nowhere concave.
+/// parameters — over the face's region's box and inside it on a trimmed face, so a tight place
+/// of the surface beyond the trim does not shrink the tool. `None` where it is nowhere concave.
 pub fn tightest_concave_radius(
     surface: &NurbsSurface,
+    region: Option<&FaceRegion>,
     lattice: usize,
     reverse_normal: bool,
 ) -> Option<f64> {
-    let (u0, u1) = surface.domain_u();
-    let (v0, v1) = surface.domain_v();
+    let ((u0, u1), (v0, v1)) = match region {
+        Some(r) => {
+            let ((a, b), (c, d)) = r.bounds();
+            let (du, dv) = (surface.domain_u(), surface.domain_v());
+            ((a.max(du.0), b.min(du.1)), (c.max(dv.0), d.min(dv.1)))
+        }
+        None => (surface.domain_u(), surface.domain_v()),
+    };
     let n = lattice.max(2);
     let mut worst = 0.0f64;
     for i in 0..=n {
         for j in 0..=n {
             let u = u0 + (u1 - u0) * i as f64 / n as f64;
             let v = v0 + (v1 - v0) * j as f64 / n as f64;
+            if region.is_some_and(|r| !r.contains(u, v)) {
+                continue;
+            }
             if let Some(pc) = surface.principal_curvatures(u, v) {
                 let k = if reverse_normal { -pc.k2 } else { pc.k1 };
                 worst = worst.max(k);
@@ -162,22 +175,35 @@ mod tests {
     #[test]
     fn tightest_radius_of_known_surfaces() {
         // Inside a trough of radius 20 every point is concave 1/20 across it.
-        let r = tightest_concave_radius(&testing::cylinder(20.0, 50.0, false), 8, false).unwrap();
+        let r =
+            tightest_concave_radius(&testing::cylinder(20.0, 50.0, false), None, 8, false).unwrap();
         assert!((r - 20.0).abs() < 1e-9, "{r}");
         // The roller is convex: nothing concave, unless machined from inside.
         assert_eq!(
-            tightest_concave_radius(&testing::cylinder(20.0, 50.0, true), 8, false),
+            tightest_concave_radius(&testing::cylinder(20.0, 50.0, true), None, 8, false),
             None
         );
-        let r = tightest_concave_radius(&testing::sphere(30.0), 8, true).unwrap();
+        let r = tightest_concave_radius(&testing::sphere(30.0), None, 8, true).unwrap();
         assert!((r - 30.0).abs() < 1e-9, "{r}");
         // Saddle z = (x² − y²)/80 over [−50, 50]²: the sharpest concave curvature is at the
         // centre along x, 1/40.
-        let r = tightest_concave_radius(&testing::saddle(50.0, 40.0), 10, false).unwrap();
+        let r = tightest_concave_radius(&testing::saddle(50.0, 40.0), None, 10, false).unwrap();
         assert!((r - 40.0).abs() < 1e-9, "{r}");
         let p = propose(Some(r), &STANDARD_DIAMETERS, 20.0).unwrap();
         assert_eq!(p.ball, Some(32.0));
         assert_eq!(p.flat.unwrap().diameter, 25.0);
         assert!(propose(Some(r), &[], 20.0).is_err());
+    }
+
+    #[test]
+    fn a_trimmed_face_is_sized_on_itself_not_its_surface() {
+        // The saddle trimmed to x ∈ [30, 50] (u ∈ [0.8, 1]): the centre's radius 40 is beyond
+        // the trim; the tightest place left is the trim's middle (30, 0), where the section
+        // z = x²/80 has radius 40·(1 + (30/40)²)^{3/2} = 78.125.
+        let saddle = testing::saddle(50.0, 40.0);
+        let strip =
+            FaceRegion::new(vec![vec![(0.8, 0.0), (1.0, 0.0), (1.0, 1.0), (0.8, 1.0)]]).unwrap();
+        let r = tightest_concave_radius(&saddle, Some(&strip), 10, false).unwrap();
+        assert!((r - 78.125).abs() < 1e-9, "{r}");
     }
 }

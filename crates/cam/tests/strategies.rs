@@ -827,3 +827,57 @@ fn a_bull_nose_turns_about_the_sphere_pole_under_a_lead() {
     assert!(v.max_scallop_mm - v.sweep_bound_mm <= h, "{v:?}");
     assert!(v.gouge_depth_mm <= 0.001, "{v:?}");
 }
+
+#[test]
+fn a_trimmed_face_is_stepped_for_itself_not_for_its_surface() {
+    // The saddle z = (x² − y²)/80 fed along x, stepped along v (y = −50 + 100 v): the
+    // constant parametric step is narrowest at y = ±50, where the surface is steepest across
+    // the feed and a step of v spans 1.6 times the millimetres it does in the middle. Trimmed
+    // to y ∈ [−10, 10] (v ∈ [0.4, 0.6]) the face holds no such place, so its step is wider
+    // (≈ 1.5×), and the cut still holds the target on the face (simulated within it).
+    use tezgah_cam::region::FaceRegion;
+    use tezgah_cam::verify::{path_poses, simulate_on, MachinedRegion, VerifyOptions};
+    let s = testing::saddle(50.0, 40.0);
+    let h = 0.05;
+    let shares = tezgah_cam::ToleranceShares::of(0.01);
+    let mut settings = Settings::new(StrategyKind::ZigZag, h, shares.chord);
+    settings.band = Some(shares.band());
+    settings.gouge.depth_tolerance = 0.0005;
+    settings.direction = FeedDirection::AlongU;
+    let whole = iso_parametric_side_step(&s, &ball(6.0), &settings).unwrap();
+    let strip =
+        FaceRegion::new(vec![vec![(0.0, 0.4), (1.0, 0.4), (1.0, 0.6), (0.0, 0.6)]]).unwrap();
+    settings.region = Some(strip.clone());
+    let trimmed = iso_parametric_side_step(&s, &ball(6.0), &settings).unwrap();
+    eprintln!("parametric step: surface {whole}, face {trimmed}");
+    assert!(trimmed > 1.2 * whole, "{trimmed} vs {whole}");
+    let p = plan(&s, &ball(6.0), &settings).unwrap();
+    assert!(p.refused.iter().all(|r| r.refusal == Refusal::OutsideFace));
+    // Every pass on the face: none spent outside it.
+    for q in &p.path.passes {
+        assert!(
+            q.points
+                .iter()
+                .all(|c| (0.4 - 1e-9..=0.6 + 1e-9).contains(&c.uv.1)),
+            "{:?}",
+            q.points[0]
+        );
+    }
+    let options = VerifyOptions {
+        cell_mm: 0.1,
+        sweep_spacing_mm: 0.1,
+        region: MachinedRegion::ContactBox,
+    };
+    let v = simulate_on(
+        &s,
+        &p.path,
+        &path_poses(&p.path, 0.1),
+        &options,
+        Some(&strip),
+    )
+    .unwrap();
+    assert_eq!(v.uncut, 0, "{v:?}");
+    assert!(v.max_scallop_mm - v.sweep_bound_mm <= h, "{v:?}");
+    assert!(v.max_scallop_mm > 0.6 * h, "{v:?}");
+    assert!(v.gouge_depth_mm <= 0.001, "{v:?}");
+}

@@ -3,6 +3,8 @@
 //! 001 §2.9 sizes it at the point of tightest convex radius only; here, as its digest
 //! recommends, the step is the minimum over a lattice of the whole surface of the local
 //! allowed step `ω / |S_s · t|` (the side step's component across the feed per unit parameter).
+//! On a trimmed face the lattice and the passes cover the face's box, and only lattice points
+//! on the face count: a tight place of the surface beyond the trim does not narrow the step.
 
 use rayon::prelude::*;
 
@@ -28,14 +30,45 @@ pub fn iso_parametric_side_step(
     side_step(&ctx)
 }
 
-fn side_step(ctx: &Context) -> Result<f64, CamError> {
+/// The (side, feed) ranges the passes cover: the domain's, or on a trimmed face the part of
+/// them its region's box spans.
+fn face_box(ctx: &Context) -> ((f64, f64), (f64, f64)) {
     let Axes { side, feed, .. } = ctx.axes;
+    let Some(region) = &ctx.settings.region else {
+        return (side, feed);
+    };
+    let (ur, vr) = region.bounds();
+    let (sr, fr) = if ctx.axes.along_v { (ur, vr) } else { (vr, ur) };
+    let clip = |(lo, hi): (f64, f64), (a, b): (f64, f64)| {
+        let (l, h) = (lo.max(a), hi.min(b));
+        if l < h {
+            (l, h)
+        } else {
+            (lo, hi)
+        }
+    };
+    (clip(side, sr), clip(feed, fr))
+}
+
+/// True when the contact at (u, v) is on the face (always on an untrimmed one).
+fn on_face(ctx: &Context, (u, v): (f64, f64)) -> bool {
+    ctx.settings
+        .region
+        .as_ref()
+        .is_none_or(|r| r.contains(u, v))
+}
+
+fn side_step(ctx: &Context) -> Result<f64, CamError> {
+    let (side, feed) = face_box(ctx);
     let mut best = side.1 - side.0;
     for i in 0..=LATTICE {
         let s = side.0 + (side.1 - side.0) * i as f64 / LATTICE as f64;
         for j in 0..=LATTICE {
             let f = feed.0 + (feed.1 - feed.0) * j as f64 / LATTICE as f64;
             let (u, v) = ctx.axes.uv(s, f);
+            if !on_face(ctx, (u, v)) {
+                continue;
+            }
             let tangent = ctx.axes.uv(0.0, 1.0);
             let Some(local) = ctx.local(u, v, tangent) else {
                 continue;
@@ -62,12 +95,15 @@ fn side_step(ctx: &Context) -> Result<f64, CamError> {
 /// (`true_cusp`), fits the target at every lattice point: the worst place of a constant step
 /// is where the model's osculating circle departs most from the surface across it.
 fn true_surface_step(ctx: &Context, step: f64) -> f64 {
-    let Axes { side, feed, .. } = ctx.axes;
+    let (side, feed) = face_box(ctx);
     let tangent = ctx.axes.uv(0.0, 1.0);
     let allowed = |s: f64, f: f64| -> f64 {
+        if !on_face(ctx, ctx.axes.uv(s, f)) {
+            return step;
+        }
         let fits = |d: f64| {
             let s2 = s + d;
-            if s2 > side.1 {
+            if s2 > side.1 || !on_face(ctx, ctx.axes.uv(s2, f)) {
                 return true;
             }
             ctx.cusp_fits(ctx.axes.uv(s, f), ctx.axes.uv(s2, f), tangent)
@@ -99,11 +135,8 @@ fn true_surface_step(ctx: &Context, step: f64) -> f64 {
 
 /// The passes: iso lines at `side.0 + k·Δ`, `k = 0..=n`, `n = ⌈range / Δs⌉`, in order.
 pub(super) fn passes(ctx: &Context) -> Result<Vec<PassPath>, CamError> {
-    let Axes {
-        side,
-        feed,
-        along_v,
-    } = ctx.axes;
+    let along_v = ctx.axes.along_v;
+    let (side, feed) = face_box(ctx);
     let step = side_step(ctx)?;
     let range = side.1 - side.0;
     let count = (range / step).ceil();
