@@ -1,8 +1,8 @@
 //! The part's other faces in the gouge checks (`Settings::neighbours`): a floor cut up to the
 //! shoulder that stands on its edge, and the trim of a neighbouring face (its surface beyond
-//! the trim is not the part and must not refuse anything). The shoulder is 5 mm high, within
-//! the two tool radii the rear check covers exactly; above them the flutes, shank and holder
-//! keep the global check's clearance.
+//! the trim is not the part and must not refuse anything). The wall is 20 mm high: the
+//! flutes and shank beside it are checked as exactly as the cutting end (a 1 mm clearance
+//! there stopped every pass at x = 46).
 
 use nalgebra::Unit;
 use tezgah_cam::gouge::rear::penetration;
@@ -20,8 +20,7 @@ fn quad(a: Vec3, b: Vec3, c: Vec3, d: Vec3) -> NurbsSurface {
     NurbsSurface::bspline(1, 1, &[a, b, c, d], knots.clone(), knots).unwrap()
 }
 
-/// The floor `[0, 50]² × {0}` (normal +z) and the shoulder's wall `x = 50`, 5 mm high, on
-/// its edge.
+/// The floor `[0, 50]² × {0}` (normal +z) and the wall `x = 50`, 20 mm high, on its edge.
 fn floor_and_wall() -> (NurbsSurface, NurbsSurface) {
     let floor = quad(
         Vec3::new(0.0, 0.0, 0.0),
@@ -32,8 +31,8 @@ fn floor_and_wall() -> (NurbsSurface, NurbsSurface) {
     let wall = quad(
         Vec3::new(50.0, 0.0, 0.0),
         Vec3::new(50.0, 50.0, 0.0),
-        Vec3::new(50.0, 0.0, 5.0),
-        Vec3::new(50.0, 50.0, 5.0),
+        Vec3::new(50.0, 0.0, 20.0),
+        Vec3::new(50.0, 50.0, 20.0),
     );
     (floor, wall)
 }
@@ -111,7 +110,7 @@ fn a_neighbour_counts_only_inside_its_trim() {
     if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
         *max_lead_deg = 0.0;
     }
-    // The wall's (u, v): u up the wall (z / 5), v along it (y / 50).
+    // The wall's (u, v): u up the wall (z / 20), v along it (y / 50).
     let region =
         FaceRegion::new(vec![vec![(0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.0, 0.4)]]).unwrap();
     settings.neighbours = vec![CheckFace {

@@ -6,7 +6,7 @@ use nalgebra::Unit;
 use tezgah_geom::Vec3;
 
 use super::index::PointGrid;
-use super::rear::CUTTING_END_RADII;
+use super::rear::checked_height;
 use super::ToolPart;
 use crate::cutter::{Cutter, Cylinder};
 
@@ -19,10 +19,11 @@ pub struct Collision {
     pub point: Vec3,
 }
 
-/// The tool's non-cutting-end cylinders, each with its part.
+/// The tool's cylinders above what the rear check covers ([`checked_height`]), each with
+/// its part.
 pub fn cylinders(cutter: &Cutter) -> Vec<(ToolPart, Cylinder)> {
     let big_r = cutter.shape.radius();
-    let end = CUTTING_END_RADII * big_r;
+    let end = checked_height(cutter);
     let mut parts = Vec::new();
     if cutter.flute_length > end {
         parts.push((
@@ -38,9 +39,11 @@ pub fn cylinders(cutter: &Cutter) -> Vec<(ToolPart, Cylinder)> {
         (ToolPart::Shank, cutter.shank),
         (ToolPart::Holder, cutter.holder),
     ] {
-        // Whole, even where it overlaps the checked cutting end: a holder wider than the
+        // A shank of the tool's radius within the checked solid is covered exactly there.
+        let covered = c.radius <= big_r && c.from + c.length <= end;
+        // Otherwise whole, even where it overlaps the checked solid: a holder wider than the
         // tool can sit lower than two radii on a stubby tool.
-        if c.length > 0.0 && c.radius > 0.0 {
+        if c.length > 0.0 && c.radius > 0.0 && !covered {
             parts.push((part, c));
         }
     }

@@ -1,6 +1,7 @@
 //! Gouge checks for a placed cutter: local (curvature interference at the contact), rear
-//! (the whole cutting end against the surface, through a spatial index of surface samples)
-//! and global (flutes above the cutting end, shank and holder against the surface). The
+//! (the cutting end, the flutes and a shank of the tool's radius against the surface, exact
+//! to the tolerance through a spatial index of surface samples) and global (a shank of
+//! another radius and the holder against the surface, with a clearance). The
 //! strategies call [`GougeChecker::check`] for every cutter location and correct the tool
 //! axis or report the point; nothing gouging is emitted silently. The checks run against the
 //! machined face and any other faces of the part given ([`CheckFace`]), each only inside its
@@ -174,6 +175,17 @@ impl GougeChecker {
         })
     }
 
+    /// The part of the tool `z` mm above its tip, within the rear check's solid.
+    fn part_at(&self, z: f64) -> ToolPart {
+        if z <= rear::CUTTING_END_RADII * self.cutter.shape.radius() {
+            ToolPart::CuttingEnd
+        } else if z <= self.cutter.flute_length {
+            ToolPart::Flutes
+        } else {
+            ToolPart::Shank
+        }
+    }
+
     /// Rear and global checks of the cutter standing at `tip` along `axis` (the local check
     /// needs the contact's curvature and lives in [`local`]).
     pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {
@@ -184,12 +196,14 @@ impl GougeChecker {
     /// pose of it ([`rear::RearIndex::first_penetration_along`]), the global check (shank and
     /// holder, which keep a clearance of the global spacing) at its middle.
     pub fn check_sweep(&self, sweep: &sweep::Sweep) -> Option<Gouge> {
+        let height = rear::checked_height(&self.cutter);
         for (index, tolerance) in &self.fine {
-            if let Some(rear::Penetration { depth, point, .. }) =
-                index.first_penetration_along(&self.cutter.shape, sweep, *tolerance)
+            if let Some(rear::Penetration { depth, point, at }) =
+                index.first_penetration_within(&self.cutter.shape, height, sweep, *tolerance)
             {
+                let (tip, axis) = sweep.pose(at);
                 return Some(Gouge::Interference {
-                    part: ToolPart::CuttingEnd,
+                    part: self.part_at((point - tip).dot(&axis)),
                     depth,
                     point,
                 });

@@ -28,8 +28,24 @@ use super::sweep::Sweep;
 use crate::cutter::CutterShape;
 use crate::region::{FaceRegion, RectSide};
 
-/// Height of the checked cutting end above the tip, in tool radii.
+/// Height of the checked cutting end above the tip, in tool radii, at least: the flutes and a
+/// shank of the tool's radius above it are checked with it when the cutter has them
+/// ([`checked_height`]).
 pub const CUTTING_END_RADII: f64 = 2.0;
+
+/// How high above the tip the rear check's solid reaches for `cutter`: the cutting end's two
+/// radii, the flutes (the same radius) and a shank of that radius standing on them — one
+/// convex solid of revolution, checked to the tolerance; a narrower or wider shank and the
+/// holder are the global check's.
+pub fn checked_height(cutter: &crate::cutter::Cutter) -> f64 {
+    let big_r = cutter.shape.radius();
+    let mut height = (CUTTING_END_RADII * big_r).max(cutter.flute_length);
+    let shank = cutter.shank;
+    if shank.length > 0.0 && (shank.radius - big_r).abs() <= 1e-9 && shank.from <= height {
+        height = height.max(shank.from + shank.length);
+    }
+    height
+}
 
 /// Cells are split until their cover falls to this fraction of the tolerance: what the bound
 /// then leaves unproven is below it (`|g_t| ≤ 1`), so the check holds to `1.25 × tolerance`.
@@ -55,6 +71,17 @@ pub struct Depth {
 /// concave) above it. Flat:
 /// `min(z, R − ρ)` inside; torus: `r − |(ρ, z) − (R − r, r)|`; ball: `R − |p − centre|`.
 pub fn depth(shape: &CutterShape, tip: &Vec3, axis: &Unit<Vec3>, p: &Vec3) -> Depth {
+    depth_to(shape, CUTTING_END_RADII * shape.radius(), tip, axis, p)
+}
+
+/// [`depth`] in the solid cut off at `height` above the tip instead of two radii.
+pub fn depth_to(
+    shape: &CutterShape,
+    height: f64,
+    tip: &Vec3,
+    axis: &Unit<Vec3>,
+    p: &Vec3,
+) -> Depth {
     let (big_r, r) = (shape.radius(), shape.corner_radius());
     let a = axis.into_inner();
     let d = p - tip;
@@ -87,7 +114,7 @@ pub fn depth(shape: &CutterShape, tip: &Vec3, axis: &Unit<Vec3>, p: &Vec3) -> De
         (dist, (radial * er - a * ez) / dist)
     };
     let (depth, gradient) = (r - sd, -grad_sd);
-    let top = CUTTING_END_RADII * big_r - z;
+    let top = height - z;
     if top < depth {
         Depth {
             depth: top,
@@ -300,11 +327,24 @@ impl RearIndex {
         sweep: &Sweep,
         tolerance: f64,
     ) -> Option<Penetration> {
+        self.first_penetration_within(shape, CUTTING_END_RADII * shape.radius(), sweep, tolerance)
+    }
+
+    /// [`RearIndex::first_penetration_along`] for the solid reaching `height` above the tip
+    /// ([`checked_height`]).
+    pub fn first_penetration_within(
+        &self,
+        shape: &CutterShape,
+        height: f64,
+        sweep: &Sweep,
+        tolerance: f64,
+    ) -> Option<Penetration> {
         let big_r = shape.radius();
-        let (lo, hi) = sweep.bounding_box(CUTTING_END_RADII * big_r, big_r);
+        let (lo, hi) = sweep.bounding_box(height, big_r);
         let search = Search {
             index: self,
             shape,
+            height,
             sweep,
             tolerance,
         };
@@ -397,6 +437,8 @@ impl Span {
 struct Search<'a> {
     index: &'a RearIndex,
     shape: &'a CutterShape,
+    /// Top of the checked solid above the tip.
+    height: f64,
     sweep: &'a Sweep,
     tolerance: f64,
 }
@@ -408,7 +450,7 @@ impl Search<'_> {
             return None;
         }
         let (tip, axis, h) = (span.tip, span.axis, 0.5 * (span.s1 - span.s0));
-        let d = depth(self.shape, &tip, &axis, &patch.point);
+        let d = depth_to(self.shape, self.height, &tip, &axis, &patch.point);
         let cover = patch.reach.cover();
         // A point outside the face, in a cell across its trim: the face's part of the cell
         // lies within the cover of it, and the depth changes by at most the distance.
@@ -528,6 +570,26 @@ mod tests {
         } else {
             -dist
         }
+    }
+
+    #[test]
+    fn the_checked_solid_reaches_up_the_flutes_and_a_shank_of_the_same_radius() {
+        // Standard D6: flutes to 18 mm, shank r 3 from 18 to 30 — one cylinder to 30 mm.
+        let ball = crate::cutter::Cutter::standard(CutterShape::Ball { radius: 3.0 });
+        assert_eq!(checked_height(&ball), 30.0);
+        // A wall beside the tool 20 mm up: inside the checked solid by 0.5 mm at the shank.
+        let (tip, z) = (Vec3::zeros(), Unit::new_unchecked(Vec3::z()));
+        let p = Vec3::new(2.5, 0.0, 20.0);
+        assert!((depth_to(&ball.shape, 30.0, &tip, &z, &p).depth - 0.5).abs() < 1e-12);
+        assert!(depth(&ball.shape, &tip, &z, &p).depth < 0.0);
+        // A thinner shank stays the global check's: the solid ends with the flutes.
+        let mut thin = ball;
+        thin.shank.radius = 2.0;
+        assert_eq!(checked_height(&thin), 18.0);
+        // Stubby flutes below two radii: the cutting end's height.
+        let mut stub = thin;
+        stub.flute_length = 4.0;
+        assert_eq!(checked_height(&stub), 6.0);
     }
 
     fn shapes() -> [CutterShape; 3] {
