@@ -340,7 +340,6 @@ impl RearIndex {
         tolerance: f64,
     ) -> Option<Penetration> {
         let big_r = shape.radius();
-        let (lo, hi) = sweep.bounding_box(height, big_r);
         let search = Search {
             index: self,
             shape,
@@ -350,29 +349,38 @@ impl RearIndex {
         };
         let whole = Span::new(sweep, 0.0, 1.0, 0);
         let mut hit = None;
-        self.grid.visit_box(&lo, &hi, |s| {
-            let (uv, side) = match &self.region {
-                None => (None, RectSide::Inside),
-                Some(r) => (
-                    Some((
-                        self.lines.u[s.node[0] as usize],
-                        self.lines.v[s.node[1] as usize],
-                    )),
-                    r.classify(self.lines.cell(s.node)),
-                ),
-            };
-            let patch = Patch {
-                point: s.point,
-                normal: s.normal,
-                reach: s.reach,
-                cell: None,
-                level: 0,
-                uv,
-                side,
-            };
-            hit = search.examine(&patch, s.node, &whole);
-            hit.is_none()
-        });
+        // The solid in pieces of two radii up the axis, each with its own box: a tall solid
+        // on a leaning axis has a box far wider than the samples it can reach.
+        let piece = CUTTING_END_RADII * big_r;
+        let mut z0 = 0.0;
+        while z0 < height && hit.is_none() {
+            let z1 = (z0 + piece).min(height);
+            let (lo, hi) = sweep.bounding_box_between(z0, z1, big_r);
+            self.grid.visit_box(&lo, &hi, |s| {
+                let (uv, side) = match &self.region {
+                    None => (None, RectSide::Inside),
+                    Some(r) => (
+                        Some((
+                            self.lines.u[s.node[0] as usize],
+                            self.lines.v[s.node[1] as usize],
+                        )),
+                        r.classify(self.lines.cell(s.node)),
+                    ),
+                };
+                let patch = Patch {
+                    point: s.point,
+                    normal: s.normal,
+                    reach: s.reach,
+                    cell: None,
+                    level: 0,
+                    uv,
+                    side,
+                };
+                hit = search.examine(&patch, s.node, &whole);
+                hit.is_none()
+            });
+            z0 = z1;
+        }
         hit
     }
 }

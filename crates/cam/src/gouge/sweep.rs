@@ -62,12 +62,18 @@ impl Sweep {
     /// up the axis, at every pose of the sweep: the ends' boxes, grown by how far the axis's
     /// arc strays from its chord (at most the turn, per unit of height).
     pub fn bounding_box(&self, height: f64, margin: f64) -> (Vec3, Vec3) {
-        let grow = Vec3::repeat(margin + height * self.turn);
+        self.bounding_box_between(0.0, height, margin)
+    }
+
+    /// [`Sweep::bounding_box`] of the piece of the axis from `z0` to `z1` above the tip.
+    pub fn bounding_box_between(&self, z0: f64, z1: f64, margin: f64) -> (Vec3, Vec3) {
+        let grow = Vec3::repeat(margin + z1.abs().max(z0.abs()) * self.turn);
+        let (a, b) = (self.axis_from.into_inner(), self.axis_to.into_inner());
         let ends = [
-            self.from,
-            self.from + self.axis_from.into_inner() * height,
-            self.from + self.step,
-            self.from + self.step + self.axis_to.into_inner() * height,
+            self.from + a * z0,
+            self.from + a * z1,
+            self.from + self.step + b * z0,
+            self.from + self.step + b * z1,
         ];
         let (lo, hi) = ends[1..]
             .iter()
