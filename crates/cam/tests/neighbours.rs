@@ -144,3 +144,53 @@ fn a_neighbour_counts_only_inside_its_trim() {
     assert!(stopped > 0 && stopped < p.path.passes.len());
     assert!(p.refused.iter().all(|r| r.refusal != Refusal::OutsideFace));
 }
+
+#[test]
+fn the_simulated_cut_measures_how_deep_the_tool_went_into_a_neighbour() {
+    // The verification's view of the same two plans: the cut simulated over the wall (its
+    // outside −x) measures the 3 mm the ball stood in it when the floor was planned alone,
+    // and nothing beyond the depth tolerance when the wall was kept out of the tool's way.
+    use tezgah_cam::verify::VerifyOptions;
+    use tezgah_cam::verify::{path_poses, simulate_neighbour, Bounding, MachinedRegion};
+    let (floor, wall) = floor_and_wall();
+    let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
+        *max_lead_deg = 0.0;
+    }
+    let options = VerifyOptions {
+        cell_mm: 0.2,
+        sweep_spacing_mm: 0.05,
+        region: MachinedRegion::ContactBox,
+    };
+    // The wall's S_u × S_v: up (+z) × along (+y) = −x, its outside (the floor's side).
+    let neighbour = Bounding {
+        surface: &wall,
+        outward_is_su_x_sv: true,
+        face: None,
+        margin: 0.0,
+    };
+    let machined = Bounding {
+        surface: &floor,
+        outward_is_su_x_sv: true,
+        face: None,
+        margin: 0.001,
+    };
+    let deepest = |p: &Plan| {
+        let poses = path_poses(&p.path, 0.05);
+        simulate_neighbour(neighbour, machined, &p.path, &poses, &options)
+            .unwrap()
+            .expect("the tool comes near the wall")
+            .gouge_depth_mm
+    };
+    let alone = plan(&floor, &cutter, &settings).unwrap();
+    let cut = deepest(&alone);
+    assert!((cut - 3.0).abs() < 1e-6, "{cut}");
+    settings.neighbours = vec![CheckFace {
+        surface: wall.clone(),
+        region: None,
+    }];
+    let kept = deepest(&plan(&floor, &cutter, &settings).unwrap());
+    assert!(kept <= settings.gouge.neighbour_depth_tolerance, "{kept}");
+}

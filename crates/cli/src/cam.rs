@@ -14,7 +14,7 @@ use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_
 use tezgah_cam::{
     Band, CheckFace, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
 };
-use tezgah_geom::NurbsSurface;
+use tezgah_geom::{NurbsSurface, Vec3};
 use tezgah_kinematics::{Kinematics, Machine};
 
 use crate::cam_tool::{self, ToolSpec};
@@ -187,6 +187,10 @@ struct Planned {
     /// How far the normal may lean from +Z where the path machines the face: the tilt limit
     /// less the cutter's nominal lean (`Settings::reach_normal_tilt_deg`).
     reach_normal_tilt_deg: f64,
+    /// The part's other faces.
+    neighbours: Vec<NeighbourFace>,
+    /// The face's outside is the side `S_u × S_v` points to.
+    outward_is_su_x_sv: bool,
 }
 
 /// The face of a STEP file to machine, the part's other faces (kept out of the cutter's way)
@@ -211,10 +215,19 @@ fn read_face(path: &Path, id: Option<u64>) -> Result<PartFaces> {
     Ok(PartFaces { face, others, part })
 }
 
+/// Another face of the part: its `#id`, which side is its outside, and its surface within its
+/// trim as the gouge checks and the verification see it.
+#[derive(Debug, Clone)]
+pub struct NeighbourFace {
+    pub id: u64,
+    pub outward_is_su_x_sv: bool,
+    pub check: CheckFace,
+}
+
 /// The part's other faces as the gouge checks see them: each surface within its trim. A face
 /// whose trim cannot be followed is checked whole (more than the face: it can only refuse
 /// more), with a note.
-fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<CheckFace> {
+fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<NeighbourFace> {
     others
         .into_iter()
         .map(|f| {
@@ -227,9 +240,13 @@ fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<CheckFac
                 );
                 None
             });
-            CheckFace {
-                surface: f.surface,
-                region,
+            NeighbourFace {
+                id: f.id,
+                outward_is_su_x_sv: f.same_sense,
+                check: CheckFace {
+                    surface: f.surface,
+                    region,
+                },
             }
         })
         .collect()
@@ -262,7 +279,8 @@ fn plan_surface(
     settings.region = face
         .uv_region(0.25 * request.tolerance_mm)
         .map_err(|e| miette!("{}: {e}", path.display()))?;
-    settings.neighbours = neighbours(path, others, request.tolerance_mm);
+    let neighbours = neighbours(path, others, request.tolerance_mm);
+    settings.neighbours = neighbours.iter().map(|n| n.check.clone()).collect();
     if !settings.neighbours.is_empty() {
         eprintln!(
             "note: the tool is kept out of the part's {} other faces too",
@@ -328,6 +346,8 @@ fn plan_surface(
             .reach_normal_tilt_deg(&cutter.shape)
             .unwrap_or(request.max_tilt_deg),
         region: settings.region,
+        neighbours,
+        outward_is_su_x_sv: face.same_sense,
     })
 }
 
@@ -448,6 +468,8 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         direction,
         region: face_region,
         reach_normal_tilt_deg,
+        neighbours,
+        outward_is_su_x_sv,
     } = plan_surface(&args.surface, faces, cutter, &request)?;
     let options = PostOptions {
         form: if args.joints {
@@ -487,6 +509,14 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         Judged {
             region,
             face: face_region.as_ref(),
+            neighbours: &neighbours,
+            machined: verify::Bounding {
+                surface: &surface,
+                outward_is_su_x_sv,
+                face: face_region.as_ref(),
+                margin: request.neighbour_tolerance_mm,
+            },
+            check_tolerance_mm: request.neighbour_tolerance_mm,
         },
     )?;
     std::fs::write(&args.output, &done.posted.program)
@@ -525,6 +555,22 @@ pub struct Finished {
     pub posted: Posted,
     pub verification: Verification,
     pub step_over_mm: f64,
+    /// The same cut over the part's other faces where the tool comes near them.
+    pub neighbours: NeighbourCheck,
+}
+
+/// What the simulation found on the part's other faces.
+#[derive(Debug, Clone, Default)]
+pub struct NeighbourCheck {
+    /// Faces the tool came near (simulated).
+    pub simulated: usize,
+    /// Of all of them: the deepest cut into one, mm, the face's `#id` and where.
+    pub deepest_mm: f64,
+    pub deepest_on: Option<(u64, Vec3)>,
+    /// The largest grid bound among them, mm.
+    pub grid_bound_mm: f64,
+    /// How deep the tool may reach into them (`--check-tolerance`), mm.
+    pub limit_mm: f64,
 }
 
 impl Finished {
@@ -537,6 +583,7 @@ impl Finished {
         v.gouge_depth_mm <= GOUGE_LIMIT_MM
             && v.max_scallop_mm - v.sweep_bound_mm <= scallop
             && v.uncut == 0
+            && self.neighbours.deepest_mm <= self.neighbours.limit_mm
     }
 }
 
@@ -546,6 +593,11 @@ impl Finished {
 pub struct Judged<'a> {
     pub region: MachinedRegion,
     pub face: Option<&'a FaceRegion>,
+    /// The part's other faces: the cut is simulated over them too, for gouges only, their
+    /// dexels ending where the machined face bounds the material.
+    pub neighbours: &'a [NeighbourFace],
+    pub machined: verify::Bounding<'a>,
+    pub check_tolerance_mm: f64,
 }
 
 /// Post `path` and simulate the cut along the program as the machine moves it over `region`:
@@ -601,11 +653,54 @@ pub fn finish(
             other => break other.into_diagnostic()?,
         }
     };
+    let neighbours = check_neighbours(path, &poses, &verify_options, &judged)?;
     Ok(Finished {
         posted,
         verification,
         step_over_mm: step_over,
+        neighbours,
     })
+}
+
+/// The cut simulated over each of the part's other faces the tool comes near, at the face's
+/// verification cell (grown like it where a face's grid would not fit in memory).
+fn check_neighbours(
+    path: &ToolPath,
+    poses: &[verify::CutterPose],
+    options: &VerifyOptions,
+    judged: &Judged,
+) -> Result<NeighbourCheck> {
+    let mut out = NeighbourCheck {
+        limit_mm: judged.check_tolerance_mm,
+        ..NeighbourCheck::default()
+    };
+    for n in judged.neighbours {
+        let mut options = *options;
+        let mut tries = 0;
+        let found = loop {
+            let neighbour = verify::Bounding {
+                surface: &n.check.surface,
+                outward_is_su_x_sv: n.outward_is_su_x_sv,
+                face: n.check.region.as_ref(),
+                margin: 0.0,
+            };
+            match verify::simulate_neighbour(neighbour, judged.machined, path, poses, &options) {
+                Err(verify::VerifyError::TooFine(count)) if tries < 4 => {
+                    tries += 1;
+                    options.cell_mm *= (count as f64 / (0.95 * MAX_DEXELS as f64)).sqrt();
+                }
+                other => break other.into_diagnostic()?,
+            }
+        };
+        let Some(v) = found else { continue };
+        out.simulated += 1;
+        out.grid_bound_mm = out.grid_bound_mm.max(v.grid_bound_mm);
+        if v.gouge_depth_mm > out.deepest_mm {
+            out.deepest_mm = v.gouge_depth_mm;
+            out.deepest_on = v.gouge_at.map(|(_, p)| (n.id, p));
+        }
+    }
+    Ok(out)
 }
 
 fn report_json(
@@ -661,6 +756,14 @@ fn report_json(
             "sweep_bound_mm": v.sweep_bound_mm,
         },
         "gouge_limit_mm": GOUGE_LIMIT_MM,
+        "other_faces": {
+            "simulated": done.neighbours.simulated,
+            "deepest_gouge_mm": done.neighbours.deepest_mm,
+            "deepest_on_face": done.neighbours.deepest_on.map(|(id, _)| id),
+            "deepest_at": done.neighbours.deepest_on.map(|(_, p)| [p.x, p.y, p.z]),
+            "grid_bound_mm": done.neighbours.grid_bound_mm,
+            "limit_mm": done.neighbours.limit_mm,
+        },
         "planned_scallop_mm": scallop - args.tolerance,
         "verified": done.verified(scallop),
     })
@@ -707,6 +810,17 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64) {
         v.sweep_bound_mm,
         v.uncut
     );
+    let n = &done.neighbours;
+    if n.simulated > 0 {
+        println!(
+            "other faces: {} near the tool simulated, deepest cut into one {:.4} mm{} (limit {})",
+            n.simulated,
+            n.deepest_mm,
+            n.deepest_on
+                .map_or(String::new(), |(id, _)| format!(" on #{id}")),
+            n.limit_mm
+        );
+    }
     if !done.verified(scallop) {
         eprintln!("verification FAILED: the program is written but does not meet the targets");
     }
@@ -776,7 +890,18 @@ mod tests {
         let region = MachinedRegion::Reachable {
             max_tilt_deg: 120.0,
         };
-        let judged = Judged { region, face: None };
+        let judged = Judged {
+            region,
+            face: None,
+            neighbours: &[],
+            machined: verify::Bounding {
+                surface: &surface,
+                outward_is_su_x_sv: true,
+                face: None,
+                margin: 0.01,
+            },
+            check_tolerance_mm: 0.01,
+        };
         let done = finish(&surface, &path, &machine, &options, None, judged).unwrap();
         let v = &done.verification;
         // h = R − √(R² − (s/2)²) for R = 1.5, s = 1.

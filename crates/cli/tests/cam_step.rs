@@ -408,6 +408,12 @@ fn twisted_blade_face_is_machined_past_vertical_within_the_tilt_range() {
         ],
     );
     assert_meets_issue_7(&report, h, false);
+    // The simulated cut reaches into #876 at the crease near the tip, within the 0.1 mm
+    // allowed (the planner refused what went deeper).
+    let other = &report["other_faces"];
+    let into = f(other, "deepest_gouge_mm");
+    assert!(into > 0.01 && into <= 0.1, "{report}");
+    assert_eq!(other["deepest_on_face"], 876, "{report}");
     assert!(!stderr.contains("away from +Z"), "{stderr}");
     let (a_min, a_max) = tilt_range(&program);
     assert!(a_max > 90.0 && a_max <= 120.0, "A {a_min} … {a_max}");
@@ -571,5 +577,10 @@ fn a_fillet_of_a_block_is_machined_beside_its_neighbours_within_their_trims() {
     assert!(stderr.contains("part's 10 other faces"), "{stderr}");
     assert!(!stderr.contains("would gouge"), "{stderr}");
     assert_meets_issue_7(&report, h, false);
+    // The cut simulated over the faces beside the fillet (the top, the bottom and the two
+    // sides it rounds, at least) cuts none of them.
+    let other = &report["other_faces"];
+    assert!(other["simulated"].as_u64().unwrap() >= 4, "{report}");
+    assert!(f(other, "deepest_gouge_mm") <= 0.001, "{report}");
     check_and_run("fillet", None);
 }

@@ -121,6 +121,9 @@ struct Dexel {
     normal: Vec3,
     uv: (f64, f64),
     height: f64,
+    /// How deep below its foot it reaches into the material: the simulation's depth, less
+    /// where another face of the part bounds the material sooner along it.
+    floor: f64,
 }
 
 /// Poses along a tool path's passes as straight tip motion and great-circle axis motion
@@ -222,8 +225,6 @@ pub fn simulate_on(
     options: &VerifyOptions,
     face: Option<&FaceRegion>,
 ) -> Result<Verification, VerifyError> {
-    let cell = positive("the cell size", options.cell_mm)?;
-    let spacing = positive("the sweep spacing", options.sweep_spacing_mm)?;
     let cls: Vec<_> = path.passes.iter().flat_map(|p| &p.points).collect();
     let first = cls.first().ok_or(VerifyError::Empty)?;
     // Orient the normals out of the material as the path's first contact says.
@@ -264,6 +265,187 @@ pub fn simulate_on(
             b
         }
     };
+    let judging = Judging {
+        face,
+        flip,
+        min_normal_z,
+        uv_box: (u0, u1, v0, v1),
+        bounded_by: None,
+    };
+    simulate_over(surface, path, poses, options, &judging)
+}
+
+/// The same cut simulated over another face of the part (`neighbour`) where the tool comes
+/// near it, its dexels ending where the `machined` face bounds the material: the
+/// part of its domain whose points lie within the tool's reach of a pose (a lattice of
+/// [`REACH_SAMPLES`]² nodes, its box grown by one node). Only the gouge counts there (the
+/// program does not machine that face; what it leaves on it is no fault). `None` when the
+/// tool never comes near the face.
+pub fn simulate_neighbour(
+    neighbour: Bounding,
+    machined: Bounding,
+    path: &ToolPath,
+    poses: &[CutterPose],
+    options: &VerifyOptions,
+) -> Result<Option<Verification>, VerifyError> {
+    let Bounding {
+        surface,
+        outward_is_su_x_sv,
+        face,
+        ..
+    } = neighbour;
+    let r = path.cutter.shape.radius();
+    let height = crate::gouge::rear::checked_height(&path.cutter);
+    let mut lo = Vec3::repeat(f64::INFINITY);
+    let mut hi = Vec3::repeat(f64::NEG_INFINITY);
+    for p in poses {
+        for q in [p.tip, p.tip + p.axis * height] {
+            lo = lo.inf(&q);
+            hi = hi.sup(&q);
+        }
+    }
+    let (du, dv) = (surface.domain_u(), surface.domain_v());
+    let n = REACH_SAMPLES;
+    let at = |(a, b): (f64, f64), k: usize| a + (b - a) * k as f64 / n as f64;
+    let mut uv_box = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for i in 0..=n {
+        for j in 0..=n {
+            let (u, v) = (at(du, i), at(dv, j));
+            let d = surface.derivs(u, v);
+            // A node stands for the surface within a node's spacing of it.
+            let reach =
+                r + d.su.norm() * (du.1 - du.0) / n as f64 + d.sv.norm() * (dv.1 - dv.0) / n as f64;
+            let p = d.point;
+            if (0..3).all(|k| p[k] >= lo[k] - reach && p[k] <= hi[k] + reach) {
+                uv_box = (
+                    uv_box.0.min(at(du, i.saturating_sub(1))),
+                    uv_box.1.max(at(du, (i + 1).min(n))),
+                    uv_box.2.min(at(dv, j.saturating_sub(1))),
+                    uv_box.3.max(at(dv, (j + 1).min(n))),
+                );
+            }
+        }
+    }
+    if !(uv_box.0 < uv_box.1 && uv_box.2 < uv_box.3) {
+        return Ok(None);
+    }
+    if let Some(f) = face {
+        let ((fu0, fu1), (fv0, fv1)) = f.bounds();
+        uv_box = (
+            uv_box.0.max(fu0),
+            uv_box.1.min(fu1),
+            uv_box.2.max(fv0),
+            uv_box.3.min(fv1),
+        );
+        if !(uv_box.0 < uv_box.1 && uv_box.2 < uv_box.3) {
+            return Ok(None);
+        }
+    }
+    let judging = Judging {
+        face,
+        flip: !outward_is_su_x_sv,
+        min_normal_z: None,
+        uv_box,
+        bounded_by: Some(machined),
+    };
+    simulate_over(surface, path, poses, options, &judging).map(Some)
+}
+
+/// How a surface is judged: its trim, whether its outward normal is `−S_u × S_v`, the reach
+/// limit on the normal's z (none: every normal), and the (u, v) box its dexels stand in.
+struct Judging<'a> {
+    face: Option<&'a FaceRegion>,
+    flip: bool,
+    min_normal_z: Option<f64>,
+    uv_box: (f64, f64, f64, f64),
+    /// Another face that bounds the material below this one (the machined face, beside one
+    /// of its neighbours).
+    bounded_by: Option<Bounding<'a>>,
+}
+
+/// A face of the part as a bound of the material: its surface, which side is its outside,
+/// its trim, and how close to it the tool's cut there counts as its own (the machined face is
+/// cut to within its tolerance, so a neighbour's dexel ends that far inside it).
+#[derive(Debug, Clone, Copy)]
+pub struct Bounding<'a> {
+    pub surface: &'a NurbsSurface,
+    pub outward_is_su_x_sv: bool,
+    pub face: Option<&'a FaceRegion>,
+    pub margin: f64,
+}
+
+impl Bounding<'_> {
+    /// How far (≤ `depth`) the material runs from `foot` along `−n` before it comes within
+    /// the margin of this face: where the line crosses the face's tangent plane at the face
+    /// point nearest `foot`, lowered by the margin, outward. Near the edge where the two faces
+    /// meet that is the face itself to first order; farther than `depth` from the face, or off
+    /// its trim, it does not bound the dexel. The cutter touches the machined face where the
+    /// line leaves the part (a tangent ball at the blade's edge met the cap's dexel exactly
+    /// there, at its full 3 mm). Without it a neighbour's dexels near a convex edge run on past the
+    /// machined face into the air where the tool cuts it, and read that as a gouge (3 mm on
+    /// the blade's bottom cap beside #17).
+    fn material_along(&self, foot: &Vec3, n: &Vec3, depth: f64) -> f64 {
+        // The line's signed height over the face (outward positive) at `t`, from the face
+        // point nearest it; `None` off the face or beyond reach.
+        let height_at = |t: f64| -> Option<(f64, ())> {
+            let q = foot - n * t;
+            let c = self.surface.closest_point(&q, 1e-7).ok()?;
+            if c.distance > depth || self.face.is_some_and(|f| !f.contains(c.u, c.v)) {
+                return None;
+            }
+            let m = self.surface.normal(c.u, c.v)?.into_inner();
+            let m = if self.outward_is_su_x_sv { m } else { -m };
+            Some(((q - c.point).dot(&m), ()))
+        };
+        // Where the line first comes within the margin of the face: marched in steps, then
+        // bisected (its nearest face point and normal move as the face curves — the blade's
+        // edge curves by 1/1.2 mm — so no single tangent plane serves).
+        let outside = |t: f64| height_at(t).is_some_and(|(h, _)| h >= -self.margin);
+        let step = depth / MATERIAL_MARCH as f64;
+        let Some(k) = (1..=MATERIAL_MARCH).find(|&k| outside(k as f64 * step)) else {
+            return depth;
+        };
+        let (mut lo, mut hi) = ((k - 1) as f64 * step, k as f64 * step);
+        for _ in 0..MATERIAL_BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if outside(mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        lo
+    }
+}
+
+/// Steps of [`Bounding::material_along`]'s march along the dexel.
+const MATERIAL_MARCH: usize = 6;
+/// Its bisections (the bracket shrinks to depth/6/2⁸, 2 µm for a D6).
+const MATERIAL_BISECTIONS: usize = 8;
+
+/// The simulation proper over `judging`'s box of `surface`.
+fn simulate_over(
+    surface: &NurbsSurface,
+    path: &ToolPath,
+    poses: &[CutterPose],
+    options: &VerifyOptions,
+    judging: &Judging,
+) -> Result<Verification, VerifyError> {
+    let cell = positive("the cell size", options.cell_mm)?;
+    let spacing = positive("the sweep spacing", options.sweep_spacing_mm)?;
+    let cls: Vec<_> = path.passes.iter().flat_map(|p| &p.points).collect();
+    let Judging {
+        face,
+        flip,
+        min_normal_z,
+        uv_box: (u0, u1, v0, v1),
+        ..
+    } = *judging;
     // Grid lines at equal steps of arc length (each parameter's speed taken as its largest
     // across the other parameter): a surface whose parametric speed varies — STEP fits often
     // run 5:1 — gets nodes no denser than the cell where it is slow.
@@ -308,6 +490,13 @@ pub fn simulate_on(
     // uncut, deeper gouges are reported as that deep.
     let up = r;
     let depth = r;
+    // Where another face bounds the material along a dexel, the dexel ends there.
+    let floor_at = |foot: &Vec3, n: &Vec3| {
+        judging
+            .bounded_by
+            .as_ref()
+            .map_or(depth, |b| b.material_along(foot, n, depth))
+    };
     // One dexel on the surface at (u, v), along its outward normal (none where that is
     // undefined); one surface evaluation each.
     let dexel = |node: (usize, usize), u: f64, v: f64| {
@@ -326,6 +515,7 @@ pub fn simulate_on(
             normal: n,
             uv: (u, v),
             height: up,
+            floor: floor_at(&d.point, &n),
         })
     };
     let dexels: Vec<Vec<Dexel>> = u_nodes
@@ -343,7 +533,6 @@ pub fn simulate_on(
     let sweeper = Sweeper {
         solid: CutterSolid::of(&path.cutter),
         radius: r,
-        depth,
         tile: TILE_CELLS * cell,
     };
     sweeper.run(&mut dexels, poses);
@@ -364,6 +553,12 @@ pub fn simulate_on(
     };
     out.uncut = dexels.iter().filter(|d| d.height >= up).count();
     measure(&dexels, up, &mut out);
+    // A neighbouring face is judged for gouges only: what the program leaves on a face it
+    // does not machine is no scallop, and must not widen the gouge's bounds.
+    let gouge_only = judging.bounded_by.is_some();
+    if gouge_only {
+        (out.uncut, out.max_scallop_mm, out.max_scallop_at) = (0, 0.0, None);
+    }
     let solid = sweeper.solid;
     let rho = if solid.corner > 0.0 { solid.corner } else { r };
     let edge = if solid.corner > 0.0 {
@@ -381,7 +576,9 @@ pub fn simulate_on(
     // quarter cell of a sub-node and the bound shrinks fourfold; otherwise the highest ones are
     // refined and the coarse bound stands.
     let mut scallops: Vec<usize> = (0..dexels.len())
-        .filter(|&k| dexels[k].height < up && dexels[k].height >= out.max_scallop_mm - coarse)
+        .filter(|&k| {
+            !gouge_only && dexels[k].height < up && dexels[k].height >= out.max_scallop_mm - coarse
+        })
         .collect();
     let mut gouges: Vec<usize> = (0..dexels.len())
         .filter(|&k| dexels[k].height < 0.0 && -dexels[k].height >= out.gouge_depth_mm - coarse)
@@ -416,6 +613,9 @@ pub fn simulate_on(
     if !fine.is_empty() {
         sweeper.run(&mut fine, poses);
         measure(&fine, up, &mut out);
+        if gouge_only {
+            (out.max_scallop_mm, out.max_scallop_at) = (0.0, None);
+        }
     }
     out.sweep_bound_mm = sweep_bound(spacing, rho, out.max_scallop_mm) + edge;
     out.grid_bound_mm = if complete {

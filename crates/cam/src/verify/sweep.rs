@@ -44,8 +44,6 @@ pub(super) struct Sweeper {
     pub solid: CutterSolid,
     /// Tool radius R.
     pub radius: f64,
-    /// How deep below its foot a dexel reaches.
-    pub depth: f64,
     /// Tile edge, mm.
     pub tile: f64,
 }
@@ -181,6 +179,8 @@ struct Ray {
     foot: Vec3,
     normal: Vec3,
     height: f64,
+    /// How deep below its foot it reaches.
+    floor: f64,
     /// The pose that last lowered it.
     best: Option<u32>,
     /// Its deepest point, its point at the current height, and the box of the two.
@@ -191,12 +191,13 @@ struct Ray {
 }
 
 impl Ray {
-    fn new(d: &Dexel, depth: f64) -> Self {
-        let bottom = d.foot - d.normal * depth;
+    fn new(d: &Dexel) -> Self {
+        let bottom = d.foot - d.normal * d.floor;
         let mut ray = Ray {
             foot: d.foot,
             normal: d.normal,
             height: d.height,
+            floor: d.floor,
             best: None,
             bottom,
             top: bottom,
@@ -268,7 +269,7 @@ impl Sweeper {
     fn enter(&self, pose: &CutterPose, d: &mut Dexel) {
         if let Some(t) = self
             .solid
-            .entry(pose, &d.foot, &d.normal, -self.depth, d.height)
+            .entry(pose, &d.foot, &d.normal, -d.floor, d.height)
         {
             d.height = d.height.min(t);
         }
@@ -286,7 +287,7 @@ impl Sweeper {
         let mut hi = Vec3::repeat(f64::NEG_INFINITY);
         for &(_, k) in members {
             let d = &dexels[k as usize];
-            let (a, b) = (d.foot - d.normal * self.depth, d.foot + d.normal * d.height);
+            let (a, b) = (d.foot - d.normal * d.floor, d.foot + d.normal * d.height);
             lo = lo.inf(&a).inf(&b);
             hi = hi.sup(&a).sup(&b);
         }
@@ -308,7 +309,7 @@ impl Sweeper {
             .iter()
             .map(|&(_, k)| {
                 let d = &dexels[k as usize];
-                let mut ray = Ray::new(d, self.depth);
+                let mut ray = Ray::new(d);
                 // The neighbour's lowest pose is most often this dexel's too.
                 if let Some(h) = hint {
                     self.leaf(&mut ray, &poses[h as usize], h);
@@ -327,7 +328,7 @@ impl Sweeper {
     fn leaf(&self, ray: &mut Ray, pose: &CutterPose, k: u32) {
         if let Some(t) = self
             .solid
-            .entry(pose, &ray.foot, &ray.normal, -self.depth, ray.height)
+            .entry(pose, &ray.foot, &ray.normal, -ray.floor, ray.height)
         {
             if t < ray.height {
                 ray.lower(t);
@@ -383,7 +384,7 @@ impl Sweeper {
             if below < -(node.e0 + node.e1 * m) {
                 let (c0, along, len) = node.chord;
                 let reach = self.solid.corner + node.deviation;
-                return capsule_entry(&c0, &along, len, reach, &ray.foot, &ray.normal, -self.depth)
+                return capsule_entry(&c0, &along, len, reach, &ray.foot, &ray.normal, -ray.floor)
                     .is_some_and(|t| t < ray.height + SLACK);
             }
         }
@@ -393,7 +394,7 @@ impl Sweeper {
                 rep,
                 &ray.foot,
                 &ray.normal,
-                -self.depth,
+                -ray.floor,
                 ray.height + SLACK,
                 reach,
             )
@@ -407,13 +408,14 @@ mod tests {
     use crate::cutter::{Cutter, CutterShape};
     use proptest::prelude::*;
 
-    fn dexel(foot: Vec3, normal: Vec3, height: f64) -> Dexel {
+    fn dexel(foot: Vec3, normal: Vec3, height: f64, floor: f64) -> Dexel {
         Dexel {
             node: (0, 0),
             foot,
             normal,
             uv: (0.0, 0.0),
             height,
+            floor,
         }
     }
 
@@ -424,7 +426,6 @@ mod tests {
         let sweeper = Sweeper {
             solid,
             radius: r,
-            depth: r,
             tile: 1.0,
         };
         let mut rng = seed;
@@ -453,12 +454,12 @@ mod tests {
                 let (x, y) = (i as f64 * 0.1 * count as f64 / 40.0, j as f64 * 0.23);
                 let slope = -amp * freq * (freq * x).sin();
                 let n = Vec3::new(-slope, 0.0, 1.0).normalize();
-                plain.push(dexel(Vec3::new(x, y, amp * (freq * x).cos()), n, r));
+                plain.push(dexel(Vec3::new(x, y, amp * (freq * x).cos()), n, r, r));
             }
         }
         let mut fast: Vec<Dexel> = plain
             .iter()
-            .map(|d| dexel(d.foot, d.normal, d.height))
+            .map(|d| dexel(d.foot, d.normal, d.height, d.floor))
             .collect();
         for d in &mut plain {
             for p in &poses {
