@@ -37,6 +37,17 @@ fn floor_and_wall() -> (NurbsSurface, NurbsSurface) {
     (floor, wall)
 }
 
+/// Zig-zag along x (toward the wall) at h 0.05, the axis held along the normal: a ball's
+/// lean would not clear the wall, and trying only costs time.
+fn toward_the_wall() -> Settings {
+    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
+    settings.direction = FeedDirection::AlongU;
+    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
+        *max_lead_deg = 0.0;
+    }
+    settings
+}
+
 /// The deepest any point of `face` (for `v` within `v_range`, if given) on a lattice of 400
 /// steps each way lies in the cutting end at any location of the plan.
 fn deepest_in(face: &NurbsSurface, cutter: &Cutter, p: &Plan, v_range: Option<(f64, f64)>) -> f64 {
@@ -64,11 +75,7 @@ fn a_floor_is_cut_up_to_the_wall_on_its_edge_and_no_further() {
     // contacts beyond are refused as interference with the wall.
     let (floor, wall) = floor_and_wall();
     let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
-    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
-    settings.direction = FeedDirection::AlongU;
-    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
-        *max_lead_deg = 0.0;
-    }
+    let mut settings = toward_the_wall();
     let alone = plan(&floor, &cutter, &settings).unwrap();
     assert!(alone.refused.is_empty());
     assert!(deepest_in(&wall, &cutter, &alone, None) > 2.9);
@@ -105,11 +112,7 @@ fn a_neighbour_counts_only_inside_its_trim() {
     // touches the wall or its end edge.
     let (floor, wall) = floor_and_wall();
     let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
-    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
-    settings.direction = FeedDirection::AlongU;
-    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
-        *max_lead_deg = 0.0;
-    }
+    let mut settings = toward_the_wall();
     // The wall's (u, v): u up the wall (z / 20), v along it (y / 50).
     let region =
         FaceRegion::new(vec![vec![(0.0, 0.0), (1.0, 0.0), (1.0, 0.4), (0.0, 0.4)]]).unwrap();
@@ -154,11 +157,7 @@ fn the_simulated_cut_measures_how_deep_the_tool_went_into_a_neighbour() {
     use tezgah_cam::verify::{path_poses, simulate_neighbour, Bounding, MachinedRegion};
     let (floor, wall) = floor_and_wall();
     let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
-    let mut settings = Settings::new(StrategyKind::ZigZag, 0.05, 0.005);
-    settings.direction = FeedDirection::AlongU;
-    if let ToolAxis::Surface { max_lead_deg, .. } = &mut settings.axis {
-        *max_lead_deg = 0.0;
-    }
+    let mut settings = toward_the_wall();
     let options = VerifyOptions {
         cell_mm: 0.2,
         sweep_spacing_mm: 0.05,
