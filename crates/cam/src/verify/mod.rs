@@ -392,7 +392,7 @@ impl Bounding<'_> {
     fn material_along(&self, foot: &Vec3, n: &Vec3, depth: f64) -> f64 {
         // The line's signed height over the face (outward positive) at `t`, from the face
         // point nearest it; `None` off the face or beyond reach.
-        let height_at = |t: f64| -> Option<(f64, ())> {
+        let height_at = |t: f64| -> Option<f64> {
             let q = foot - n * t;
             let c = self.surface.closest_point(&q, 1e-7).ok()?;
             if c.distance > depth || self.face.is_some_and(|f| !f.contains(c.u, c.v)) {
@@ -400,12 +400,18 @@ impl Bounding<'_> {
             }
             let m = self.surface.normal(c.u, c.v)?.into_inner();
             let m = if self.outward_is_su_x_sv { m } else { -m };
-            Some(((q - c.point).dot(&m), ()))
+            Some((q - c.point).dot(&m))
         };
         // Where the line first comes within the margin of the face: marched in steps, then
         // bisected (its nearest face point and normal move as the face curves — the blade's
         // edge curves by 1/1.2 mm — so no single tangent plane serves).
-        let outside = |t: f64| height_at(t).is_some_and(|(h, _)| h >= -self.margin);
+        // A face farther from the foot than the dexel is long (and the margin) cannot bound it:
+        // one nearest point settles most dexels.
+        match self.surface.closest_point(foot, 1e-7) {
+            Ok(c) if c.distance <= depth + self.margin => {}
+            _ => return depth,
+        }
+        let outside = |t: f64| height_at(t).is_some_and(|h| h >= -self.margin);
         let step = depth / MATERIAL_MARCH as f64;
         let Some(k) = (1..=MATERIAL_MARCH).find(|&k| outside(k as f64 * step)) else {
             return depth;
