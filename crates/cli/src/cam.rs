@@ -569,6 +569,8 @@ pub struct NeighbourCheck {
     pub deepest_on: Option<(u64, Vec3)>,
     /// The largest grid bound among them, mm.
     pub grid_bound_mm: f64,
+    /// Their dexel spacing, mm (the largest, where a face's grid had to grow to fit).
+    pub cell_mm: f64,
     /// How deep the tool may reach into them (`--check-tolerance`), mm.
     pub limit_mm: f64,
 }
@@ -674,8 +676,18 @@ fn check_neighbours(
         limit_mm: judged.check_tolerance_mm,
         ..NeighbourCheck::default()
     };
+    // A cut as deep as the limit under the cutter's corner (radius ρ) is 2√(2ρ·limit) wide:
+    // cells a quarter of that see it at two nodes at least, so the other faces need not be
+    // sampled as finely as the machined face's 1 µm gouge limit asks (a flat end's sharp rim
+    // keeps the face's cell).
+    let rho = path.cutter.shape.corner_radius();
+    let seen = 0.5 * (2.0 * rho * judged.check_tolerance_mm).sqrt();
+    let cell = options.cell_mm.max(seen);
     for n in judged.neighbours {
-        let mut options = *options;
+        let mut options = VerifyOptions {
+            cell_mm: cell,
+            ..*options
+        };
         let mut tries = 0;
         let found = loop {
             let neighbour = verify::Bounding {
@@ -694,6 +706,7 @@ fn check_neighbours(
         };
         let Some(v) = found else { continue };
         out.simulated += 1;
+        out.cell_mm = out.cell_mm.max(v.cell_mm);
         out.grid_bound_mm = out.grid_bound_mm.max(v.grid_bound_mm);
         if v.gouge_depth_mm > out.deepest_mm {
             out.deepest_mm = v.gouge_depth_mm;
@@ -762,6 +775,7 @@ fn report_json(
             "deepest_on_face": done.neighbours.deepest_on.map(|(id, _)| id),
             "deepest_at": done.neighbours.deepest_on.map(|(_, p)| [p.x, p.y, p.z]),
             "grid_bound_mm": done.neighbours.grid_bound_mm,
+            "cell_mm": done.neighbours.cell_mm,
             "limit_mm": done.neighbours.limit_mm,
         },
         "planned_scallop_mm": scallop - args.tolerance,
