@@ -111,6 +111,16 @@ impl FaceRegion {
         (self.u_range, self.v_range)
     }
 
+    /// The region's (u, v) box within the parameter ranges `u` and `v` (a surface's domain or
+    /// a part of it); `None` when they do not meet.
+    pub fn clip_box(&self, u: (f64, f64), v: (f64, f64)) -> Option<((f64, f64), (f64, f64))> {
+        let (cu, cv) = (
+            (u.0.max(self.u_range.0), u.1.min(self.u_range.1)),
+            (v.0.max(self.v_range.0), v.1.min(self.v_range.1)),
+        );
+        (cu.0 < cu.1 && cv.0 < cv.1).then_some((cu, cv))
+    }
+
     /// True when (u, v) lies in the region or within [`BOUNDARY_SLACK`] of its boundary.
     pub fn contains(&self, u: f64, v: f64) -> bool {
         let s = self.slack;

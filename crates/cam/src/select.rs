@@ -7,9 +7,8 @@
 
 use tezgah_geom::NurbsSurface;
 
-use crate::region::FaceRegion;
-
 use crate::error::CamError;
+use crate::region::FaceRegion;
 
 /// Metric end-mill diameters (mm) offered by default.
 pub const STANDARD_DIAMETERS: [f64; 14] = [
@@ -41,14 +40,10 @@ pub fn tightest_concave_radius(
     lattice: usize,
     reverse_normal: bool,
 ) -> Option<f64> {
-    let ((u0, u1), (v0, v1)) = match region {
-        Some(r) => {
-            let ((a, b), (c, d)) = r.bounds();
-            let (du, dv) = (surface.domain_u(), surface.domain_v());
-            ((a.max(du.0), b.min(du.1)), (c.max(dv.0), d.min(dv.1)))
-        }
-        None => (surface.domain_u(), surface.domain_v()),
-    };
+    let domain = (surface.domain_u(), surface.domain_v());
+    let ((u0, u1), (v0, v1)) = region
+        .and_then(|r| r.clip_box(domain.0, domain.1))
+        .unwrap_or(domain);
     let n = lattice.max(2);
     let mut worst = 0.0f64;
     for i in 0..=n {

@@ -193,26 +193,36 @@ struct Planned {
     outward_is_su_x_sv: bool,
 }
 
-/// The face of a STEP file to machine, the part's other faces (kept out of the cutter's way)
-/// and a box around every face (the part the links keep clear of).
+/// The face of a STEP file to machine and its trim, the part's other faces (kept out of the
+/// cutter's way) and a box around every face (the part the links keep clear of).
 struct PartFaces {
     face: Face,
-    others: Vec<Face>,
+    region: Option<FaceRegion>,
+    neighbours: Vec<NeighbourFace>,
     part: Option<PartBox>,
 }
 
 /// The face of the STEP file at `path` to machine (`--face`, or its only face), its other
-/// faces and the part's box.
-fn read_face(path: &Path, id: Option<u64>) -> Result<PartFaces> {
+/// faces and the part's box; every trim followed to `trim_mm`, once for all that use it.
+fn read_face(path: &Path, id: Option<u64>, trim_mm: f64) -> Result<PartFaces> {
     let model = tezgah_cam::step::read_file(path).into_diagnostic()?;
     let part = part_box(&model);
     let face = pick_face(path, &model, id)?;
+    // A trimmed face is machined within its loops.
+    let region = face
+        .uv_region(trim_mm)
+        .map_err(|e| miette!("{}: {e}", path.display()))?;
     let others = model
         .faces
         .into_iter()
         .filter(|f| f.id != face.id)
         .collect();
-    Ok(PartFaces { face, others, part })
+    Ok(PartFaces {
+        face,
+        region,
+        neighbours: neighbours(path, others, trim_mm),
+        part,
+    })
 }
 
 /// Another face of the part: its `#id`, which side is its outside, and its surface within its
@@ -227,11 +237,11 @@ pub struct NeighbourFace {
 /// The part's other faces as the gouge checks see them: each surface within its trim. A face
 /// whose trim cannot be followed is checked whole (more than the face: it can only refuse
 /// more), with a note.
-fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<NeighbourFace> {
+fn neighbours(path: &Path, others: Vec<Face>, trim_mm: f64) -> Vec<NeighbourFace> {
     others
         .into_iter()
         .map(|f| {
-            let region = f.uv_region(0.25 * tolerance_mm).unwrap_or_else(|e| {
+            let region = f.uv_region(trim_mm).unwrap_or_else(|e| {
                 eprintln!(
                     "note: {}: face #{}'s trim cannot be followed ({e}); the gouge checks keep \
                      the tool off its whole surface",
@@ -256,7 +266,12 @@ fn neighbours(path: &Path, others: Vec<Face>, tolerance_mm: f64) -> Vec<Neighbou
 /// strategy could not correct are left out of the path and listed here.
 fn plan_surface(
     path: &Path,
-    PartFaces { face, others, part }: PartFaces,
+    PartFaces {
+        face,
+        region,
+        neighbours,
+        part,
+    }: PartFaces,
     cutter: Cutter,
     request: &PlanRequest,
 ) -> Result<Planned> {
@@ -274,13 +289,14 @@ fn plan_surface(
         .direction
         .unwrap_or_else(|| FeedDirection::for_surface(&face.surface));
     settings.band = request.band;
-    // A trimmed face is machined within its loops, followed to a quarter of the chord
-    // tolerance.
-    settings.region = face
-        .uv_region(0.25 * request.tolerance_mm)
-        .map_err(|e| miette!("{}: {e}", path.display()))?;
-    let neighbours = neighbours(path, others, request.tolerance_mm);
-    settings.neighbours = neighbours.iter().map(|n| n.check.clone()).collect();
+    settings.region = region;
+    // The other faces go to the planner and come back with the plan (no copy of their
+    // surfaces).
+    let (known, checks): (Vec<_>, Vec<_>) = neighbours
+        .into_iter()
+        .map(|n| ((n.id, n.outward_is_su_x_sv), n.check))
+        .unzip();
+    settings.neighbours = checks;
     if !settings.neighbours.is_empty() {
         eprintln!(
             "note: the tool is kept out of the part's {} other faces too",
@@ -292,9 +308,9 @@ fn plan_surface(
         // issue 7's 1 µm.
         settings.gouge.depth_tolerance = 0.5 * GOUGE_LIMIT_MM;
     }
-    // The other faces are kept clear to within the tolerance the motion runs at: where they
-    // meet the face at a crease a few µm deep (the lofted blade's), cutting the face to its
-    // edge reaches that far into them.
+    // The other faces are kept clear to within the check tolerance: where one meets the face
+    // at a concave crease, cutting the face to its edge reaches into it (0.073 mm into the
+    // lofted blade's #876 from #17 with a D6 ball).
     settings.gouge.neighbour_depth_tolerance = request.neighbour_tolerance_mm;
     let plan = tezgah_cam::plan(&face.surface, &cutter, &settings).into_diagnostic()?;
     let gouges = plan.refused.iter().filter(|r| r.refusal.is_gouge()).count();
@@ -346,7 +362,15 @@ fn plan_surface(
             .reach_normal_tilt_deg(&cutter.shape)
             .unwrap_or(request.max_tilt_deg),
         region: settings.region,
-        neighbours,
+        neighbours: known
+            .into_iter()
+            .zip(settings.neighbours)
+            .map(|((id, outward_is_su_x_sv), check)| NeighbourFace {
+                id,
+                outward_is_su_x_sv,
+                check,
+            })
+            .collect(),
         outward_is_su_x_sv: face.same_sense,
     })
 }
@@ -428,7 +452,12 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
     }
-    let faces = read_face(&args.surface, args.face)?;
+    // One guarantee (DESIGN.md "Tolerance"), one-sided: the machine's motion runs between
+    // the exact cutter-location surface and the tolerance outside it. Chords get half,
+    // linearisation and blending an eighth each (`ToleranceShares`).
+    let shares = ToleranceShares::of(tolerance);
+    // Trims are followed to a quarter of the chord tolerance.
+    let faces = read_face(&args.surface, args.face, 0.25 * shares.chord)?;
     let (shape, tool_number) = match spec {
         ToolSpec::Given(shape) => (shape, args.tool_number.unwrap_or(1)),
         ToolSpec::Auto => {
@@ -436,17 +465,17 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
                 Some(p) => Some((p, crate::library::load_tool_table(Some(p))?)),
                 None => None,
             };
-            let pick = cam_tool::choose(&faces.face, table.as_ref().map(|(p, t)| (*p, t)))?;
+            let pick = cam_tool::choose(
+                &faces.face,
+                faces.region.as_ref(),
+                table.as_ref().map(|(p, t)| (*p, t)),
+            )?;
             println!("tool auto: {} — {}", pick.shape, pick.why);
             (pick.shape, args.tool_number.or(pick.number).unwrap_or(1))
         }
     };
     let length = tool_length(args.tool_table.as_deref(), tool_number)?;
     let cutter = Cutter::standard(shape);
-    // One guarantee (DESIGN.md "Tolerance"), one-sided: the machine's motion runs between
-    // the exact cutter-location surface and the tolerance outside it. Chords get half,
-    // linearisation and blending an eighth each (`ToleranceShares`).
-    let shares = ToleranceShares::of(tolerance);
     let request = PlanRequest {
         strategy,
         scallop_mm: scallop,
@@ -509,13 +538,8 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         Judged {
             region,
             face: face_region.as_ref(),
+            outward_is_su_x_sv,
             neighbours: &neighbours,
-            machined: verify::Bounding {
-                surface: &surface,
-                outward_is_su_x_sv,
-                face: face_region.as_ref(),
-                margin: request.neighbour_tolerance_mm,
-            },
             check_tolerance_mm: request.neighbour_tolerance_mm,
         },
     )?;
@@ -595,10 +619,11 @@ impl Finished {
 pub struct Judged<'a> {
     pub region: MachinedRegion,
     pub face: Option<&'a FaceRegion>,
+    /// The machined face's outside is the side `S_u × S_v` points to.
+    pub outward_is_su_x_sv: bool,
     /// The part's other faces: the cut is simulated over them too, for gouges only, their
-    /// dexels ending where the machined face bounds the material.
+    /// dexels ending where the machined face bounds the material (less the check tolerance).
     pub neighbours: &'a [NeighbourFace],
-    pub machined: verify::Bounding<'a>,
     pub check_tolerance_mm: f64,
 }
 
@@ -655,7 +680,7 @@ pub fn finish(
             other => break other.into_diagnostic()?,
         }
     };
-    let neighbours = check_neighbours(path, &poses, &verify_options, &judged)?;
+    let neighbours = check_neighbours(surface, path, &poses, &verify_options, &judged)?;
     Ok(Finished {
         posted,
         verification,
@@ -667,6 +692,7 @@ pub fn finish(
 /// The cut simulated over each of the part's other faces the tool comes near, at the face's
 /// verification cell (grown like it where a face's grid would not fit in memory).
 fn check_neighbours(
+    surface: &NurbsSurface,
     path: &ToolPath,
     poses: &[verify::CutterPose],
     options: &VerifyOptions,
@@ -683,6 +709,14 @@ fn check_neighbours(
     let rho = path.cutter.shape.corner_radius();
     let seen = 0.5 * (2.0 * rho * judged.check_tolerance_mm).sqrt();
     let cell = options.cell_mm.max(seen);
+    let machined = verify::Bounded {
+        by: verify::Bounding {
+            surface,
+            outward_is_su_x_sv: judged.outward_is_su_x_sv,
+            face: judged.face,
+        },
+        margin: judged.check_tolerance_mm,
+    };
     for n in judged.neighbours {
         let mut options = VerifyOptions {
             cell_mm: cell,
@@ -694,9 +728,8 @@ fn check_neighbours(
                 surface: &n.check.surface,
                 outward_is_su_x_sv: n.outward_is_su_x_sv,
                 face: n.check.region.as_ref(),
-                margin: 0.0,
             };
-            match verify::simulate_neighbour(neighbour, judged.machined, path, poses, &options) {
+            match verify::simulate_neighbour(neighbour, machined, path, poses, &options) {
                 Err(verify::VerifyError::TooFine(count)) if tries < 4 => {
                     tries += 1;
                     options.cell_mm *= (count as f64 / (0.95 * MAX_DEXELS as f64)).sqrt();
@@ -907,13 +940,8 @@ mod tests {
         let judged = Judged {
             region,
             face: None,
+            outward_is_su_x_sv: true,
             neighbours: &[],
-            machined: verify::Bounding {
-                surface: &surface,
-                outward_is_su_x_sv: true,
-                face: None,
-                margin: 0.01,
-            },
             check_tolerance_mm: 0.01,
         };
         let done = finish(&surface, &path, &machine, &options, None, judged).unwrap();

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use miette::{miette, IntoDiagnostic, Result};
+use tezgah_cam::region::FaceRegion;
 use tezgah_cam::select::{propose, tightest_concave_radius, STANDARD_DIAMETERS};
 use tezgah_cam::step::Face;
 use tezgah_cam::CutterShape;
@@ -12,8 +13,6 @@ use tezgah_gcode::ToolTable;
 
 /// Parameter lattice (per direction) on which the face's principal curvatures are sampled.
 const CURVATURE_LATTICE: usize = 64;
-/// How closely a trimmed face's loops are followed for the lattice's membership test, mm.
-const TRIM_FOLLOW_MM: f64 = 0.001;
 /// The ball must stay this fraction below the tightest sampled concave radius: the lattice
 /// sees the curvature only at its nodes, and the strategy refuses any point where the ball's
 /// radius exceeds the local one (a local gouge), splitting the pass there.
@@ -58,16 +57,14 @@ fn table_balls(table: &ToolTable) -> Vec<(u32, f64)> {
 }
 
 /// The largest ball of the table (`Some((file, table))`) or of the standard set that fits
-/// `face` (machined on its outside, as the strategy cuts it).
-pub fn choose(face: &Face, table: Option<(&Path, &ToolTable)>) -> Result<ToolPick> {
-    // Sized on the face itself: a trimmed face within its loops (followed to 1 µm).
-    let region = face.uv_region(TRIM_FOLLOW_MM).into_diagnostic()?;
-    let rho = tightest_concave_radius(
-        &face.surface,
-        region.as_ref(),
-        CURVATURE_LATTICE,
-        !face.same_sense,
-    );
+/// `face` (machined on its outside, as the strategy cuts it) — on a trimmed face, within its
+/// `region`.
+pub fn choose(
+    face: &Face,
+    region: Option<&FaceRegion>,
+    table: Option<(&Path, &ToolTable)>,
+) -> Result<ToolPick> {
+    let rho = tightest_concave_radius(&face.surface, region, CURVATURE_LATTICE, !face.same_sense);
     let (set, source): (Vec<f64>, String) = match table {
         Some((path, table)) => {
             let balls = table_balls(table);

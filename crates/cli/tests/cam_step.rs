@@ -387,8 +387,8 @@ fn vertical_cylinder_side_is_machined_with_the_table_at_90_degrees() {
 fn twisted_blade_face_is_machined_past_vertical_within_the_tilt_range() {
     // A face of the lofted blade leans past vertical in places (normals below the
     // horizontal): table-ac's A reaches 120°, so by default those are machined too. The
-    // blade's faces meet #17 at creases (up to ~6° concave near the tip) where the ball
-    // cutting #17 to its edge reaches up to ~25 µm into the face beside: the test is about
+    // blade's #876 meets #17 at a concave crease (~4° 80 mm up) where the ball cutting #17
+    // to its edge reaches 0.073 mm into #876 (asserted below): the test is about
     // #17's own shape, so the other faces are allowed 0.1 mm (`--check-tolerance`).
     let h = 0.3;
     let (report, program, stderr) = cam(

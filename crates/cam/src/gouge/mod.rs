@@ -64,10 +64,10 @@ pub struct GougeSettings {
     pub global_spacing: f64,
     /// Penetration below which a surface point does not count as a rear gouge (mm).
     pub depth_tolerance: f64,
-    /// The same for the part's other faces ([`CheckFace`]): a CAD model's faces meet only to
-    /// within its modelling accuracy (the lofted blade's pieces overlap by up to 2.6 µm along
-    /// their shared edges), so a cutter at the machined face's edge may reach that far into
-    /// the face beside it without cutting anything the model means.
+    /// The same for the part's other faces ([`CheckFace`]): where one meets the machined face
+    /// at a concave crease, cutting the face to its edge reaches into it (a D6 ball reaches
+    /// 0.073 mm into the lofted blade's #876 from #17), so how deep is the user's to say
+    /// (`tezgah cam --check-tolerance`).
     pub neighbour_depth_tolerance: f64,
     pub rear: bool,
     pub global: bool,
@@ -93,6 +93,8 @@ pub struct GougeChecker {
     settings: GougeSettings,
     /// One rear index per face, with its depth tolerance.
     fine: Vec<(rear::RearIndex, f64)>,
+    /// How high the rear check's solid reaches ([`rear::checked_height`]).
+    height: f64,
     /// The samples of every face inside its trim, together.
     coarse: Option<PointGrid>,
 }
@@ -170,6 +172,7 @@ impl GougeChecker {
         Ok(GougeChecker {
             cutter: *cutter,
             settings,
+            height: rear::checked_height(cutter),
             fine,
             coarse,
         })
@@ -196,10 +199,9 @@ impl GougeChecker {
     /// pose of it ([`rear::RearIndex::first_penetration_along`]), the global check (shank and
     /// holder, which keep a clearance of the global spacing) at its middle.
     pub fn check_sweep(&self, sweep: &sweep::Sweep) -> Option<Gouge> {
-        let height = rear::checked_height(&self.cutter);
         for (index, tolerance) in &self.fine {
             if let Some(rear::Penetration { depth, point, at }) =
-                index.first_penetration_within(&self.cutter.shape, height, sweep, *tolerance)
+                index.first_penetration_within(&self.cutter.shape, self.height, sweep, *tolerance)
             {
                 let (tip, axis) = sweep.pose(at);
                 return Some(Gouge::Interference {

@@ -239,8 +239,9 @@ pub struct Penetration {
 #[derive(Debug, Clone)]
 pub struct RearIndex {
     surface: NurbsSurface,
-    /// The face's region on the surface (`None`: the whole surface).
-    region: Option<FaceRegion>,
+    /// The face's region on the surface (`None`: the whole surface) and where each lattice
+    /// cell lies against it, by node (`u` index × `v` count + `v` index), classified once.
+    region: Option<(FaceRegion, Vec<RectSide>)>,
     /// The lattice's parameter lines (its samples live in `grid`).
     lines: SurfaceSamples,
     grid: PointGrid,
@@ -266,15 +267,18 @@ impl RearIndex {
         mut samples: SurfaceSamples,
         bucket: f64,
     ) -> RearIndex {
-        if let Some(r) = region {
-            let keep: Vec<bool> = samples
-                .samples
-                .iter()
-                .map(|s| r.classify(samples.cell(s.node)) != RectSide::Outside)
-                .collect();
-            let mut k = keep.iter();
-            samples.samples.retain(|_| *k.next().unwrap_or(&false));
-        }
+        let region = region.map(|r| {
+            let nv = samples.v.len();
+            let mut sides = vec![RectSide::Outside; samples.u.len() * nv];
+            for s in &samples.samples {
+                sides[s.node[0] as usize * nv + s.node[1] as usize] =
+                    r.classify(samples.cell(s.node));
+            }
+            samples.samples.retain(|s| {
+                sides[s.node[0] as usize * nv + s.node[1] as usize] != RectSide::Outside
+            });
+            (r.clone(), sides)
+        });
         let (du, dv) = (surface.domain_u(), surface.domain_v());
         let at = |(lo, hi): (f64, f64), k: usize| {
             lo + (hi - lo) * k as f64 / (CURVATURE_SAMPLES - 1) as f64
@@ -289,7 +293,7 @@ impl RearIndex {
         }
         RearIndex {
             surface: surface.clone(),
-            region: region.cloned(),
+            region,
             kappa: kappa * CURVATURE_MARGIN,
             grid: PointGrid::new(std::mem::take(&mut samples.samples), bucket),
             lines: samples,
@@ -357,14 +361,12 @@ impl RearIndex {
             let z1 = (z0 + piece).min(height);
             let (lo, hi) = sweep.bounding_box_between(z0, z1, big_r);
             self.grid.visit_box(&lo, &hi, |s| {
+                let (i, j) = (s.node[0] as usize, s.node[1] as usize);
                 let (uv, side) = match &self.region {
                     None => (None, RectSide::Inside),
-                    Some(r) => (
-                        Some((
-                            self.lines.u[s.node[0] as usize],
-                            self.lines.v[s.node[1] as usize],
-                        )),
-                        r.classify(self.lines.cell(s.node)),
+                    Some((_, sides)) => (
+                        Some((self.lines.u[i], self.lines.v[j])),
+                        sides[i * self.lines.v.len() + j],
                     ),
                 };
                 let patch = Patch {
@@ -463,7 +465,7 @@ impl Search<'_> {
         // A point outside the face, in a cell across its trim: the face's part of the cell
         // lies within the cover of it, and the depth changes by at most the distance.
         let outside = match (patch.side, &self.index.region, patch.uv) {
-            (RectSide::Across, Some(r), Some((u, v))) => !r.contains(u, v),
+            (RectSide::Across, Some((r, _)), Some((u, v))) => !r.contains(u, v),
             _ => false,
         };
         let counted = if outside { d.depth - cover } else { d.depth };
@@ -521,7 +523,7 @@ impl Search<'_> {
             );
             let e = self.index.surface.derivs(quarter[0] + hu, quarter[2] + hv);
             let side = match (&self.index.region, patch.side) {
-                (Some(r), RectSide::Across) => r.classify(quarter),
+                (Some((r, _)), RectSide::Across) => r.classify(quarter),
                 (_, side) => side,
             };
             let part = Patch {

@@ -33,29 +33,17 @@ pub fn iso_parametric_side_step(
 /// The (side, feed) ranges the passes cover: the domain's, or on a trimmed face the part of
 /// them its region's box spans.
 fn face_box(ctx: &Context) -> ((f64, f64), (f64, f64)) {
-    let Axes { side, feed, .. } = ctx.axes;
-    let Some(region) = &ctx.settings.region else {
-        return (side, feed);
-    };
-    let (ur, vr) = region.bounds();
-    let (sr, fr) = if ctx.axes.along_v { (ur, vr) } else { (vr, ur) };
-    let clip = |(lo, hi): (f64, f64), (a, b): (f64, f64)| {
-        let (l, h) = (lo.max(a), hi.min(b));
-        if l < h {
-            (l, h)
-        } else {
-            (lo, hi)
-        }
-    };
-    (clip(side, sr), clip(feed, fr))
-}
-
-/// True when the contact at (u, v) is on the face (always on an untrimmed one).
-fn on_face(ctx: &Context, (u, v): (f64, f64)) -> bool {
-    ctx.settings
-        .region
-        .as_ref()
-        .is_none_or(|r| r.contains(u, v))
+    let Axes {
+        side,
+        feed,
+        along_v,
+    } = ctx.axes;
+    let (u, v) = if along_v { (side, feed) } else { (feed, side) };
+    match ctx.settings.region.as_ref().and_then(|r| r.clip_box(u, v)) {
+        Some((u, v)) if along_v => (u, v),
+        Some((u, v)) => (v, u),
+        None => (side, feed),
+    }
 }
 
 fn side_step(ctx: &Context) -> Result<f64, CamError> {
@@ -66,7 +54,7 @@ fn side_step(ctx: &Context) -> Result<f64, CamError> {
         for j in 0..=LATTICE {
             let f = feed.0 + (feed.1 - feed.0) * j as f64 / LATTICE as f64;
             let (u, v) = ctx.axes.uv(s, f);
-            if !on_face(ctx, (u, v)) {
+            if !ctx.on_face(u, v) {
                 continue;
             }
             let tangent = ctx.axes.uv(0.0, 1.0);
@@ -98,15 +86,17 @@ fn true_surface_step(ctx: &Context, step: f64) -> f64 {
     let (side, feed) = face_box(ctx);
     let tangent = ctx.axes.uv(0.0, 1.0);
     let allowed = |s: f64, f: f64| -> f64 {
-        if !on_face(ctx, ctx.axes.uv(s, f)) {
+        let (u, v) = ctx.axes.uv(s, f);
+        if !ctx.on_face(u, v) {
             return step;
         }
         let fits = |d: f64| {
             let s2 = s + d;
-            if s2 > side.1 || !on_face(ctx, ctx.axes.uv(s2, f)) {
+            let (u2, v2) = ctx.axes.uv(s2, f);
+            if s2 > side.1 || !ctx.on_face(u2, v2) {
                 return true;
             }
-            ctx.cusp_fits(ctx.axes.uv(s, f), ctx.axes.uv(s2, f), tangent)
+            ctx.cusp_fits((u, v), (u2, v2), tangent)
         };
         if fits(step) {
             return step;

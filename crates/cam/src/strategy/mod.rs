@@ -603,6 +603,15 @@ impl<'a> Context<'a> {
         &self.cutter.shape
     }
 
+    /// True when (u, v) is on the face: inside its trim ([`Settings::region`]), or anywhere
+    /// on an untrimmed one.
+    fn on_face(&self, u: f64, v: f64) -> bool {
+        self.settings
+            .region
+            .as_ref()
+            .is_none_or(|r| r.contains(u, v))
+    }
+
     /// Frame and curvature at `(u, v)` for a path running along `tangent_uv`.
     fn local(&self, u: f64, v: f64, tangent_uv: (f64, f64)) -> Option<Local> {
         self.local_of(self.derivs(u, v), tangent_uv)
@@ -754,12 +763,7 @@ impl<'a> Context<'a> {
             contact,
             refusal,
         };
-        if self
-            .settings
-            .region
-            .as_ref()
-            .is_some_and(|r| !r.contains(u, v))
-        {
+        if !self.on_face(u, v) {
             return Err(refuse(Refusal::OutsideFace));
         }
         let local = self
@@ -966,22 +970,17 @@ impl<'a> Context<'a> {
     /// the feed into the last contact from the latest one apart from it (none for a turn
     /// about a pole, whose contacts are all one point).
     fn close_pass(&self, passes: &mut Vec<Pass>, mut pass: Pass) {
-        if let [.., last] = pass.points.as_slice() {
-            if pass.points.len() < 2 {
-                return;
-            }
-            let prev = pass
-                .points
-                .iter()
-                .rev()
+        let [.., _, last] = pass.points.as_slice() else {
+            return;
+        };
+        if self.settings.band.is_some() {
+            let apart = (pass.points.iter().rev())
                 .find(|p| (p.contact - last.contact).norm() > pole::SAME_POINT);
-            if let (Some(prev), Some(_)) = (prev, self.settings.band) {
-                if let Some(extra) = self.run_out(prev, last) {
-                    pass.points.push(extra);
-                }
+            if let Some(extra) = apart.and_then(|prev| self.run_out(prev, last)) {
+                pass.points.push(extra);
             }
-            passes.push(pass);
         }
+        passes.push(pass);
     }
 
     /// Raises leads so consecutive placed locations differ by at most `rate` (radians): each

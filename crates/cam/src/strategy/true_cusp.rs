@@ -33,7 +33,7 @@ const CUSP_SLACK: f64 = 1e-6;
 /// One pass's cutter at a contact: tip and unit axis at the nominal orientation.
 pub(super) struct Standing {
     pub(super) tip: Vec3,
-    pub(super) axis: Vec3,
+    axis: Vec3,
 }
 
 impl Context<'_> {

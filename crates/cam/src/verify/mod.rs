@@ -254,22 +254,18 @@ pub fn simulate_on(
             reachable_box(surface, z, &outward).ok_or(VerifyError::EmptyRegion(options.region))?
         }
     };
-    let (u0, u1, v0, v1) = match face {
+    let uv_box = match face {
         None => (u0, u1, v0, v1),
-        Some(f) => {
-            let ((fu0, fu1), (fv0, fv1)) = f.bounds();
-            let b = (u0.max(fu0), u1.min(fu1), v0.max(fv0), v1.min(fv1));
-            if !(b.0 < b.1 && b.2 < b.3) {
-                return Err(VerifyError::EmptyRegion(options.region));
-            }
-            b
-        }
+        Some(f) => f
+            .clip_box((u0, u1), (v0, v1))
+            .map(|((u0, u1), (v0, v1))| (u0, u1, v0, v1))
+            .ok_or(VerifyError::EmptyRegion(options.region))?,
     };
     let judging = Judging {
         face,
         flip,
         min_normal_z,
-        uv_box: (u0, u1, v0, v1),
+        uv_box,
         bounded_by: None,
     };
     simulate_over(surface, path, poses, options, &judging)
@@ -283,7 +279,7 @@ pub fn simulate_on(
 /// tool never comes near the face.
 pub fn simulate_neighbour(
     neighbour: Bounding,
-    machined: Bounding,
+    machined: Bounded,
     path: &ToolPath,
     poses: &[CutterPose],
     options: &VerifyOptions,
@@ -292,7 +288,6 @@ pub fn simulate_neighbour(
         surface,
         outward_is_su_x_sv,
         face,
-        ..
     } = neighbour;
     let r = path.cutter.shape.radius();
     let height = crate::gouge::rear::checked_height(&path.cutter);
@@ -335,15 +330,9 @@ pub fn simulate_neighbour(
         return Ok(None);
     }
     if let Some(f) = face {
-        let ((fu0, fu1), (fv0, fv1)) = f.bounds();
-        uv_box = (
-            uv_box.0.max(fu0),
-            uv_box.1.min(fu1),
-            uv_box.2.max(fv0),
-            uv_box.3.min(fv1),
-        );
-        if !(uv_box.0 < uv_box.1 && uv_box.2 < uv_box.3) {
-            return Ok(None);
+        match f.clip_box((uv_box.0, uv_box.1), (uv_box.2, uv_box.3)) {
+            Some(((u0, u1), (v0, v1))) => uv_box = (u0, u1, v0, v1),
+            None => return Ok(None),
         }
     }
     let judging = Judging {
@@ -365,53 +354,57 @@ struct Judging<'a> {
     uv_box: (f64, f64, f64, f64),
     /// Another face that bounds the material below this one (the machined face, beside one
     /// of its neighbours).
-    bounded_by: Option<Bounding<'a>>,
+    bounded_by: Option<Bounded<'a>>,
 }
 
-/// A face of the part as a bound of the material: its surface, which side is its outside,
-/// its trim, and how close to it the tool's cut there counts as its own (the machined face is
-/// cut to within its tolerance, so a neighbour's dexel ends that far inside it).
+/// A face of the part: its surface, which side is its outside, and its trim.
 #[derive(Debug, Clone, Copy)]
 pub struct Bounding<'a> {
     pub surface: &'a NurbsSurface,
     pub outward_is_su_x_sv: bool,
     pub face: Option<&'a FaceRegion>,
+}
+
+/// The machined face as the bound of a neighbour's material, and how close to it the tool's
+/// cut counts as the face's own (it is cut to within a tolerance, so a neighbour's dexel ends
+/// that far inside it).
+#[derive(Debug, Clone, Copy)]
+pub struct Bounded<'a> {
+    pub by: Bounding<'a>,
     pub margin: f64,
 }
 
-impl Bounding<'_> {
+impl Bounded<'_> {
     /// How far (≤ `depth`) the material runs from `foot` along `−n` before it comes within
-    /// the margin of this face: where the line crosses the face's tangent plane at the face
-    /// point nearest `foot`, lowered by the margin, outward. Near the edge where the two faces
-    /// meet that is the face itself to first order; farther than `depth` from the face, or off
-    /// its trim, it does not bound the dexel. The cutter touches the machined face where the
-    /// line leaves the part (a tangent ball at the blade's edge met the cap's dexel exactly
-    /// there, at its full 3 mm). Without it a neighbour's dexels near a convex edge run on past the
-    /// machined face into the air where the tool cuts it, and read that as a gouge (3 mm on
-    /// the blade's bottom cap beside #17).
+    /// the margin of the face: marched in steps and bisected, each point judged by its
+    /// height over the face at the face's nearest point (that point and its normal move as the
+    /// face curves — the blade's edge curves by 1/1.2 mm — so no single tangent plane serves).
+    /// Farther than `depth` from the face, or off its trim, the face does not bound the dexel.
+    /// Without the bound a neighbour's dexels near a convex edge run on past the machined face
+    /// into the air where the tool cuts it, and read that as a gouge (3 mm on the blade's
+    /// bottom cap beside #17); without the margin the ball touching the face where the line
+    /// leaves the part read the same.
     fn material_along(&self, foot: &Vec3, n: &Vec3, depth: f64) -> f64 {
+        let Bounded { by, margin } = *self;
         // The line's signed height over the face (outward positive) at `t`, from the face
         // point nearest it; `None` off the face or beyond reach.
         let height_at = |t: f64| -> Option<f64> {
             let q = foot - n * t;
-            let c = self.surface.closest_point(&q, 1e-7).ok()?;
-            if c.distance > depth || self.face.is_some_and(|f| !f.contains(c.u, c.v)) {
+            let c = by.surface.closest_point(&q, 1e-7).ok()?;
+            if c.distance > depth || by.face.is_some_and(|f| !f.contains(c.u, c.v)) {
                 return None;
             }
-            let m = self.surface.normal(c.u, c.v)?.into_inner();
-            let m = if self.outward_is_su_x_sv { m } else { -m };
+            let m = by.surface.normal(c.u, c.v)?.into_inner();
+            let m = if by.outward_is_su_x_sv { m } else { -m };
             Some((q - c.point).dot(&m))
         };
-        // Where the line first comes within the margin of the face: marched in steps, then
-        // bisected (its nearest face point and normal move as the face curves — the blade's
-        // edge curves by 1/1.2 mm — so no single tangent plane serves).
         // A face farther from the foot than the dexel is long (and the margin) cannot bound it:
         // one nearest point settles most dexels.
-        match self.surface.closest_point(foot, 1e-7) {
-            Ok(c) if c.distance <= depth + self.margin => {}
+        match by.surface.closest_point(foot, 1e-7) {
+            Ok(c) if c.distance <= depth + margin => {}
             _ => return depth,
         }
-        let outside = |t: f64| height_at(t).is_some_and(|h| h >= -self.margin);
+        let outside = |t: f64| height_at(t).is_some_and(|h| h >= -margin);
         let step = depth / MATERIAL_MARCH as f64;
         let Some(k) = (1..=MATERIAL_MARCH).find(|&k| outside(k as f64 * step)) else {
             return depth;
@@ -429,7 +422,7 @@ impl Bounding<'_> {
     }
 }
 
-/// Steps of [`Bounding::material_along`]'s march along the dexel.
+/// Steps of [`Bounded::material_along`]'s march along the dexel.
 const MATERIAL_MARCH: usize = 6;
 /// Its bisections (the bracket shrinks to depth/6/2⁸, 2 µm for a D6).
 const MATERIAL_BISECTIONS: usize = 8;
@@ -581,11 +574,13 @@ fn simulate_over(
     // neighbouring cells. If they all fit under the cap, the true extremes lie within a
     // quarter cell of a sub-node and the bound shrinks fourfold; otherwise the highest ones are
     // refined and the coarse bound stands.
-    let mut scallops: Vec<usize> = (0..dexels.len())
-        .filter(|&k| {
-            !gouge_only && dexels[k].height < up && dexels[k].height >= out.max_scallop_mm - coarse
-        })
-        .collect();
+    let mut scallops: Vec<usize> = if gouge_only {
+        Vec::new()
+    } else {
+        (0..dexels.len())
+            .filter(|&k| dexels[k].height < up && dexels[k].height >= out.max_scallop_mm - coarse)
+            .collect()
+    };
     let mut gouges: Vec<usize> = (0..dexels.len())
         .filter(|&k| dexels[k].height < 0.0 && -dexels[k].height >= out.gouge_depth_mm - coarse)
         .collect();
