@@ -856,11 +856,7 @@ impl Executor {
         self.done_length += end;
         self.s = 0.0;
         self.passed.extend(cursor.passed().iter().cloned());
-        let stop = cursor
-            .piece()
-            .segments
-            .last()
-            .is_some_and(|s| s.end == Junction::Stop);
+        let stop = cursor.piece().end_junction() == Junction::Stop;
         self.current = None;
         Ok(stop)
     }

@@ -149,7 +149,7 @@ impl Executor {
             return None;
         };
         let (last, head) = (piece.segments.last()?, next.segments.first()?);
-        if last.end == Junction::Stop {
+        if piece.end_junction() == Junction::Stop {
             return None;
         }
         let at = time_to(first, left);

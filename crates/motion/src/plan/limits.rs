@@ -5,10 +5,11 @@
 //! A joint q(σ) along the path coordinate σ (arc length, or degrees for a rotary-only move) at
 //! path speed v, acceleration a, jerk j moves with
 //!   q̇ = q'v,  q̈ = q''v² + q'a,  q⃛ = q'''v³ + 3q''va + q'j            (chain rule)
-//! so with g1, g2, g3 the largest |q'|, |q''|, |q'''| over the segment the profile limits
-//! (V, A, J) below keep every joint inside its limits; this is reference 000 §2.5–2.8's
-//! v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint for the speed, with the cross term 3q''va paid by the
-//! path acceleration (see [`segment_limits`]).
+//! so the profile limits (V, A, J) chosen below keep every joint inside its limits at every
+//! point of the segment ([`Geometry::cells`]); this is reference 000 §2.5–2.8's v ≤ √(A/κ),
+//! v ≤ (J/κ²)^⅓ per joint for the speed, with no fixed share of a joint's budget set aside for
+//! one term: the split between speed, path acceleration and jerk is chosen per segment (see
+//! [`segment_limits`]).
 
 use tezgah_geom::{ArcLengthMap, Curve, Vec3};
 use tezgah_kinematics::Joints;
@@ -29,12 +30,6 @@ pub struct PlanOptions {
     /// Share of a segment's tolerance given to the chord error at the period (the rest is for
     /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance.
     pub chord_share: f64,
-    /// Share of each joint's acceleration and jerk that the pure curvature terms |q''|v² and
-    /// |q'''|v³ may take on curved segments; it sets their speed cap (see [`segment_limits`]).
-    pub curvature_share: f64,
-    /// Share of the jerk left after |q'''|v³ that the cross term 3|q''|·v·a may take; it caps
-    /// the path acceleration on curved segments, and the rest drives the path jerk.
-    pub cross_share: f64,
     /// Share of each joint's acceleration and jerk kept back on segments next to a junction
     /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
     /// finite differences at the period (Δv/Ts² + Δa/Ts for the jerk).
@@ -58,8 +53,6 @@ impl Default for PlanOptions {
         PlanOptions {
             period: 0.001,
             chord_share: 0.5,
-            curvature_share: 0.5,
-            cross_share: 0.5,
             junction_reserve: 0.25,
             min_junction_share: 0.05,
             window: 64,
@@ -92,8 +85,6 @@ impl PlanOptions {
             });
         }
         unit("chord_share", self.chord_share, true)?;
-        unit("curvature_share", self.curvature_share, true)?;
-        unit("cross_share", self.cross_share, true)?;
         unit("junction_reserve", self.junction_reserve, false)?;
         unit("group_ratio", self.group_ratio, true)?;
         unit("min_junction_share", self.min_junction_share, false)?;
@@ -124,6 +115,29 @@ pub struct Geometry {
     pub d2_end: [f64; MAX_JOINTS],
     /// Largest curvature of the tip path, 1/mm.
     pub kappa_max: f64,
+    /// The same maxima in each of [`CELLS`] equal stretches of the segment's parameter:
+    /// `cells[c][i]` = (|q'|, |q''|, |q'''|) of joint i over stretch c (and one sample spacing
+    /// either side). The joint limits are then met point by point along the segment, not by
+    /// the worst of each derivative taken at different places (see [`segment_limits`]).
+    pub cells: Cells,
+}
+
+/// Per stretch of a segment and per joint, the largest (|q'|, |q''|, |q'''|).
+pub type Cells = [[[f64; 3]; MAX_JOINTS]; CELLS];
+
+/// Stretches a segment's derivative maxima are kept in ([`Geometry::cells`]).
+pub const CELLS: usize = 16;
+
+/// Raises the (|q'|, |q''|, |q'''|) maxima of joint `i` in the cells a sample at `f` ∈ [0, 1]
+/// along the segment bounds: its own and those within `df` (one sample spacing), since between
+/// two samples a derivative is bounded by theirs with a margin, on either side.
+fn raise(cells: &mut Cells, i: usize, f: f64, df: f64, d: [f64; 3]) {
+    let cell = |x: f64| ((x * CELLS as f64).floor().max(0.0) as usize).min(CELLS - 1);
+    for cell in &mut cells[cell(f - df)..=cell(f + df)] {
+        for (m, x) in cell[i].iter_mut().zip(d) {
+            *m = m.max(x);
+        }
+    }
 }
 
 impl Geometry {
@@ -176,6 +190,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
     let mut g1 = [0.0f64; 3];
     let mut g2 = [0.0f64; 3];
     let mut g3 = [0.0f64; 3];
+    let mut tip_cells: Cells = Default::default();
     if !rotary_only {
         let curve: &dyn Curve = &*seg.curve;
         let [t0, k0, _] = frame(curve, ua);
@@ -189,12 +204,25 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
         if straight {
             for i in 0..3 {
                 g1[i] = t0[i].abs().max(t1[i].abs()).max(tm[i].abs());
+                for cell in tip_cells.iter_mut() {
+                    cell[i][0] = g1[i];
+                }
             }
         } else {
             // Enough samples that the turning between two is small (≤ ~0.1 rad on arcs):
             // a sampled sinusoid then misses its peak by < 0.1 % (|q'| by ~(0.1)²/8 = 0.13 %);
             // the 1.005 and 1.05 below cover it and the change between samples.
-            let turning = (k0.norm().max(k1.norm()).max(km.norm())) * seg.length;
+            // The turning is estimated on a first coarse pass too: a curvature spike away
+            // from the ends and the middle (a tight bend inside a spline) needs the samples.
+            const COARSE: usize = 64;
+            let dc = (ub - ua) / COARSE as f64;
+            let coarse: f64 = (0..COARSE)
+                .map(|c| {
+                    let u = ua + dc * (c as f64 + 0.5);
+                    frame(curve, u)[1].norm() * curve.speed(u) * dc
+                })
+                .sum();
+            let turning = (k0.norm().max(k1.norm()).max(km.norm()) * seg.length).max(coarse);
             let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
             let du = (ub - ua) / samples as f64;
             // Per axis, the sample where |q''| and where |q'''| peak: the peak between samples
@@ -202,17 +230,43 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // or blend can fall between coarse samples).
             let mut peaks = [[0usize; 3]; 2];
             let mut best = [[0.0f64; 3]; 2];
-            let take = |u: f64, g1: &mut [f64; 3], g2: &mut [f64; 3], g3: &mut [f64; 3]| {
+            let df = 1.0 / samples as f64;
+            let take = |u: f64,
+                        g1: &mut [f64; 3],
+                        g2: &mut [f64; 3],
+                        g3: &mut [f64; 3],
+                        cells: &mut Cells| {
                 let [t, k, dk] = frame(curve, u);
+                let f = (u - ua) / (ub - ua);
+                // Half a sample spacing in arc length: between samples a derivative strays
+                // from its sampled value by at most that times the next derivative (the
+                // whole segment's maxima have the peak refinement below; a cell does not).
+                let h = 0.5 * curve.speed(u) * du;
                 for i in 0..3 {
-                    g1[i] = g1[i].max(t[i].abs() * 1.005);
-                    g2[i] = g2[i].max(k[i].abs() * 1.05);
-                    g3[i] = g3[i].max(dk[i].abs() * 1.05);
+                    let d = [t[i].abs() * 1.005, k[i].abs() * 1.05, dk[i].abs() * 1.05];
+                    g1[i] = g1[i].max(d[0]);
+                    g2[i] = g2[i].max(d[1]);
+                    g3[i] = g3[i].max(d[2]);
+                    let local = [
+                        (t[i].abs() + h * k[i].abs()) * 1.005,
+                        (k[i].abs() + h * dk[i].abs()) * 1.05,
+                        d[2],
+                    ];
+                    raise(cells, i, f, df, local);
                 }
-                (k, dk)
+                (t, k, dk)
             };
+            // |q'|, |q''|, |q'''| per axis at every sample, for the peaks between them.
+            let mut rows: Vec<[[f64; 3]; 3]> = Vec::with_capacity(samples + 1);
             for s in 0..=samples {
-                let (k, dk) = take(ua + du * s as f64, &mut g1, &mut g2, &mut g3);
+                let (t, k, dk) = take(
+                    ua + du * s as f64,
+                    &mut g1,
+                    &mut g2,
+                    &mut g3,
+                    &mut tip_cells,
+                );
+                rows.push([0, 1, 2].map(|i| [t[i].abs(), k[i].abs(), dk[i].abs()]));
                 g.kappa_max = g.kappa_max.max(k.norm());
                 for i in 0..3 {
                     for (d, x) in [k[i].abs(), dk[i].abs()].into_iter().enumerate() {
@@ -221,6 +275,22 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                             peaks[d][i] = s;
                         }
                     }
+                }
+            }
+            // A cell's peak between two samples: the vertex of the parabola through a local
+            // maximum and its neighbours (the whole segment's peak is refined below too).
+            for s in 1..samples {
+                let (before, here, after) = (&rows[s - 1], &rows[s], &rows[s + 1]);
+                for i in 0..3 {
+                    let mut d = [0.0; 3];
+                    for (o, x) in d.iter_mut().enumerate() {
+                        let (a, b, c) = (before[i][o], here[i][o], after[i][o]);
+                        let bend = 2.0 * b - a - c;
+                        if b >= a && b >= c && bend > 0.0 {
+                            *x = (b + (c - a) * (c - a) / (8.0 * bend)) * [1.01, 1.06, 1.06][o];
+                        }
+                    }
+                    raise(&mut tip_cells, i, s as f64 * df, df, d);
                 }
             }
             const FINE: usize = 16;
@@ -233,19 +303,42 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 })
                 .map(|(d, i)| peaks[d][i])
                 .collect();
+            // And every other local peak of |q''| or |q'''| within half of the largest: a
+            // narrow spike sampled off its top may hide a higher peak than the one sampled
+            // highest.
+            for s in 1..samples {
+                for i in 0..3 {
+                    for o in 1..3 {
+                        let (a, b, c) = (rows[s - 1][i][o], rows[s][i][o], rows[s + 1][i][o]);
+                        if b >= a && b >= c && b >= 0.5 * best[o - 1][i] && b > 0.0 {
+                            around.push(s);
+                        }
+                    }
+                }
+            }
             around.sort_unstable();
             around.dedup();
+            // Each window is narrowed around its highest |q'''| (relative to the largest
+            // sampled) a few times over: a spike narrower than a fine step is still found.
+            const NARROWINGS: usize = 3;
             for s in &around {
-                let lo = ua + du * (*s as f64 - 1.0).max(0.0);
-                let hi = (ua + du * (*s as f64 + 1.0)).min(ub);
-                for f in 1..FINE {
-                    let (k, _) = take(
-                        lo + (hi - lo) * f as f64 / FINE as f64,
-                        &mut g1,
-                        &mut g2,
-                        &mut g3,
-                    );
-                    g.kappa_max = g.kappa_max.max(k.norm());
+                let mut lo = ua + du * (*s as f64 - 1.0).max(0.0);
+                let mut hi = (ua + du * (*s as f64 + 1.0)).min(ub);
+                for _ in 0..NARROWINGS {
+                    let mut top = (f64::NEG_INFINITY, lo);
+                    for f in 1..FINE {
+                        let u = lo + (hi - lo) * f as f64 / FINE as f64;
+                        let (_, k, dk) = take(u, &mut g1, &mut g2, &mut g3, &mut tip_cells);
+                        g.kappa_max = g.kappa_max.max(k.norm());
+                        let level = (0..3)
+                            .map(|i| dk[i].abs() / best[1][i].max(1e-300))
+                            .fold(0.0, f64::max);
+                        if level > top.0 {
+                            top = (level, u);
+                        }
+                    }
+                    let step = (hi - lo) / FINE as f64;
+                    (lo, hi) = ((top.1 - step).max(ua), (top.1 + step).min(ub));
                 }
             }
         }
@@ -264,10 +357,16 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 g.d1_end[j] = tip_d1_end[i];
                 g.d2_start[j] = tip_d2_start[i];
                 g.d2_end[j] = tip_d2_end[i];
+                for (cell, tip) in g.cells.iter_mut().zip(&tip_cells) {
+                    cell[j] = tip[i];
+                }
             }
             JointMap::Rotary(k) => {
                 let r = rot_rate(k);
                 g.g1[j] = r.abs();
+                for cell in g.cells.iter_mut() {
+                    cell[j] = [r.abs(), 0.0, 0.0];
+                }
                 g.d1_start[j] = r;
                 g.d1_end[j] = r;
             }
@@ -377,14 +476,37 @@ fn numeric_joints(
         let mut g1: f64 = 0.0;
         let mut g2: f64 = 0.0;
         let mut g3: f64 = 0.0;
+        // Each difference also raises the cells of its stretch, with the margins below.
+        let df = 1.0 / m as f64;
+        let at = |k: f64| k / m as f64;
+        let cells = &mut g.cells;
+        // Second differences at every inner step (the ends take their neighbour's): they
+        // bound how far q' strays from a first difference within its step, h/2·|q''|.
+        let second = |k: usize| {
+            let k = k.clamp(1, m - 1);
+            ((x(k + 1) - 2.0 * x(k) + x(k - 1)) / (h * h)).abs()
+        };
         for k in 0..m {
-            g1 = g1.max(((x(k + 1) - x(k)) / h).abs());
+            let d = ((x(k + 1) - x(k)) / h).abs();
+            g1 = g1.max(d);
+            let stray = 0.5 * h * second(k).max(second(k + 1));
+            raise(
+                cells,
+                i,
+                at(k as f64 + 0.5),
+                df,
+                [(d + stray) * 1.01, 0.0, 0.0],
+            );
         }
         for k in 1..m {
-            g2 = g2.max(((x(k + 1) - 2.0 * x(k) + x(k - 1)) / (h * h)).abs());
+            let d = second(k);
+            g2 = g2.max(d);
+            raise(cells, i, at(k as f64), df, [0.0, d * 1.1, 0.0]);
         }
         for k in 1..m - 1 {
-            g3 = g3.max(((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs());
+            let d = ((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs();
+            g3 = g3.max(d);
+            raise(cells, i, at(k as f64 + 0.5), df, [0.0, 0.0, d * 1.2]);
         }
         // q''' is largest at an end of a blend (its curvature rises from the straight line's
         // zero at a finite rate there): one-sided second-order formulas, which the central
@@ -399,6 +521,19 @@ fn numeric_joints(
         g.d1_end[i] = (3.0 * x(m) - 4.0 * x(m - 1) + x(m - 2)) / (2.0 * h);
         g.d2_start[i] = (2.0 * x(0) - 5.0 * x(1) + 4.0 * x(2) - x(3)) / (h * h);
         g.d2_end[i] = (2.0 * x(m) - 5.0 * x(m - 1) + 4.0 * x(m - 2) - x(m - 3)) / (h * h);
+        let ends = [
+            (0.0, g.d1_start[i], g.d2_start[i], d3_start),
+            (1.0, g.d1_end[i], g.d2_end[i], d3_end),
+        ];
+        for (f, d1, d2, d3) in ends {
+            raise(
+                &mut g.cells,
+                i,
+                f,
+                df,
+                [d1.abs() * 1.01, d2.abs() * 1.1, d3.abs() * 1.2],
+            );
+        }
         g.g1[i] = g1.max(g.d1_start[i].abs()).max(g.d1_end[i].abs()) * 1.01;
         g.g2[i] = g2.max(g.d2_start[i].abs()).max(g.d2_end[i].abs()) * 1.1;
         g.g3[i] = g3 * 1.2;
@@ -428,20 +563,24 @@ pub enum LimitedBy {
 /// Speed, acceleration and jerk of the path profile on `seg` (see the module doc). `reserve`
 /// keeps [`PlanOptions::junction_reserve`] of the joint budgets back for junction jumps.
 ///
-/// On a curved segment V, A and J are chosen jointly so that for every joint i (budget b)
-///   g1ᵢ·V ≤ Vᵢ,   g2ᵢV² + g1ᵢA ≤ b·Aᵢ,   g3ᵢV³ + 3g2ᵢ·V·A + g1ᵢJ ≤ b·Jᵢ:
-/// 1. the speed cap takes only the pure curvature terms, each within its share c
-///    ([`PlanOptions::curvature_share`]): V ≤ √(c·b·Aᵢ/g2ᵢ), V ≤ ∛(c·b·Jᵢ/g3ᵢ) (ref 000
-///    §2.5–2.8, v ≤ √(A/κ) and v ≤ (J/κ²)^⅓ per joint);
-/// 2. at the speed finally chosen (feed, chord error and joint speed may lower it) the jerk
-///    left, Rᵢ = b·Jᵢ − g3ᵢV³ ≥ (1 − c)·b·Jᵢ, is shared between the cross term and the path
-///    jerk: A ≤ x·Rᵢ/(3g2ᵢV) with x = [`PlanOptions::cross_share`], and A ≤ (b·Aᵢ − g2ᵢV²)/g1ᵢ;
-/// 3. J takes what is left: J = minᵢ (Rᵢ − 3g2ᵢ·V·A)/g1ᵢ ≥ (1 − x)·Rᵢ/g1ᵢ.
+/// The profile's (v, a, j) stay in the box |v| ≤ V, |a| ≤ A, |j| ≤ J, so V, A and J are chosen
+/// together such that at every point of the segment (each of its [`Geometry::cells`]) and for
+/// every joint i (budget b):
+///   |q'|·V ≤ Vᵢ,   |q''|V² + |q'|A ≤ b·Aᵢ,   |q'''|V³ + 3|q''|·V·A + |q'|J ≤ b·Jᵢ.
+/// The constraints are met point by point: where a joint's slope peaks its curvature term is
+/// usually small, and the other way round, so the budget left for A and J is the least over
+/// the points, not the worst slope times the worst curvature.
 ///
-/// The cross term is thus paid by a lower path acceleration where the curvature is high, not
-/// by a lower speed: charging it at a fixed A (as a speed cap) made tight corner blends
-/// (g2 ≈ 1/r large) crawl at ~0.07 mm/s, while their speed need only obey √(A/κ) and ∛(J/κ²).
-/// A tight blend is then driven at nearly constant speed, which is what the jerk allows there.
+/// On a curved segment the speed at which a = j = 0 just fits, the least over the segment of
+/// √(b·Aᵢ/|q''|) and ∛(b·Jᵢ/|q'''|) (ref 000 §2.5–2.8, v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint; the
+/// maximum-velocity curve of the phase plane, Bobrow et al. 1985), leaves nothing to change
+/// speed with. No fixed share of the budget is set aside: among speeds V = β·V_top (V_top the
+/// least of that curve, the feed, the joints' speeds and the chord error), and accelerations up
+/// to what is left, [`best_split`] takes the (V, A, J) that would cover a reference stretch
+/// fastest, ramps to and from it included. A long arc or helix thus runs close to its
+/// curvature limit, and a short stretch between speed changes keeps more for its ramps.
+/// The cross term 3|q''|·V·A is paid by the path acceleration, not by the speed: charging it
+/// at a fixed A (as a speed cap) made tight corner blends crawl.
 pub fn segment_limits(
     seg: &Segment,
     geom: &Geometry,
@@ -482,15 +621,14 @@ pub fn segment_limits_at_feed(
         }
     }
     if curved {
-        let c = options.curvature_share * budget;
         let mut vc = f64::INFINITY;
         for i in 0..n {
             let (g2, g3) = (geom.g2[i], geom.g3[i]);
             if g2 > 0.0 {
-                vc = vc.min((c * machine.max_acceleration[i] / g2).sqrt());
+                vc = vc.min((budget * machine.max_acceleration[i] / g2).sqrt());
             }
             if g3 > 0.0 {
-                vc = vc.min((c * machine.max_jerk[i] / g3).cbrt());
+                vc = vc.min((budget * machine.max_jerk[i] / g3).cbrt());
             }
         }
         if vc < v {
@@ -526,27 +664,18 @@ pub fn segment_limits_at_feed(
         by = LimitedBy::Idle;
     }
     if curved && v.is_finite() {
-        // Steps 2 and 3 of the doc above, at the speed finally chosen.
-        let x = options.cross_share;
-        for i in 0..n {
-            let (g1, g2) = (geom.g1[i], geom.g2[i]);
-            let rest = budget * machine.max_jerk[i] - geom.g3[i] * v * v * v;
-            if g1 > 0.0 {
-                a = a.min((budget * machine.max_acceleration[i] - g2 * v * v) / g1);
-            }
-            if g2 > 0.0 && v > 0.0 {
-                a = a.min(x * rest / (3.0 * g2 * v));
-            }
-        }
-        for i in 0..n {
-            let g1 = geom.g1[i];
-            if g1 > 0.0 {
-                let rest = budget * machine.max_jerk[i]
-                    - geom.g3[i] * v * v * v
-                    - 3.0 * geom.g2[i] * v * a;
-                j = j.min(rest / g1);
-            }
-        }
+        let budgets = Budgets {
+            cells: &geom.cells,
+            acceleration: std::array::from_fn(|i| {
+                budget * machine.max_acceleration.get(i).copied().unwrap_or(0.0)
+            }),
+            jerk: std::array::from_fn(|i| budget * machine.max_jerk.get(i).copied().unwrap_or(0.0)),
+            n,
+        };
+        (v, a, j) = best_split(v, geom.length, &budgets).ok_or_else(|| PlanError::NoLimit {
+            line: seg.line,
+            reason: "no acceleration is left at any speed".into(),
+        })?;
     }
     if !a.is_finite() {
         a = options.idle_rotary[1];
@@ -559,6 +688,172 @@ pub fn segment_limits_at_feed(
         reason: e.to_string(),
     })?;
     Ok(SegmentLimits { limits, by })
+}
+
+/// The joint budgets of a curved segment, point by point.
+struct Budgets<'a> {
+    cells: &'a Cells,
+    /// b·Aᵢ and b·Jᵢ per joint.
+    acceleration: [f64; MAX_JOINTS],
+    jerk: [f64; MAX_JOINTS],
+    n: usize,
+}
+
+/// Fractions of the top speed [`best_split`] tries (a speed just under the curvature limit
+/// leaves almost no acceleration; the finest steps are near 1, where a long arc runs).
+const SPEED_FRACTIONS: [f64; 14] = [
+    1.0, 0.995, 0.99, 0.98, 0.97, 0.95, 0.92, 0.9, 0.85, 0.8, 0.7, 0.6, 0.45, 0.3,
+];
+/// Fractions of the acceleration left at a speed that [`best_split`] tries (the rest of the
+/// jerk budget then goes to the path jerk through the cross term 3|q''|·V·A).
+const ACCEL_FRACTIONS: [f64; 5] = [1.0, 0.7, 0.45, 0.25, 0.1];
+/// Shortest stretch the choice is made for, mm: neighbouring segments of like limits share
+/// one profile (the look-ahead's groups), so a short segment is timed as part of a longer run.
+const REFERENCE_LENGTH: f64 = 20.0;
+/// Speed change, as a share of the speed, assumed at each end of the reference stretch.
+const REFERENCE_CHANGE: f64 = 0.1;
+
+/// The (V, A, J) that covers a reference stretch fastest: V ≤ `top`, and for V and A every
+/// point and joint within its budgets (see [`segment_limits`]). The time is the cruise L/V
+/// plus, at each end, what a jerk-limited ramp of `REFERENCE_CHANGE`·V costs over cruising
+/// (half its duration times the change's share of V). `None` if no speed leaves room for
+/// acceleration.
+fn best_split(top: f64, length: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
+    let reference = length.max(REFERENCE_LENGTH);
+    let mut best: Option<(f64, (f64, f64, f64))> = None;
+    for beta in SPEED_FRACTIONS {
+        let v = beta * top;
+        if let Some((a, j, ramp)) = at_speed(v, REFERENCE_CHANGE * v, budgets) {
+            let time = reference / v + ramp * REFERENCE_CHANGE;
+            if best.is_none_or(|(t, _)| time < t) {
+                best = Some((time, (v, a, j)));
+            }
+        }
+    }
+    best.map(|(_, x)| x)
+}
+
+/// At path speed `v`, the (A, J) within every point's budgets that changes the speed by `dv`
+/// fastest, with that ramp's duration: A takes a share of what the acceleration and the jerk
+/// (through the cross term 3|q''|·v·A) leave, J the rest of the jerk. `None` if nothing is left.
+fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
+    let mut a_cap = f64::INFINITY;
+    for cell in budgets.cells {
+        for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
+            let rest_a = budgets.acceleration[i] - g2 * v * v;
+            let rest_j = budgets.jerk[i] - g3 * v * v * v;
+            if rest_a < 0.0 || rest_j < 0.0 {
+                a_cap = 0.0;
+            }
+            if g1 > 0.0 {
+                a_cap = a_cap.min(rest_a / g1);
+            }
+            if g2 > 0.0 {
+                a_cap = a_cap.min(rest_j / (3.0 * g2 * v));
+            }
+        }
+    }
+    if !(a_cap > 0.0 && a_cap.is_finite()) {
+        return None;
+    }
+    let mut best: Option<(f64, f64, f64)> = None;
+    for alpha in ACCEL_FRACTIONS {
+        let a = alpha * a_cap;
+        let mut j = f64::INFINITY;
+        for cell in budgets.cells {
+            for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
+                if g1 > 0.0 {
+                    let rest = budgets.jerk[i] - g3 * v * v * v - 3.0 * g2 * v * a;
+                    j = j.min(rest / g1);
+                }
+            }
+        }
+        if !(j > 0.0 && j.is_finite()) {
+            continue;
+        }
+        let ramp = if dv * j >= a * a {
+            dv / a + a / j
+        } else {
+            2.0 * (dv / j).sqrt()
+        };
+        if best.is_none_or(|(_, _, t)| ramp < t) {
+            best = Some((a, j, ramp));
+        }
+    }
+    best
+}
+
+/// Speeds, as shares of a curved segment's cruise speed, of the steps [`ladder`] climbs by.
+const LADDER: [f64; 3] = [0.55, 0.75, 0.9];
+/// A step is kept only where it accelerates at least this many times faster than the cruise.
+const LADDER_GAIN: f64 = 2.0;
+/// A step must rise at least this share above the speed it starts from.
+const LADDER_STEP: f64 = 0.05;
+/// The steps at both ends together take at most this share of the segment.
+const LADDER_SHARE: f64 = 0.5;
+
+/// The speed steps of one end of a long curved segment entered or left at `from` (the cap
+/// of its junction there), slowest first, as (length, limits): the
+/// phase-plane's acceleration limit falls as the speed rises (what the curvature leaves,
+/// |q''|v², is less at low speed), and one profile's constant A is what is left at its top
+/// speed. A segment entered or left slowly (a helix after a corner) would climb to its cruise
+/// at that smallest A; instead its ends are cut into steps, each timed with the acceleration
+/// its own top speed leaves: a staircase under the maximum-acceleration curve of Bobrow,
+/// Dubowsky & Gibson (1985) and Shin & McKay (1985), each stair a jerk-limited profile. The
+/// look-ahead passes the steps like any segments. Empty where the steps do not pay.
+pub fn ladder(
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+    cruise: &Limits,
+    from: f64,
+) -> Vec<(f64, Limits)> {
+    if !geom.curved() || geom.rotary_only {
+        return vec![];
+    }
+    let budget = if reserve {
+        1.0 - options.junction_reserve
+    } else {
+        1.0
+    };
+    let budgets = Budgets {
+        cells: &geom.cells,
+        acceleration: std::array::from_fn(|i| {
+            budget * machine.max_acceleration.get(i).copied().unwrap_or(0.0)
+        }),
+        jerk: std::array::from_fn(|i| budget * machine.max_jerk.get(i).copied().unwrap_or(0.0)),
+        n: machine.joint_count().min(MAX_JOINTS),
+    };
+    let top = cruise.max_velocity();
+    let mut steps = vec![];
+    let mut from = from.max(0.0);
+    let mut used = 0.0;
+    for share in LADDER {
+        let v = share * top;
+        if v <= from * (1.0 + LADDER_STEP) {
+            continue;
+        }
+        let Some((a, j, _)) = at_speed(v, v - from, &budgets) else {
+            continue;
+        };
+        if a < LADDER_GAIN * cruise.max_acceleration() {
+            continue;
+        }
+        let Ok(limits) = Limits::new(v, a, j) else {
+            continue;
+        };
+        let Ok(d) = crate::profile::speed_change_distance(from, v, &limits) else {
+            continue;
+        };
+        used += d;
+        steps.push((d, limits));
+        from = v;
+    }
+    if steps.is_empty() || used > 0.5 * LADDER_SHARE * geom.length {
+        return vec![];
+    }
+    steps
 }
 
 /// The highest speed at a junction where the joints' path derivatives jump from `a` (end of the

@@ -13,29 +13,44 @@ use std::sync::Arc;
 
 use super::joints::PlanMachine;
 use super::limits::{
-    analyse, has_jump, inside_group, junction_cap, segment_limits, Geometry, PlanOptions,
+    analyse, has_jump, inside_group, junction_cap, ladder, segment_limits, Geometry, PlanOptions,
     SegmentLimits,
 };
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
 use crate::profile::{max_reachable_speed, max_start_speed, solve, solve_at_most, Limits, Profile};
 
-/// A timed group of segments.
+/// A timed group of segments. The first may be entered, and the last left, part way along
+/// (a long curved segment's speed steps, [`ladder`]): a segment's own path coordinate is the
+/// piece's minus its offset.
 #[derive(Debug, Clone)]
 pub struct Piece {
     pub segments: Vec<Arc<Segment>>,
-    /// Path coordinate where each segment starts, from 0 at the piece's start.
+    /// Piece path coordinate where each segment's own coordinate is 0 (negative for a first
+    /// segment entered part way), from 0 at the piece's start.
     pub offsets: Vec<f64>,
-    /// Path coordinate length of each segment (mm, or degrees for a rotary-only move).
+    /// Each segment's own path coordinate where the piece leaves it: its length (mm, or
+    /// degrees for a rotary-only move), or less for a last segment left part way.
     pub lengths: Vec<f64>,
     pub profile: Profile,
     pub limits: Limits,
+    /// Whether the piece ends before its last segment does.
+    pub partial_end: bool,
 }
 
 impl Piece {
     /// Total path length.
     pub fn length(&self) -> f64 {
         self.offsets.last().copied().unwrap_or(0.0) + self.lengths.last().copied().unwrap_or(0.0)
+    }
+
+    /// What joins the piece to the next: its last segment's end junction, or smooth where
+    /// the piece ends part way along it.
+    pub fn end_junction(&self) -> Junction {
+        match self.segments.last() {
+            Some(s) if !self.partial_end => s.end,
+            _ => Junction::Smooth,
+        }
     }
 }
 
@@ -49,8 +64,11 @@ pub enum Planned {
 
 struct Group {
     segments: Vec<Arc<Segment>>,
-    lengths: Vec<f64>,
+    /// Each segment's own path coordinate where the group enters and leaves it.
+    starts: Vec<f64>,
+    ends: Vec<f64>,
     length: f64,
+    partial_end: bool,
     limits: Limits,
     end_cap: f64,
     /// Highest entry speed from which the rest of the window can still stop (backward pass):
@@ -69,7 +87,10 @@ enum Entry {
 
 struct Open {
     segments: Vec<Arc<Segment>>,
-    lengths: Vec<f64>,
+    starts: Vec<f64>,
+    ends: Vec<f64>,
+    /// Whether the last segment is left part way (a speed step follows on it).
+    partial_end: bool,
     v: f64,
     a: f64,
     j: f64,
@@ -83,6 +104,9 @@ struct Held {
     geom: Geometry,
     /// A jump at its start costs it a jerk reserve.
     jump: bool,
+    /// The most it can be entered at: the cap of the junction at its start and the previous
+    /// segment's own speed limit (0 after a rest).
+    start_cap: f64,
     /// Its limits without a reserve, once computed (a junction check needs them, and `add`
     /// can reuse them when no reserve is kept).
     free: Option<SegmentLimits>,
@@ -163,10 +187,12 @@ impl Planner {
             return Ok(());
         }
         let mut free = None;
-        let start_jump = match self.pending.take() {
+        let (start_jump, start_cap) = match self.pending.take() {
             Some(mut held) => {
-                let (cap, jump) = match held.seg.end {
-                    Junction::Corner | Junction::Stop => (0.0, false),
+                // The junction's cap, whether it jumps, and the slower of the two segments'
+                // speed limits there (how fast the junction can be passed at most).
+                let (cap, jump, through) = match held.seg.end {
+                    Junction::Corner | Junction::Stop => (0.0, false, 0.0),
                     Junction::Tangent | Junction::Smooth => {
                         let cap = junction_cap(&held.geom, &geom, &self.machine, &self.options);
                         let jump = has_jump(&held.geom, &geom, &self.machine);
@@ -179,28 +205,29 @@ impl Planner {
                         let after = self.free_limits(&seg, &geom)?;
                         held.free = Some(before);
                         free = Some(after);
-                        let floor = self.options.min_junction_share
-                            * before
-                                .limits
-                                .max_velocity()
-                                .min(after.limits.max_velocity());
+                        let slower = before
+                            .limits
+                            .max_velocity()
+                            .min(after.limits.max_velocity());
+                        let floor = self.options.min_junction_share * slower;
                         if jump && cap < floor {
-                            (0.0, false)
+                            (0.0, false, 0.0)
                         } else {
-                            (cap, jump)
+                            (cap, jump, cap.min(slower))
                         }
                     }
                 };
                 let reserve = held.jump || jump;
-                self.add(held, reserve, cap)?;
-                jump
+                self.add(held, reserve, cap, through)?;
+                (jump, through)
             }
-            None => false,
+            None => (false, 0.0),
         };
         self.pending = Some(Held {
             seg,
             geom,
             jump: start_jump,
+            start_cap,
             free,
         });
         Ok(())
@@ -210,7 +237,7 @@ impl Planner {
     fn end_here(&mut self) -> Result<(), PlanError> {
         if let Some(held) = self.pending.take() {
             let reserve = held.jump;
-            self.add(held, reserve, 0.0)?;
+            self.add(held, reserve, 0.0, 0.0)?;
         }
         if let Some(open) = self.open.take() {
             self.close(open, 0.0)?;
@@ -223,14 +250,88 @@ impl Planner {
         segment_limits(seg, geom, &self.machine, &self.options, false)
     }
 
-    fn add(&mut self, held: Held, reserve: bool, end_cap: f64) -> Result<(), PlanError> {
+    /// Adds the held segment, `end_cap` the cap of its end junction and `end_speed` the most
+    /// it can be left at (the cap, and the next segment's own limit).
+    fn add(
+        &mut self,
+        held: Held,
+        reserve: bool,
+        end_cap: f64,
+        end_speed: f64,
+    ) -> Result<(), PlanError> {
         let Held {
-            seg, geom, free, ..
+            seg,
+            geom,
+            free,
+            start_cap,
+            ..
         } = held;
         let sl = match free {
             Some(l) if !reserve => l,
             _ => segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?,
         };
+        let step = |from| {
+            ladder(
+                &geom,
+                &self.machine,
+                &self.options,
+                reserve,
+                &sl.limits,
+                from,
+            )
+        };
+        let (up, down) = (step(start_cap), step(end_speed));
+        let seg = Arc::new(seg);
+        if up.is_empty() && down.is_empty() {
+            return self.add_span(seg, (0.0, geom.length), geom, sl, end_cap);
+        }
+        // Speed steps up at the start, the cruise, steps down at the end; each is a group of
+        // its own (joined, they would share the smallest acceleration again).
+        let climb: f64 = up.iter().chain(&down).map(|s| s.0).sum();
+        let mut spans: Vec<(f64, Limits)> = up;
+        spans.push((geom.length - climb, sl.limits));
+        spans.extend(down.iter().rev().copied());
+        let mut at = 0.0;
+        let last = spans.len() - 1;
+        for (k, (d, limits)) in spans.into_iter().enumerate() {
+            let end = if k == last { geom.length } else { at + d };
+            let cap = if k == last { end_cap } else { f64::INFINITY };
+            if let Some(o) = self.open.take() {
+                let cap = o.last_end_cap;
+                self.close(o, cap)?;
+            }
+            self.open = Some(Open {
+                segments: vec![seg.clone()],
+                starts: vec![at],
+                ends: vec![end],
+                partial_end: k != last,
+                v: limits.max_velocity(),
+                a: limits.max_acceleration(),
+                j: limits.max_jerk(),
+                last: geom,
+                last_end_cap: cap,
+            });
+            at = end;
+        }
+        // The last step ends the segment: the next may join it only as any segment would.
+        if end_cap <= 0.0 {
+            if let Some(o) = self.open.take() {
+                self.close(o, 0.0)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds the stretch `range` of a segment (its own path coordinate) to the open group, or
+    /// closes that group and opens a new one.
+    fn add_span(
+        &mut self,
+        seg: Arc<Segment>,
+        range: (f64, f64),
+        geom: Geometry,
+        sl: SegmentLimits,
+        end_cap: f64,
+    ) -> Result<(), PlanError> {
         let (v, a, j) = (
             sl.limits.max_velocity(),
             sl.limits.max_acceleration(),
@@ -247,15 +348,14 @@ impl Planner {
                 && close(o.j, j, o.j.min(j))
                 && inside_group(&o.last, &geom, o.a.max(a), &self.machine, &self.options)
         };
-        let len = geom.length;
-        let seg = Arc::new(seg);
         match self.open.take() {
-            Some(mut o) if joins(&o) => {
+            Some(mut o) if joins(&o) && !o.partial_end => {
                 o.v = o.v.min(v).min(o.last_end_cap);
                 o.a = o.a.min(a);
                 o.j = o.j.min(j);
                 o.segments.push(seg);
-                o.lengths.push(len);
+                o.starts.push(range.0);
+                o.ends.push(range.1);
                 o.last = geom;
                 o.last_end_cap = end_cap;
                 self.open = Some(o);
@@ -267,7 +367,9 @@ impl Planner {
                 }
                 self.open = Some(Open {
                     segments: vec![seg],
-                    lengths: vec![len],
+                    starts: vec![range.0],
+                    ends: vec![range.1],
+                    partial_end: false,
                     v,
                     a,
                     j,
@@ -290,11 +392,13 @@ impl Planner {
             line,
             reason: e.to_string(),
         })?;
-        let length = o.lengths.iter().sum();
+        let length = o.starts.iter().zip(&o.ends).map(|(a, b)| b - a).sum();
         self.window.push_back(Entry::Group(Group {
             segments: o.segments,
-            lengths: o.lengths,
+            starts: o.starts,
+            ends: o.ends,
             length,
+            partial_end: o.partial_end,
             limits,
             end_cap,
             backward: f64::NAN,
@@ -387,18 +491,19 @@ impl Planner {
             Err(_) => solve_at_most(g.length, v0, cap.min(next_start), &g.limits).map_err(err)?,
         };
         self.v_start = profile.end().v.max(0.0);
-        let mut offsets = Vec::with_capacity(g.lengths.len());
+        let mut offsets = Vec::with_capacity(g.starts.len());
         let mut acc = 0.0;
-        for l in &g.lengths {
-            offsets.push(acc);
-            acc += l;
+        for (a, b) in g.starts.iter().zip(&g.ends) {
+            offsets.push(acc - a);
+            acc += b - a;
         }
         self.out.push_back(Planned::Motion(Box::new(Piece {
             segments: g.segments,
             offsets,
-            lengths: g.lengths,
+            lengths: g.ends,
             profile,
             limits: g.limits,
+            partial_end: g.partial_end,
         })));
         Ok(())
     }

@@ -252,14 +252,20 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     if !phi.is_finite() {
         return Err(NoBlend::Corner);
     }
-    if phi < TANGENT_ANGLE {
+    let tangent = phi < TANGENT_ANGLE;
+    let jump = (ka - kb).norm();
+    if tangent {
         let scale = ka.norm().max(kb.norm());
-        let same = (ka - kb).norm() <= 1e-9 * scale.max(1e-300) || scale == 0.0;
-        return Err(NoBlend::Tangent {
-            same_curvature: same,
-        });
-    }
-    if phi > max_angle {
+        let same = jump <= 1e-9 * scale.max(1e-300) || scale == 0.0;
+        // A curvature jump (a line into a tangent arc) is an acceleration step at any speed:
+        // seen at the period it is a jerk of v²·Δκ/Ts, which only a crawl keeps within the
+        // limits. Where the program allows a deviation, the jump is spread over a G2 blend.
+        if same || max_angle <= 0.0 {
+            return Err(NoBlend::Tangent {
+                same_curvature: same,
+            });
+        }
+    } else if phi > max_angle {
         return Err(NoBlend::Corner);
     }
     let half = (0.5 * phi).sin();
@@ -271,13 +277,28 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     let room_b = room_b.min(b.s_at(b.u1) - b.s_at(b.u0));
     // A hair below the tolerance-exact leg: at exactly 8ε/(3 sin(φ/2)) the closed-form
     // deviation rounds to either side of ε, and a rounding up halved the leg.
-    let mut leg = (8.0 * share / (3.0 * half) * (1.0 - 1e-12))
-        .min(room_a)
-        .min(room_b);
+    let ideal = if tangent {
+        // A clothoid that takes the curvature from κa to κb over a length L lies ~L²·Δκ/24
+        // off the two curves it replaces (the shift of a transition curve, Meek & Walton
+        // 1992); the blend spans about 2·leg.
+        0.5 * (24.0 * share / jump).sqrt()
+    } else {
+        8.0 * share / (3.0 * half) * (1.0 - 1e-12)
+    };
+    let mut leg = ideal.min(room_a).min(room_b);
+    let refuse = || {
+        if tangent {
+            NoBlend::Tangent {
+                same_curvature: false,
+            }
+        } else {
+            NoBlend::Corner
+        }
+    };
     if !(leg > 0.0 && leg.is_finite()) {
-        return Err(NoBlend::Corner);
+        return Err(refuse());
     }
-    let both_lines = matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
+    let both_lines = !tangent && matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
     let corner = a.geo.point(a.geo.domain().1);
     for _ in 0..=LEG_HALVINGS {
         let ua = a.u_at(a.full_length - leg);
@@ -285,7 +306,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         let (pa, pb) = (a.geo.point(ua), b.geo.point(ub));
         let (fa, fb) = match (a.frame(ua), b.frame(ub)) {
             (Some(fa), Some(fb)) => (fa, fb),
-            _ => return Err(NoBlend::Corner),
+            _ => return Err(refuse()),
         };
         let lam = 2.0 * leg;
         let curve = Blend::g2(
@@ -302,7 +323,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
                 speed: lam,
             },
         )
-        .ok_or(NoBlend::Corner)?;
+        .ok_or_else(refuse)?;
         let deviation = if both_lines {
             // Closed form (reference 004 §2.5): the corner's distance to the blend.
             0.375 * leg * half
@@ -324,7 +345,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
                 curve.arc_length()
             };
             if !(length > 0.0 && length.is_finite()) {
-                return Err(NoBlend::Corner);
+                return Err(refuse());
             }
             return Ok(Placed {
                 curve,
@@ -337,7 +358,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         }
         leg *= 0.5;
     }
-    Err(NoBlend::Corner)
+    Err(refuse())
 }
 
 /// The blend's largest distance from the pieces `a` over `ca` and `b` over `cb`, sampled and

@@ -564,7 +564,12 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         let mut placed =
             blend::place(&a, b, share, max_angle).map(|p| (self.orientation(&a, b, &p), p));
         if let Ok((None, _)) = &placed {
-            placed = Err(NoBlend::Corner);
+            // Without a blend the junction is what it is: a corner, or a tangent junction
+            // whose curvature jumps.
+            placed = Err(match blend::place(&a, b, share, 0.0) {
+                Err(e) => e,
+                Ok(_) => NoBlend::Corner,
+            });
             let mut s = share;
             for _ in 0..20 {
                 s *= 0.5;
