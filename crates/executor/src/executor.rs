@@ -12,7 +12,7 @@ use tezgah_gcode::interp::SubroutineLibrary;
 use tezgah_geom::{Move, MoveKind, Pose, StopKind, Vec3};
 use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
-use tezgah_motion::path::smooth::{SmoothOptions, CHORD_SHARE};
+use tezgah_motion::path::smooth::SmoothOptions;
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
 use tezgah_motion::{Junction, Limits, Segment};
 
@@ -70,7 +70,6 @@ impl ExecOptions {
             ),
             plan: PlanOptions {
                 period,
-                chord_share: CHORD_SHARE,
                 ..PlanOptions::default()
             },
         })

@@ -158,12 +158,16 @@ impl Executor {
         if x.v > piece.profile.end().v * (1.0 + SLACK) {
             return None;
         }
-        let (ga, gb) = (
-            analyse(last, &self.machine).ok()?,
-            analyse(head, &self.machine).ok()?,
-        );
-        if !inside_group(&ga, &gb, x.a.abs(), &self.machine, &self.options.plan) {
-            return None;
+        // A piece that ends part way along its segment (a speed step) meets the next inside
+        // that segment, where nothing jumps; elsewhere the joint velocities may step.
+        if !piece.partial_end {
+            let (ga, gb) = (
+                analyse(last, &self.machine).ok()?,
+                analyse(head, &self.machine).ok()?,
+            );
+            if !inside_group(&ga, &gb, x.a.abs(), &self.machine, &self.options.plan) {
+                return None;
+            }
         }
         let second = stop_under(&x, &next.limits)?;
         (second.distance() < next.length()).then_some((second, at))

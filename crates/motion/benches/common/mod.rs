@@ -102,7 +102,6 @@ pub fn smooth_items(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
 pub fn plan_options(machine: &Machine) -> PlanOptions {
     PlanOptions {
         period: machine.motion.period_s,
-        chord_share: smooth::CHORD_SHARE,
         ..PlanOptions::default()
     }
 }

@@ -28,7 +28,9 @@ pub struct PlanOptions {
     /// Interpolation period Ts, s.
     pub period: f64,
     /// Share of a segment's tolerance given to the chord error at the period (the rest is for
-    /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance.
+    /// smoothing); the chord limit is v ≤ (2/Ts)·√(2ρδ − δ²) with δ = share·tolerance. By
+    /// default what the smoother leaves ([`crate::path::smooth::CHORD_SHARE`]), so that the
+    /// two never add up to more than the tolerance.
     pub chord_share: f64,
     /// Share of each joint's acceleration and jerk kept back on segments next to a junction
     /// where the tangent or curvature jumps; the jump is then bounded by that share as seen by
@@ -52,7 +54,7 @@ impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions {
             period: 0.001,
-            chord_share: 0.5,
+            chord_share: crate::path::smooth::CHORD_SHARE,
             junction_reserve: 0.25,
             min_junction_share: 0.05,
             window: 64,
@@ -709,9 +711,9 @@ const SPEED_FRACTIONS: [f64; 14] = [
 const ACCEL_FRACTIONS: [f64; 5] = [1.0, 0.7, 0.45, 0.25, 0.1];
 /// Shortest stretch the choice is made for, mm: neighbouring segments of like limits share
 /// one profile (the look-ahead's groups), so a short segment is timed as part of a longer run.
-const REFERENCE_LENGTH: f64 = 20.0;
+const REFERENCE_LENGTH: f64 = 2.0;
 /// Speed change, as a share of the speed, assumed at each end of the reference stretch.
-const REFERENCE_CHANGE: f64 = 0.1;
+const REFERENCE_CHANGE: f64 = 0.25;
 
 /// The (V, A, J) that covers a reference stretch fastest: V ≤ `top`, and for V and A every
 /// point and joint within its budgets (see [`segment_limits`]). The time is the cruise L/V
