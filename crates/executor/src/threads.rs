@@ -10,6 +10,8 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use tezgah_geom::Move;
+
 use crate::command::{Command, RunState, Status};
 use crate::drive::Drive;
 use crate::error::ExecError;
@@ -178,6 +180,9 @@ pub struct Handle {
     requests: mpsc::Sender<Request>,
     /// The executor's status, refreshed by the planner thread.
     pub status: Arc<Mutex<Status>>,
+    /// The moves of the program loaded last (lines keyed as the status' lines), for a
+    /// front end's preview; set by the planner thread when a load succeeds.
+    pub program: Arc<Mutex<Option<Arc<Vec<Move>>>>>,
     quit: Arc<AtomicBool>,
     planner: JoinHandle<Lead>,
     rt: JoinHandle<(RtCounters, Jitter)>,
@@ -244,6 +249,8 @@ pub fn spawn<D: Drive + Send + 'static>(
         .expect("spawning the real-time thread");
     let q = quit.clone();
     let st = status.clone();
+    let program = Arc::new(Mutex::new(None));
+    let loaded = program.clone();
     let planner = std::thread::Builder::new()
         .name("tezgah-planner".into())
         .spawn(move || {
@@ -262,12 +269,22 @@ pub fn spawn<D: Drive + Send + 'static>(
                             | Command::Mdi { .. }
                             | Command::RestartFrom { .. }
                     );
+                    let load = matches!(c, Command::Load { .. });
                     let answer = if builds {
                         let fifo = planner_settings.fifo_priority;
                         realtime::time_shared(&granted, fifo, || side.command(c))
                     } else {
                         side.command(c)
                     };
+                    if load && answer.is_ok() {
+                        let moves = side
+                            .executor()
+                            .program_moves()
+                            .map(|m| Arc::new(m.to_vec()));
+                        if let Ok(mut p) = loaded.lock() {
+                            *p = moves;
+                        }
+                    }
                     let _ = reply.send(answer);
                 }
                 side.pump();
@@ -288,6 +305,7 @@ pub fn spawn<D: Drive + Send + 'static>(
     Handle {
         requests: rtx,
         status,
+        program,
         quit,
         planner,
         rt,
