@@ -7,6 +7,7 @@ mod cam;
 mod cam_tool;
 mod diagnostics;
 mod library;
+mod panel;
 mod plot;
 mod preview;
 mod run;

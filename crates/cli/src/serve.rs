@@ -1,6 +1,8 @@
-//! `tezgah serve`: the executor behind a WebSocket on localhost, so a panel or a script can
-//! drive the machine. Each text message in is one JSON command; each reply and the status
-//! stream go out as JSON (schema in the README). The executor runs on its own threads
+//! `tezgah serve`: the executor behind a WebSocket on localhost, so the panel (served on the
+//! same port, `crate::panel`) or a script can drive the machine. Each text message in is one
+//! JSON command; each reply, control change and the status stream go out as JSON (schema in
+//! the README). Who may connect is `crate::access`'s to say; of those connected, one drives
+//! and the others watch (`Control`). The executor runs on its own threads
 //! (`tezgah_executor::threads`); this module only carries messages.
 
 use std::io::ErrorKind;
@@ -221,6 +223,11 @@ fn session(stream: TcpStream, shared: &Shared) -> Result<(), String> {
     stream
         .set_read_timeout(Some(Duration::from_secs(10)))
         .map_err(|e| e.to_string())?;
+    // The panel's pages on the same port: anything but a WebSocket handshake.
+    let head = crate::panel::peek_head(&stream)?;
+    if !crate::panel::is_upgrade(&head) {
+        return crate::panel::respond(stream, &head, &shared.access);
+    }
     let check = |request: &HandshakeRequest, response: HandshakeResponse| {
         let header = |name: &str| request.headers().get(name).and_then(|v| v.to_str().ok());
         let target = request
@@ -247,8 +254,12 @@ fn session(stream: TcpStream, shared: &Shared) -> Result<(), String> {
     let config = WebSocketConfig::default()
         .max_message_size(Some(shared.max_message))
         .max_frame_size(Some(shared.max_message));
-    let mut ws = tungstenite::accept_hdr_with_config(stream, check, Some(config))
-        .map_err(|e| e.to_string())?;
+    let mut ws = match tungstenite::accept_hdr_with_config(stream, check, Some(config)) {
+        Ok(ws) => ws,
+        // A refusal was logged with its reason by `check`.
+        Err(tungstenite::HandshakeError::Failure(tungstenite::Error::Http(_))) => return Ok(()),
+        Err(e) => return Err(e.to_string()),
+    };
     // Reads wait at most a little, so the status stream keeps its pace.
     ws.get_mut()
         .set_read_timeout(Some(Duration::from_millis(5)))
