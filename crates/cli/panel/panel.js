@@ -171,6 +171,7 @@ function onStatus(s) {
   $('homed').className = `badge ${s.homed ? 'ok' : ''}`;
   $('underruns').textContent = s.underruns;
   $('time-scale').textContent = fmt(s.time_scale, 2);
+  $('late').textContent = `${Math.round(s.late_worst_s * 1e6)} µs` + (s.late_over_half ? ` (${s.late_over_half} over ½ period)` : '');
   $('alarm').hidden = !s.error;
   $('alarm').textContent = s.error ? `ALARM: ${s.error}` : '';
   // DRO.

@@ -228,6 +228,8 @@ fn session(stream: TcpStream, shared: &Shared) -> Result<(), String> {
     if !crate::panel::is_upgrade(&head) {
         return crate::panel::respond(stream, &head, &shared.access);
     }
+    // The refusal's type is tungstenite's (its `Callback` trait), large or not.
+    #[allow(clippy::result_large_err)]
     let check = |request: &HandshakeRequest, response: HandshakeResponse| {
         let header = |name: &str| request.headers().get(name).and_then(|v| v.to_str().ok());
         let target = request

@@ -172,6 +172,8 @@ fn panel_runs_the_machine_in_a_real_browser() {
         "MDI X5 in the zeroed frame is machine X 55",
         "the first page now watches",
         "no page errors",
+        "real-time lateness shown",
+        "fits a 768 px wide tablet",
     ] {
         assert!(
             out.contains(&format!("ok: {check}")),

@@ -77,7 +77,7 @@ fn launch(extra: &[&str]) -> (Server, Banner) {
 }
 
 /// A handshake request to `url` with extra headers.
-fn handshake(url: &str, headers: &[(&str, &str)]) -> Result<Socket, tungstenite::Error> {
+fn handshake(url: &str, headers: &[(&str, &str)]) -> Result<Socket, Box<tungstenite::Error>> {
     use tungstenite::client::IntoClientRequest;
     let mut request = url.into_client_request().unwrap();
     for (k, v) in headers {
@@ -86,12 +86,14 @@ fn handshake(url: &str, headers: &[(&str, &str)]) -> Result<Socket, tungstenite:
             v.parse().unwrap(),
         );
     }
-    tungstenite::connect(request).map(|(ws, _)| ws)
+    tungstenite::connect(request)
+        .map(|(ws, _)| ws)
+        .map_err(Box::new)
 }
 
 /// The HTTP status of a refused handshake, and its body.
-fn refused(result: Result<Socket, tungstenite::Error>) -> (u16, String) {
-    match result {
+fn refused(result: Result<Socket, Box<tungstenite::Error>>) -> (u16, String) {
+    match result.map_err(|e| *e) {
         Err(tungstenite::Error::Http(response)) => (
             response.status().as_u16(),
             String::from_utf8_lossy(response.body().as_deref().unwrap_or_default()).into_owned(),
@@ -195,6 +197,10 @@ fn serve_runs_programs_mdi_hold_resume_and_abort_over_a_websocket() {
     let p = tip(&end);
     assert!((p[0] - 20.0).abs() < 1e-9 && p[1].abs() < 1e-9, "{p:?}");
     assert_eq!(end["underruns"], 0);
+    // The real-time thread's lateness is reported (the wall clock's: some, well under 1 s).
+    let late = end["late_worst_s"].as_f64().unwrap();
+    assert!((0.0..1.0).contains(&late), "{late}");
+    assert!(end["late_over_half"].is_u64(), "{end}");
 
     // MDI between programs.
     let r = request(

@@ -115,6 +115,11 @@ pub struct Status {
     pub executing_line: u32,
     /// Underruns the real-time side counted.
     pub underruns: u64,
+    /// The real-time thread's worst wake-up lateness so far, s (0 when no real-time side
+    /// reports).
+    pub late_worst_s: f64,
+    /// Periods it woke more than half a period late.
+    pub late_over_half: u64,
     /// Set-point counter.
     pub index: u64,
     pub feed_override_percent: f64,

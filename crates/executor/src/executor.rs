@@ -308,6 +308,8 @@ impl Executor {
             line: self.pose.line,
             executing_line: 0,
             underruns: 0,
+            late_worst_s: 0.0,
+            late_over_half: 0,
             index: self.k,
             feed_override_percent: self.override_pct,
             single_block: self.single_block,

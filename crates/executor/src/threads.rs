@@ -91,6 +91,8 @@ impl PlannerSide {
         if let Some(r) = &self.last {
             s.executing_line = r.line;
             s.underruns = r.underruns;
+            s.late_worst_s = r.late_worst;
+            s.late_over_half = r.late_over_half;
         }
         s
     }

@@ -45,6 +45,8 @@ async function main() {
     await page.waitForFunction(() => window.tezgah && window.tezgah.status && window.tezgah.inControl);
     check(await page.$eval('#control-text', (e) => e.textContent.startsWith('in control')), 'the first page is in control');
     check(await page.$eval('#machine-name', (e) => e.textContent) === 'mill3', 'machine name shown');
+    const late = await page.$eval('#late', (e) => e.textContent);
+    check(/^\d+ µs/.test(late), `real-time lateness shown (${late})`);
 
     // Program: edit, load, preview.
     await page.click('#edit');
@@ -174,6 +176,12 @@ async function main() {
     await other.waitForSelector('#code .ln.bad[data-line="3"]');
     check(true, 'a load error marked at line 3');
     await other.close();
+    // A tablet (portrait): one column, nothing wider than the screen.
+    await page.setViewportSize({ width: 768, height: 1024 });
+    await page.waitForTimeout(200);
+    const wide = await page.evaluate(() => document.documentElement.scrollWidth);
+    check(wide <= 768, `fits a 768 px wide tablet (${wide} px)`);
+    await page.screenshot({ path: path.join(out, 'panel-tablet.png') });
     check(errors.length === 0, `no page errors ${errors.join('; ')}`);
   } finally {
     await browser.close();
