@@ -8,41 +8,18 @@
 //! playwright-core`, where `.ci/run` installs it). Without them it is skipped — except in CI
 //! (`CI=true`), where it fails.
 
-use std::io::{BufRead, BufReader, Read, Write};
+use std::io::{Read, Write};
 use std::net::TcpStream;
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-struct Server(Child);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+mod common;
 
 /// The server on a free loopback port, and the panel's URL it printed.
-fn launch() -> (Server, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tezgah"))
-        .args(["serve", "--listen", "127.0.0.1:0", "--lead-ms", "100"])
-        .args(["--status-ms", "20"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let server = Server(child);
-    let mut lines = String::new();
-    while !lines.contains("the panel is at") {
-        assert!(out.read_line(&mut lines).unwrap() > 0, "{lines}");
-    }
-    let url = lines
-        .split_whitespace()
-        .find(|w| w.starts_with("http://"))
-        .unwrap()
-        .to_owned();
-    (server, url)
+fn launch() -> (common::Server, String) {
+    let (server, banner) = common::serve(&["--lead-ms", "100", "--status-ms", "20"]);
+    (server, banner.panel)
 }
 
 /// A raw HTTP/1.1 GET; the response whole.

@@ -6,26 +6,15 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use common::{Banner, Server};
 use serde_json::{json, Value};
 use tungstenite::stream::MaybeTlsStream;
 use tungstenite::{Message, WebSocket};
 
 type Socket = WebSocket<MaybeTlsStream<TcpStream>>;
-
-/// The server process, killed when the test ends (also on a failed assertion).
-struct Server(Child);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn start() -> (Server, Socket) {
     start_with(&[])
@@ -38,42 +27,11 @@ fn start_with(extra: &[&str]) -> (Server, Socket) {
     (server, ws)
 }
 
-/// What the server printed when it started.
-struct Banner {
-    /// `ws://127.0.0.1:port`
-    ws: String,
-    /// The panel's URL, with `?token=…` when one is needed.
-    panel: String,
-}
-
-/// The server with `extra` options, and what it printed up to the panel's URL.
+/// The server with `extra` options, and what it printed.
 fn launch(extra: &[&str]) -> (Server, Banner) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_tezgah"))
-        .args(["serve", "--listen", "127.0.0.1:0", "--lead-ms", "200"])
-        .args(["--status-ms", "10"])
-        .args(extra)
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut out = BufReader::new(child.stdout.take().unwrap());
-    let server = Server(child);
-    let mut lines = String::new();
-    while !lines.contains("the panel is at") {
-        let n = out.read_line(&mut lines).unwrap();
-        assert!(n > 0, "the server stopped; it printed {lines:?}");
-    }
-    let word = |prefix: &str| {
-        lines
-            .split_whitespace()
-            .find(|w| w.starts_with(prefix))
-            .unwrap_or_else(|| panic!("no {prefix} in {lines:?}"))
-            .to_owned()
-    };
-    let banner = Banner {
-        ws: word("ws://"),
-        panel: word("http://"),
-    };
-    (server, banner)
+    let mut options = vec!["--lead-ms", "200", "--status-ms", "10"];
+    options.extend(extra);
+    common::serve(&options)
 }
 
 /// A handshake request to `url` with extra headers.

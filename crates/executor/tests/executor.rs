@@ -422,11 +422,7 @@ fn program_stops_and_single_block() {
 fn mdi_mixed_with_auto() {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    let mdi = |e: &mut tezgah_executor::executor::Executor, t: &mut Trace, b: &str| {
-        e.command(Command::Mdi { block: b.into() }).unwrap();
-        drive(e, t, 1_000_000, |_, _| {});
-        assert_eq!(e.state(), RunState::Idle);
-    };
+    let mdi = run_mdi;
     mdi(&mut exec, &mut trace, "G21 G90 F2400");
     mdi(&mut exec, &mut trace, "G1 X20 Y5");
     // Modal state carries: G91 then two relative moves.
@@ -987,11 +983,7 @@ fn five_axis_holds_and_override() {
 fn zero_set_in_mdi_moves_the_work_frame_of_the_status_and_of_programs_loaded_after() {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    let mdi = |e: &mut tezgah_executor::executor::Executor, t: &mut Trace, b: &str| {
-        e.command(Command::Mdi { block: b.into() }).unwrap();
-        drive(e, t, 1_000_000, |_, _| {});
-        assert_eq!(e.state(), RunState::Idle);
-    };
+    let mdi = run_mdi;
     mdi(&mut exec, &mut trace, "G21 G90 G1 X30 Y-10 Z5 F3000");
     let w = exec.status().work;
     assert_eq!((w.coordinate_system, w.g5x), (1, [0.0; 3]));

@@ -178,6 +178,7 @@ async function main() {
     await other.close();
     // A tablet (portrait): one column, nothing wider than the screen.
     await page.setViewportSize({ width: 768, height: 1024 });
+    await page.evaluate(() => window.scrollTo(0, 0));
     await page.waitForTimeout(200);
     const wide = await page.evaluate(() => document.documentElement.scrollWidth);
     check(wide <= 768, `fits a 768 px wide tablet (${wide} px)`);
