@@ -202,7 +202,7 @@ function onStatus(s) {
   $('jog-override-value').textContent = `${Math.round(s.jog_override_percent)} %`;
   // Program line.
   if (s.mode === 'auto' && s.executing_line && s.executing_line !== panel.current) highlight(s.executing_line);
-  view.setTool(s.tip);
+  view.setTool(s.tip, s.tool_axis);
   record(s);
   if (first) log('');
 }

@@ -130,14 +130,17 @@ export class View3D {
     if (!this.bounds) this.fit();
   }
 
-  /// The tool's tip: a cross with a shank above it.
-  setTool(p) {
-    if (this.tool && this.tool.every((v, i) => v === p[i])) return;
-    this.tool = p.slice();
+  /// The tool's tip: a cross with a shank along the tool axis (tip → spindle; +Z when the
+  /// machine has no rotary joints).
+  setTool(p, axis) {
+    const k = axis || [0, 0, 1];
+    const key = [...p, ...k];
+    if (this.tool && this.tool.every((v, i) => v === key[i])) return;
+    this.tool = key;
     const s = this.scale() / 40, c = COLOURS.tool;
     const [x, y, z] = p;
     this.layer('tool', [x - s, y, z, ...c, x + s, y, z, ...c, x, y - s, z, ...c, x, y + s, z, ...c,
-      x, y, z, ...c, x, y, z + 4 * s, ...c]);
+      x, y, z, ...c, x + 4 * s * k[0], y + 4 * s * k[1], z + 4 * s * k[2], ...c]);
   }
 
   scale() {

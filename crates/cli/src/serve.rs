@@ -20,6 +20,7 @@ use tezgah_executor::executor::{ExecOptions, Executor};
 use tezgah_executor::realtime::RealtimeSettings;
 use tezgah_executor::threads::{spawn, Handle};
 use tezgah_geom::Pose;
+use tezgah_kinematics::Kinematics;
 use tungstenite::handshake::server::{
     ErrorResponse, Request as HandshakeRequest, Response as HandshakeResponse,
 };
@@ -84,7 +85,7 @@ enum Outgoing<'a> {
     /// Sent first: the machine, for the panel's readout, jog buttons and travel box.
     Hello { machine: &'a serde_json::Value },
     /// The periodic status.
-    Status(&'a Status),
+    Status(StatusOut<'a>),
     /// Who holds control: sent on connecting and to every client whenever it changes.
     Control {
         /// This connection's number.
@@ -94,6 +95,16 @@ enum Outgoing<'a> {
         /// This connection is in control.
         you: bool,
     },
+}
+
+/// The executor's status and, on a machine with rotary joints, the tool axis.
+#[derive(Debug, Serialize)]
+struct StatusOut<'a> {
+    #[serde(flatten)]
+    status: &'a Status,
+    /// Unit vector tip → spindle in the workpiece frame (the preview's frame).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    tool_axis: Option<[f64; 3]>,
 }
 
 /// One client holds control at a time; the others watch. The first to connect while nobody
@@ -129,6 +140,8 @@ const PREVIEW_POINTS: usize = 400_000;
 struct Shared {
     /// The machine as the `hello` message describes it.
     machine: serde_json::Value,
+    /// Its kinematics when it has rotary joints (for the tool axis in the status).
+    kinematics: Option<tezgah_kinematics::Model>,
     host: Handle,
     control: Control,
     access: Access,
@@ -198,6 +211,11 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     }
     let shared = Arc::new(Shared {
         machine: describe(&machine, period),
+        kinematics: machine
+            .joints
+            .iter()
+            .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary)
+            .then(|| machine.kinematics.clone()),
         host,
         control: Control::default(),
         access: Access { addr, token },
@@ -355,7 +373,20 @@ fn session_loop(ws: &mut WebSocket<TcpStream>, shared: &Shared, me: u64) -> Resu
                 .lock()
                 .map(|s| s.clone())
                 .map_err(|_| "the executor has stopped".to_owned())?;
-            send(ws, &Outgoing::Status(&status))?;
+            let tool_axis = shared.kinematics.as_ref().and_then(|k| {
+                let q = tezgah_kinematics::Joints::from_slice(&status.joints).ok()?;
+                let pose = k
+                    .forward(&q, &tezgah_kinematics::Tool::with_length(0.0))
+                    .ok()?;
+                Some([pose.axis.x, pose.axis.y, pose.axis.z])
+            });
+            send(
+                ws,
+                &Outgoing::Status(StatusOut {
+                    status: &status,
+                    tool_axis,
+                }),
+            )?;
         }
     }
 }

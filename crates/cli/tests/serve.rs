@@ -453,3 +453,25 @@ fn request_reply(ws: &mut Socket) -> Value {
         }
     }
 }
+
+#[test]
+fn serve_reports_the_tool_axis_on_a_machine_with_rotary_joints() {
+    let (_server, mut ws) = start_with(&["--machine", "table-ac"]);
+    let s = wait_for(&mut ws, |_| true);
+    let axis = |s: &Value| [0, 1, 2].map(|i| s["tool_axis"][i].as_f64().unwrap());
+    let a = axis(&s);
+    assert!((a[2] - 1.0).abs() < 1e-12 && a[0].abs() < 1e-12, "{a:?}");
+    // The table tilted 30° about X: in the workpiece frame the tool leans 30° off Z, in Y Z.
+    let r = request(&mut ws, json!({"command": "mdi", "block": "G0 A30"}));
+    assert_eq!(r["ok"], true, "{r}");
+    let s = wait_for(&mut ws, |s| state(s) == "idle" && s["mode"] == "mdi");
+    let a = axis(&s);
+    let c = 30f64.to_radians();
+    assert!(a[0].abs() < 1e-9, "{a:?}");
+    assert!((a[1].abs() - c.sin()).abs() < 1e-9, "{a:?}");
+    assert!((a[2] - c.cos()).abs() < 1e-9, "{a:?}");
+    // A machine without rotary joints sends none.
+    let (_server, mut ws) = start();
+    let s = wait_for(&mut ws, |_| true);
+    assert!(s.get("tool_axis").is_none(), "{s}");
+}
