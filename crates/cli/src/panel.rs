@@ -42,9 +42,17 @@ const FILES: &[(&str, &str, &[u8])] = &[
 /// The longest request head read.
 const MAX_HEAD: usize = 16 << 10;
 
+/// A request's head as peeked.
+pub struct Head {
+    /// The request line and headers (not UTF-8 bytes replaced).
+    pub text: String,
+    /// Its length on the socket, bytes.
+    pub len: usize,
+}
+
 /// The request's head (request line and headers), read without taking it off the socket, so
 /// a WebSocket handshake can still be read whole by tungstenite.
-pub fn peek_head(stream: &TcpStream) -> Result<String, String> {
+pub fn peek_head(stream: &TcpStream) -> Result<Head, String> {
     let mut buf = vec![0u8; MAX_HEAD];
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
@@ -53,7 +61,10 @@ pub fn peek_head(stream: &TcpStream) -> Result<String, String> {
             return Err("closed before a request".into());
         }
         if let Some(end) = buf[..n].windows(4).position(|w| w == b"\r\n\r\n") {
-            return Ok(String::from_utf8_lossy(&buf[..end + 4]).into_owned());
+            return Ok(Head {
+                text: String::from_utf8_lossy(&buf[..end + 4]).into_owned(),
+                len: end + 4,
+            });
         }
         if n == buf.len() {
             return Err(format!("a request head longer than {MAX_HEAD} bytes"));
@@ -79,10 +90,11 @@ pub fn is_upgrade(head: &str) -> bool {
 }
 
 /// Answers a plain HTTP request (the head already peeked) and closes.
-pub fn respond(mut stream: TcpStream, head: &str, access: &Access) -> Result<(), String> {
+pub fn respond(mut stream: TcpStream, head: &Head, access: &Access) -> Result<(), String> {
     // Take the head off the socket (its body, if any, is ignored).
-    let mut sink = vec![0u8; head.len()];
+    let mut sink = vec![0u8; head.len];
     stream.read_exact(&mut sink).map_err(|e| e.to_string())?;
+    let head = head.text.as_str();
     let mut words = head.lines().next().unwrap_or("").split_whitespace();
     let (method, target) = (words.next().unwrap_or(""), words.next().unwrap_or(""));
     let path = target.split('?').next().unwrap_or("");

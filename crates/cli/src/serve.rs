@@ -243,7 +243,7 @@ fn session(stream: TcpStream, shared: &Shared) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     // The panel's pages on the same port: anything but a WebSocket handshake.
     let head = crate::panel::peek_head(&stream)?;
-    if !crate::panel::is_upgrade(&head) {
+    if !crate::panel::is_upgrade(&head.text) {
         return crate::panel::respond(stream, &head, &shared.access);
     }
     // The refusal's type is tungstenite's (its `Callback` trait), large or not.

@@ -62,6 +62,29 @@ fn serve_hands_out_the_panel_and_its_files() {
         "{js}"
     );
     assert!(get(&url, "/nothing", None).starts_with("HTTP/1.1 404"));
+    // Bytes that are not UTF-8 in the request line: answered at once, not waited on.
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let mut sock = TcpStream::connect(addr).unwrap();
+    sock.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    let mut bad = b"GET /\xff\xfe\xfd HTTP/1.1\r\nHost: ".to_vec();
+    bad.extend(addr.as_bytes());
+    bad.extend(b"\r\n\r\n");
+    sock.write_all(&bad).unwrap();
+    let mut r = String::new();
+    let started = Instant::now();
+    sock.read_to_string(&mut r).unwrap();
+    assert!(r.starts_with("HTTP/1.1 404"), "{r}");
+    assert!(started.elapsed() < Duration::from_secs(2));
+    // Not GET: refused.
+    let mut sock = TcpStream::connect(addr).unwrap();
+    write!(
+        sock,
+        "POST / HTTP/1.1\r\nHost: {addr}\r\nContent-Length: 0\r\n\r\n"
+    )
+    .unwrap();
+    let mut r = String::new();
+    sock.read_to_string(&mut r).unwrap();
+    assert!(r.starts_with("HTTP/1.1 405"), "{r}");
     // A page of another name re-pointed at loopback (DNS rebinding) gets nothing.
     let port = url.trim_end_matches('/').rsplit(':').next().unwrap();
     let r = get(&url, "/", Some(&format!("evil.example.com:{port}")));
