@@ -163,7 +163,9 @@ fn panel_runs_the_machine_in_a_real_browser() {
         status.unwrap_or_else(|| panic!("the browser test took over 2 minutes\n{out}\n{err}"));
     assert!(status.success(), "{out}\n{err}");
     for check in [
+        "a file opened from disk is shown",
         "line 3 highlighted",
+        "feed override slider 150 % then 100 %",
         "held still at X",
         "ten plots after the run",
         "jogged X to",

@@ -48,7 +48,11 @@ async function main() {
     const late = await page.$eval('#late', (e) => e.textContent);
     check(/^\d+ µs/.test(late), `real-time lateness shown (${late})`);
 
-    // Program: edit, load, preview.
+    // Program: open from disk (a file chooser), then edit, load, preview.
+    await page.setInputFiles('#file', { name: 'square.ngc', mimeType: 'text/plain',
+      buffer: Buffer.from('G21 G90\nG1 X5 F600\nM2\n') });
+    await page.waitForFunction(() => document.getElementById('program-name').textContent === 'square.ngc');
+    check(await page.$$eval('#code .ln', (l) => l.length) === 4, 'a file opened from disk is shown');
     await page.click('#edit');
     await page.fill('#editor', PROGRAM);
     await page.click('#edit');
@@ -84,6 +88,13 @@ async function main() {
     check(x1 > 20 && x1 < 60, `DRO X moving on line 3 (${x1})`);
     const togo = await num(page, 'g-X');
     check(togo > 0 && Math.abs(x1 + togo - 60) < 1.5, `distance to go X ${togo} (to 60)`);
+
+    // Feed override from the slider.
+    await page.$eval('#feed-override', (e) => { e.value = 150; e.dispatchEvent(new Event('input')); });
+    await page.waitForFunction(() => window.tezgah.status.feed_override_percent === 150);
+    await page.$eval('#feed-override', (e) => { e.value = 100; e.dispatchEvent(new Event('input')); });
+    await page.waitForFunction(() => window.tezgah.status.feed_override_percent === 100);
+    check(true, 'feed override slider 150 % then 100 %');
 
     // Hold and resume.
     await page.click('#feed-hold');
