@@ -2,11 +2,14 @@
 //!
 //! Every command is a thin shell over a library call; see the README for the commands.
 
+mod access;
 mod cam;
 mod cam_tool;
 mod diagnostics;
 mod library;
+mod panel;
 mod plot;
+mod preview;
 mod run;
 mod serve;
 mod tracking;

@@ -1,11 +1,13 @@
 //! `--plot DIR`: feed and each joint's velocity, acceleration and jerk over time, as SVG and
-//! PNG, drawn with `plotters`.
+//! PNG, drawn with `plotters`: a title, axes with units and tick labels, and the joint's
+//! limits as red lines at ±the limit.
 //!
-//! Without a font backend (none is enabled, to keep system libraries out of the build) the
-//! plots carry no text: the file name says what is drawn (`x_velocity.svg`, …) and the
-//! terminal prints the ranges.
+//! Text is laid out and drawn by plotters' pure-Rust `ab_glyph` backend with DejaVu Sans
+//! bundled in the binary (`assets/fonts`, its licence alongside) and registered at run time,
+//! so no system font library is needed.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use plotters::prelude::*;
 use tezgah_motion::interpolate::Sample;
@@ -58,24 +60,74 @@ fn decimate(t: &[f64], y: &[f64], max: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
+/// DejaVu Sans (Bitstream Vera licence, `assets/fonts/DejaVuSans-LICENSE.txt`).
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+/// Registers the bundled font as plotters' `sans-serif`, once.
+fn font() -> Result<(), String> {
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+                .map_err(|_| "the bundled font DejaVu Sans could not be read".to_owned())
+        })
+        .clone()
+}
+
+/// A joint as plotted: its name, unit and limits (velocity, acceleration, jerk).
+pub struct JointInfo {
+    pub name: String,
+    /// "mm" or "deg".
+    pub unit: &'static str,
+    pub limits: [f64; 3],
+}
+
+/// One plot: what is drawn and how it is labelled.
+struct Plot<'a> {
+    title: String,
+    /// The y axis' label with its unit.
+    y_label: String,
+    /// Drawn at ±limit when finite.
+    limit: Option<f64>,
+    pts: &'a [(f64, f64)],
+}
+
 fn draw<DB: DrawingBackend>(
     area: DrawingArea<DB, plotters::coord::Shift>,
-    pts: &[(f64, f64)],
+    plot: &Plot,
 ) -> Result<(), String>
 where
     DB::ErrorType: 'static,
 {
+    let pts = plot.pts;
     area.fill(&WHITE).map_err(|e| e.to_string())?;
     let (t0, t1) = (
         pts.first().map_or(0.0, |p| p.0),
         pts.last().map_or(1.0, |p| p.0),
     );
-    let lo = pts.iter().map(|p| p.1).fold(0.0f64, f64::min);
-    let hi = pts.iter().map(|p| p.1).fold(0.0f64, f64::max);
+    let mut lo = pts.iter().map(|p| p.1).fold(0.0f64, f64::min);
+    let mut hi = pts.iter().map(|p| p.1).fold(0.0f64, f64::max);
+    let limit = plot.limit.filter(|l| l.is_finite() && *l > 0.0);
+    if let Some(l) = limit {
+        lo = lo.min(-l);
+        hi = hi.max(l);
+    }
     let pad = ((hi - lo) * 0.05).max(1e-9);
     let mut chart = ChartBuilder::on(&area)
+        .caption(&plot.title, ("sans-serif", 20))
         .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(80)
         .build_cartesian_2d(t0..t1.max(t0 + 1e-9), (lo - pad)..(hi + pad))
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc(&plot.y_label)
+        .label_style(("sans-serif", 13))
+        .axis_desc_style(("sans-serif", 15))
+        .y_label_formatter(&|v| tick(*v))
+        .draw()
         .map_err(|e| e.to_string())?;
     // Zero line.
     chart
@@ -83,38 +135,119 @@ where
         .map_err(|e| e.to_string())?;
     chart
         .draw_series(LineSeries::new(pts.iter().copied(), &BLUE))
+        .map_err(|e| e.to_string())?
+        .label(plot.title.split(" — ").next().unwrap_or(""))
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLUE));
+    if let Some(l) = limit {
+        for y in [l, -l] {
+            chart
+                .draw_series(LineSeries::new([(t0, y), (t1, y)], RED.stroke_width(2)))
+                .map_err(|e| e.to_string())?;
+        }
+        chart
+            .draw_series(std::iter::once(PathElement::new([(t0, l), (t0, l)], RED)))
+            .map_err(|e| e.to_string())?
+            .label(format!("limit ±{}", tick(l)))
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], RED.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
         .map_err(|e| e.to_string())?;
     area.present().map_err(|e| e.to_string())?;
     Ok(())
 }
 
-/// Writes `feed` and `<joint>_{velocity,acceleration,jerk}` as .svg and .png; returns the count.
+/// A tick label: short, in scientific notation only for very large or small values.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e6).contains(&a) {
+        format!("{v:.1e}")
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_owned()
+    }
+}
+
+/// Writes `feed` and `<joint>_{velocity,acceleration,jerk}` as .svg and .png, titled with
+/// `program`; returns the count.
 pub fn write_all(
     dir: &Path,
     trace: &Trace,
-    names: &[String],
+    joints: &[JointInfo],
     period: f64,
+    program: &str,
 ) -> Result<usize, String> {
-    let mut series: Vec<(String, Vec<f64>, &[f64])> =
-        vec![("feed".into(), trace.feed.clone(), &trace.t[..])];
+    font()?;
+    struct Series<'a> {
+        file: String,
+        title: String,
+        y_label: String,
+        limit: Option<f64>,
+        y: Vec<f64>,
+        t: &'a [f64],
+    }
+    let mut series = vec![Series {
+        file: "feed".into(),
+        title: format!("Feed — {program}"),
+        y_label: "path speed (mm/s)".into(),
+        limit: None,
+        y: trace.feed.clone(),
+        t: &trace.t[..],
+    }];
+    let t = |k: usize| trace.t.get(k..).unwrap_or(&[]);
     for (i, q) in trace.joints.iter().enumerate() {
         let v = diff(q, period);
         let a = diff(&v, period);
         let j = diff(&a, period);
-        let name = names.get(i).cloned().unwrap_or_else(|| format!("joint{i}"));
-        series.push((format!("{name}_velocity"), v, &trace.t[1..]));
-        series.push((format!("{name}_acceleration"), a, &trace.t[2..]));
-        series.push((format!("{name}_jerk"), j, &trace.t[3..]));
+        let (name, unit, limits) = match joints.get(i) {
+            Some(info) => (info.name.clone(), info.unit, info.limits),
+            None => (format!("joint{i}"), "units", [f64::NAN; 3]),
+        };
+        for (k, (what, y, power)) in [
+            ("velocity", v, "/s"),
+            ("acceleration", a, "/s²"),
+            ("jerk", j, "/s³"),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            series.push(Series {
+                file: format!("{name}_{what}"),
+                title: format!("{} {what} — {program}", name.to_uppercase()),
+                y_label: format!("{what} ({unit}{power})"),
+                limit: Some(limits[k]),
+                y,
+                t: t(k + 1),
+            });
+        }
     }
     let mut files = 0;
-    for (name, y, t) in &series {
-        let pts = decimate(t, y, 4000);
-        let svg = dir.join(format!("{name}.svg"));
-        draw(SVGBackend::new(&svg, (1000, 400)).into_drawing_area(), &pts)?;
-        let png = dir.join(format!("{name}.png"));
+    for s in &series {
+        let pts = decimate(s.t, &s.y, 4000);
+        let plot = Plot {
+            title: s.title.clone(),
+            y_label: s.y_label.clone(),
+            limit: s.limit,
+            pts: &pts,
+        };
+        let svg = dir.join(format!("{}.svg", s.file));
+        draw(
+            SVGBackend::new(&svg, (1000, 400)).into_drawing_area(),
+            &plot,
+        )?;
+        let png = dir.join(format!("{}.png", s.file));
         draw(
             BitMapBackend::new(&png, (1000, 400)).into_drawing_area(),
-            &pts,
+            &plot,
         )?;
         files += 2;
     }

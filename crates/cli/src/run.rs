@@ -355,8 +355,18 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     }
     if let (Some(dir), Some(t)) = (&args.plot, &trace) {
         std::fs::create_dir_all(dir).into_diagnostic()?;
-        let names: Vec<String> = machine.joints.iter().map(|j| j.name.clone()).collect();
-        let files = crate::plot::write_all(dir, t, &names, period).map_err(|e| miette!("{e}"))?;
+        let joints: Vec<crate::plot::JointInfo> = machine
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| crate::plot::JointInfo {
+                name: j.name.clone(),
+                unit: unit(&machine, i).0,
+                limits: [j.max_velocity, j.max_acceleration, j.max_jerk],
+            })
+            .collect();
+        let files =
+            crate::plot::write_all(dir, t, &joints, period, &name).map_err(|e| miette!("{e}"))?;
         println!("plots: {} files in {}", files, dir.display());
     }
     summary(

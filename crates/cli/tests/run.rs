@@ -52,6 +52,44 @@ fn demo_run_writes_samples_report_and_plots() {
     for name in ["feed.svg", "feed.png", "x_jerk.svg", "z_acceleration.png"] {
         assert!(plots.join(name).exists(), "{name}");
     }
+    // Every plot has a title, axis labels with units, tick labels and, for a joint, its limits
+    // (mill3: x 200 mm/s, y 2000 mm/s², z 25000 mm/s³).
+    let text = |name: &str| {
+        let svg = std::fs::read_to_string(plots.join(name)).unwrap();
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| {
+                Some(
+                    t.split_once('>')?
+                        .1
+                        .split_once("</text>")?
+                        .0
+                        .trim()
+                        .to_owned(),
+                )
+            })
+            .collect::<Vec<String>>()
+    };
+    let feed = text("feed.svg");
+    assert!(feed.iter().any(|t| t.starts_with("Feed — ")), "{feed:?}");
+    assert!(feed.contains(&"path speed (mm/s)".to_owned()), "{feed:?}");
+    assert!(feed.contains(&"time (s)".to_owned()), "{feed:?}");
+    for (file, label, limit) in [
+        ("x_velocity.svg", "velocity (mm/s)", "limit ±200"),
+        ("y_acceleration.svg", "acceleration (mm/s²)", "limit ±2000"),
+        ("z_jerk.svg", "jerk (mm/s³)", "limit ±25000"),
+    ] {
+        let t = text(file);
+        assert!(t.contains(&label.to_owned()), "{file}: {t:?}");
+        assert!(t.contains(&limit.to_owned()), "{file}: {t:?}");
+        assert!(
+            t.iter().any(|s| s.ends_with(" — built-in demo")),
+            "{file}: {t:?}"
+        );
+        // Tick labels: numbers on both axes.
+        let numbers = t.iter().filter(|s| s.parse::<f64>().is_ok()).count();
+        assert!(numbers >= 6, "{file}: {t:?}");
+    }
 }
 
 #[test]

@@ -115,6 +115,11 @@ pub struct Status {
     pub executing_line: u32,
     /// Underruns the real-time side counted.
     pub underruns: u64,
+    /// The real-time thread's worst wake-up lateness so far, s (0 when no real-time side
+    /// reports).
+    pub late_worst_s: f64,
+    /// Periods it woke more than half a period late.
+    pub late_over_half: u64,
     /// Set-point counter.
     pub index: u64,
     pub feed_override_percent: f64,
@@ -133,4 +138,33 @@ pub struct Status {
     pub time_scale: f64,
     /// The last error, if any.
     pub error: Option<String>,
+    /// The MDI interpreter's modal state and offsets, and the tool tip in its work frame.
+    pub work: WorkState,
+}
+
+/// The modal state and offsets the DRO shows (those of the MDI interpreter: zero-set by
+/// `G10 L20` in MDI moves them), lengths in mm.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct WorkState {
+    /// The active coordinate system, 1 (G54) … 9 (G59.3).
+    pub coordinate_system: usize,
+    /// Its X Y Z offsets and XY rotation (degrees).
+    pub g5x: [f64; 3],
+    pub rotation_deg: f64,
+    /// G92/G52 offsets in force.
+    pub g92: [f64; 3],
+    /// Tool length offsets in force.
+    pub tool: [f64; 3],
+    /// G20 (inch) in force, else G21.
+    pub inches: bool,
+    /// G91 in force, else G90.
+    pub incremental: bool,
+    /// 17, 18 or 19 (0 for a U V W plane).
+    pub plane: u8,
+    /// The motion mode, G code × 10 (10 for G1, 20 for G2, …), if any.
+    pub motion: Option<u32>,
+    /// The feed rate in force, program units per minute.
+    pub feed_rate: f64,
+    /// The tool tip in the active work frame: `R⁻¹(tip − g5x) − g92`, mm.
+    pub position: [f64; 3],
 }

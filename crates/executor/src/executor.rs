@@ -295,6 +295,11 @@ impl Executor {
         &self.passed
     }
 
+    /// The loaded program's moves.
+    pub fn program_moves(&self) -> Option<&[Move]> {
+        self.program.as_ref().map(|p| &p.moves[..])
+    }
+
     pub fn status(&self) -> Status {
         Status {
             mode: self.mode,
@@ -302,6 +307,8 @@ impl Executor {
             line: self.pose.line,
             executing_line: 0,
             underruns: 0,
+            late_worst_s: 0.0,
+            late_over_half: 0,
             index: self.k,
             feed_override_percent: self.override_pct,
             single_block: self.single_block,
@@ -313,6 +320,9 @@ impl Executor {
             tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
             time_scale: self.scale.r,
             error: self.error.clone(),
+            work: self
+                .mdi
+                .work([self.pose.tip.x, self.pose.tip.y, self.pose.tip.z]),
         }
     }
 
@@ -436,7 +446,8 @@ impl Executor {
                 if self.state != RunState::Idle {
                     return Err(self.busy("load"));
                 }
-                let program = Program::interpret(program, &self.gcode)?;
+                let config = self.mdi.program_config(&self.gcode);
+                let program = Program::interpret(program, &config)?;
                 let here = self.program_pose();
                 self.built = Some(self.preflight(program.moves.clone(), here, &program.origins)?);
                 self.program = Some(program);

@@ -4,8 +4,11 @@
 use std::sync::mpsc;
 
 use tezgah_gcode::interp::{line_at, LinePos};
+use tezgah_gcode::params::ParameterFile;
 use tezgah_gcode::{Config, Interpreter, MoveBuilder, Units};
-use tezgah_geom::{Move, Pose};
+use tezgah_geom::{Move, Plane, Pose};
+
+use crate::command::WorkState;
 
 use crate::error::ExecError;
 
@@ -69,6 +72,70 @@ impl Mdi {
 
     /// The moves of one block (line number 1). An error leaves the modal state as the
     /// interpreter leaves it after a failed block.
+    /// `config` with the offsets MDI has set (G10, G92, G28.1/G30.1: the parameters LinuxCNC
+    /// keeps between runs, #5161–#5390) in place of the ones it started with, so a program
+    /// loaded after a zero-set runs in the zeroed frame.
+    pub fn program_config(&self, config: &Config) -> Config {
+        let kept = 5161..=5390;
+        let params = self.interp.params();
+        let mut text = String::new();
+        let file = config.parameters.as_deref();
+        let mut values: Vec<(usize, f64)> = file
+            .map(|f| f.values())
+            .unwrap_or_default()
+            .iter()
+            .copied()
+            .filter(|(n, _)| !kept.contains(n))
+            .collect();
+        values.extend(kept.map(|n| (n, params.get(n))).filter(|&(_, v)| v != 0.0));
+        values.sort_by_key(|&(n, _)| n);
+        for (n, v) in values {
+            text += &format!("{n} {v:?}\n");
+        }
+        let mut config = config.clone();
+        // The text is made of valid numbers in increasing order: parsing cannot fail.
+        if let Ok(file) = ParameterFile::parse(&text) {
+            config.parameters = Some(std::sync::Arc::new(file));
+        }
+        config
+    }
+
+    /// The modal state and offsets, and `tip` (mm, machine frame) in the active work frame.
+    pub fn work(&self, tip: [f64; 3]) -> WorkState {
+        let st = self.interp.state();
+        let mm = match st.units {
+            Units::Inches => 25.4,
+            _ => 1.0,
+        };
+        let xyz = |p: &Pose| [p.0[0] * mm, p.0[1] * mm, p.0[2] * mm];
+        let (g5x, g92) = (xyz(&st.origin), xyz(&st.axis_offset));
+        let (sin, cos) = (-st.rotation.to_radians()).sin_cos();
+        let (dx, dy) = (tip[0] - g5x[0], tip[1] - g5x[1]);
+        let position = [
+            cos * dx - sin * dy - g92[0],
+            sin * dx + cos * dy - g92[1],
+            tip[2] - g5x[2] - g92[2],
+        ];
+        WorkState {
+            coordinate_system: st.origin_index,
+            g5x,
+            rotation_deg: st.rotation,
+            g92,
+            tool: xyz(&st.tool_offset),
+            inches: matches!(st.units, Units::Inches),
+            incremental: st.incremental,
+            plane: match st.plane {
+                Some(Plane::XY) => 17,
+                Some(Plane::ZX) => 18,
+                Some(Plane::YZ) => 19,
+                None => 0,
+            },
+            motion: st.motion,
+            feed_rate: st.feed_rate,
+            position,
+        }
+    }
+
     pub fn block(&mut self, text: &str) -> Result<Vec<Move>, ExecError> {
         if text.contains('\n') {
             return Err(ExecError::Gcode("an MDI block is one line".into()));

@@ -50,6 +50,10 @@ pub struct RtReport {
     pub measured: Joints,
     pub underruns: u64,
     pub fault: Option<DriveFault>,
+    /// The worst wake-up lateness of the real-time thread so far, s.
+    pub late_worst: f64,
+    /// Periods it woke more than half a period late.
+    pub late_over_half: u64,
 }
 
 /// The producer ends (planner thread) and consumer ends (real-time thread) of both rings.

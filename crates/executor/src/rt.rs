@@ -44,6 +44,8 @@ pub struct RtLoop<D: Drive> {
     stop: Option<(PlayedStop, u32)>,
     fault: Option<DriveFault>,
     counters: RtCounters,
+    /// Wake-up lateness so far ([`RtLoop::run`] records it; reports carry it).
+    jitter: Jitter,
 }
 
 fn moving(sp: &SetPoint) -> bool {
@@ -64,6 +66,7 @@ impl<D: Drive> RtLoop<D> {
             stop: None,
             fault: None,
             counters: RtCounters::default(),
+            jitter: Jitter::default(),
         }
     }
 
@@ -118,6 +121,8 @@ impl<D: Drive> RtLoop<D> {
             measured: status.position,
             underruns: self.counters.underruns,
             fault: self.fault,
+            late_worst: self.jitter.worst,
+            late_over_half: self.jitter.over_half,
         };
         if self.ends.reports.push(report).is_err() {
             self.counters.reports_dropped += 1;
@@ -194,13 +199,13 @@ impl<D: Drive> RtLoop<D> {
     /// Runs periods on `clock` until `quit` is set; returns the counters and the clock's
     /// timing figures. Nothing in the loop allocates.
     pub fn run(&mut self, clock: &mut impl Clock, quit: &AtomicBool) -> (RtCounters, Jitter) {
-        let mut jitter = Jitter::default();
+        self.jitter = Jitter::default();
         while !quit.load(Ordering::Relaxed) {
             let late = clock.wait();
-            jitter.record(late, self.period);
+            self.jitter.record(late, self.period);
             self.tick();
         }
-        (self.counters, jitter)
+        (self.counters, self.jitter)
     }
 }
 

@@ -10,6 +10,8 @@ use std::time::Duration;
 
 use serde::Serialize;
 
+use tezgah_geom::Move;
+
 use crate::command::{Command, RunState, Status};
 use crate::drive::Drive;
 use crate::error::ExecError;
@@ -89,6 +91,8 @@ impl PlannerSide {
         if let Some(r) = &self.last {
             s.executing_line = r.line;
             s.underruns = r.underruns;
+            s.late_worst_s = r.late_worst;
+            s.late_over_half = r.late_over_half;
         }
         s
     }
@@ -178,6 +182,9 @@ pub struct Handle {
     requests: mpsc::Sender<Request>,
     /// The executor's status, refreshed by the planner thread.
     pub status: Arc<Mutex<Status>>,
+    /// The moves of the program loaded last (lines keyed as the status' lines), for a
+    /// front end's preview; set by the planner thread when a load succeeds.
+    pub program: Arc<Mutex<Option<Arc<Vec<Move>>>>>,
     quit: Arc<AtomicBool>,
     planner: JoinHandle<Lead>,
     rt: JoinHandle<(RtCounters, Jitter)>,
@@ -244,6 +251,8 @@ pub fn spawn<D: Drive + Send + 'static>(
         .expect("spawning the real-time thread");
     let q = quit.clone();
     let st = status.clone();
+    let program = Arc::new(Mutex::new(None));
+    let loaded = program.clone();
     let planner = std::thread::Builder::new()
         .name("tezgah-planner".into())
         .spawn(move || {
@@ -262,12 +271,22 @@ pub fn spawn<D: Drive + Send + 'static>(
                             | Command::Mdi { .. }
                             | Command::RestartFrom { .. }
                     );
+                    let load = matches!(c, Command::Load { .. });
                     let answer = if builds {
                         let fifo = planner_settings.fifo_priority;
                         realtime::time_shared(&granted, fifo, || side.command(c))
                     } else {
                         side.command(c)
                     };
+                    if load && answer.is_ok() {
+                        let moves = side
+                            .executor()
+                            .program_moves()
+                            .map(|m| Arc::new(m.to_vec()));
+                        if let Ok(mut p) = loaded.lock() {
+                            *p = moves;
+                        }
+                    }
                     let _ = reply.send(answer);
                 }
                 side.pump();
@@ -288,6 +307,7 @@ pub fn spawn<D: Drive + Send + 'static>(
     Handle {
         requests: rtx,
         status,
+        program,
         quit,
         planner,
         rt,

@@ -422,11 +422,7 @@ fn program_stops_and_single_block() {
 fn mdi_mixed_with_auto() {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    let mdi = |e: &mut tezgah_executor::executor::Executor, t: &mut Trace, b: &str| {
-        e.command(Command::Mdi { block: b.into() }).unwrap();
-        drive(e, t, 1_000_000, |_, _| {});
-        assert_eq!(e.state(), RunState::Idle);
-    };
+    let mdi = run_mdi;
     mdi(&mut exec, &mut trace, "G21 G90 F2400");
     mdi(&mut exec, &mut trace, "G1 X20 Y5");
     // Modal state carries: G91 then two relative moves.
@@ -981,4 +977,43 @@ fn five_axis_holds_and_override() {
     assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0));
     assert!((a.tip - b.tip).norm() <= 1e-9);
     assert!((a.rotary[0] - b.rotary[0]).abs() <= 1e-9 && (a.rotary[2] - b.rotary[2]).abs() <= 1e-9);
+}
+
+#[test]
+fn zero_set_in_mdi_moves_the_work_frame_of_the_status_and_of_programs_loaded_after() {
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    let mdi = run_mdi;
+    mdi(&mut exec, &mut trace, "G21 G90 G1 X30 Y-10 Z5 F3000");
+    let w = exec.status().work;
+    assert_eq!((w.coordinate_system, w.g5x), (1, [0.0; 3]));
+    assert_eq!(
+        (w.inches, w.incremental, w.plane, w.motion),
+        (false, false, 17, Some(10))
+    );
+    assert_eq!(w.position, [30.0, -10.0, 5.0]);
+    // G10 L20: the work X and Y are zero here; the machine stays.
+    mdi(&mut exec, &mut trace, "G10 L20 P1 X0 Y0");
+    let s = exec.status();
+    assert_eq!(s.work.g5x, [30.0, -10.0, 0.0]);
+    assert_eq!(s.work.position, [0.0, 0.0, 5.0]);
+    assert_eq!(s.tip, [30.0, -10.0, 5.0]);
+    // A program loaded now runs in the zeroed frame.
+    run_program(&mut exec, &mut trace, "G90 F3000\nG1 X5 Y5\nM2\n");
+    let s = exec.status();
+    assert!(
+        (s.tip[0] - 35.0).abs() < 1e-9 && (s.tip[1] + 5.0).abs() < 1e-9,
+        "{:?}",
+        s.tip
+    );
+    assert!((s.work.position[0] - 5.0).abs() < 1e-9, "{:?}", s.work);
+    // G92 and G20 show in the state (lengths stay mm).
+    mdi(&mut exec, &mut trace, "G20 G92 X0");
+    let w = exec.status().work;
+    assert!(w.inches);
+    assert!((w.g92[0] - 5.0).abs() < 1e-9, "{w:?}");
+    assert!(w.position[0].abs() < 1e-9, "{w:?}");
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
 }

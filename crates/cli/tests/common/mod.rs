@@ -104,3 +104,52 @@ pub fn check_and_run(name: &str, samples: Option<&Path>) -> serde_json::Value {
     );
     report
 }
+
+/// A `tezgah serve` process, killed when dropped (also on a failed assertion).
+pub struct Server(pub std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// What `tezgah serve` printed when it started.
+pub struct Banner {
+    /// `ws://127.0.0.1:port`
+    pub ws: String,
+    /// The panel's URL, with `?token=…` when one is needed.
+    pub panel: String,
+}
+
+/// `tezgah serve --listen 127.0.0.1:0` with `options`, and what it printed up to the panel's
+/// URL.
+pub fn serve(options: &[&str]) -> (Server, Banner) {
+    use std::io::{BufRead, BufReader};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tezgah"))
+        .args(["serve", "--listen", "127.0.0.1:0"])
+        .args(options)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let server = Server(child);
+    let mut lines = String::new();
+    while !lines.contains("the panel is at") {
+        let n = out.read_line(&mut lines).unwrap();
+        assert!(n > 0, "the server stopped; it printed {lines:?}");
+    }
+    let word = |prefix: &str| {
+        lines
+            .split_whitespace()
+            .find(|w| w.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no {prefix} in {lines:?}"))
+            .to_owned()
+    };
+    let banner = Banner {
+        ws: word("ws://"),
+        panel: word("http://"),
+    };
+    (server, banner)
+}

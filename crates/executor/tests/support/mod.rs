@@ -90,6 +90,16 @@ pub fn drive(
     max
 }
 
+/// One MDI block, run to its end.
+pub fn run_mdi(exec: &mut Executor, trace: &mut Trace, block: &str) {
+    exec.command(Command::Mdi {
+        block: block.into(),
+    })
+    .unwrap();
+    drive(exec, trace, 1_000_000, |_, _| {});
+    assert_eq!(exec.state(), RunState::Idle);
+}
+
 pub fn run_program(exec: &mut Executor, trace: &mut Trace, program: &str) {
     exec.command(Command::Load {
         program: program.into(),
