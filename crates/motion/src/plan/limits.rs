@@ -604,6 +604,48 @@ pub fn segment_limits_at_feed(
     reserve: bool,
     feed_scale: f64,
 ) -> Result<SegmentLimits, PlanError> {
+    limits_for_change(
+        seg,
+        geom,
+        machine,
+        options,
+        reserve,
+        feed_scale,
+        REFERENCE_CHANGE,
+    )
+}
+
+/// The limits of the cruise between a curved segment's speed steps ([`ladder`]): the steps
+/// climb to 90 % of it, so the cruise's own ramps are a tenth of its speed, and it may run
+/// closer to the curvature limit than a segment that must change speed by a quarter.
+pub fn cruise_limits(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+) -> Result<SegmentLimits, PlanError> {
+    limits_for_change(
+        seg,
+        geom,
+        machine,
+        options,
+        reserve,
+        1.0,
+        1.0 - LADDER[LADDER.len() - 1],
+    )
+}
+
+/// [`segment_limits_at_feed`] with the split chosen for ramps of `change`·V at the ends.
+fn limits_for_change(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+    feed_scale: f64,
+    change: f64,
+) -> Result<SegmentLimits, PlanError> {
     let n = machine.joint_count().min(MAX_JOINTS);
     let budget = if reserve {
         1.0 - options.junction_reserve
@@ -674,10 +716,11 @@ pub fn segment_limits_at_feed(
             jerk: std::array::from_fn(|i| budget * machine.max_jerk.get(i).copied().unwrap_or(0.0)),
             n,
         };
-        (v, a, j) = best_split(v, geom.length, &budgets).ok_or_else(|| PlanError::NoLimit {
-            line: seg.line,
-            reason: "no acceleration is left at any speed".into(),
-        })?;
+        (v, a, j) =
+            best_split(v, geom.length, change, &budgets).ok_or_else(|| PlanError::NoLimit {
+                line: seg.line,
+                reason: "no acceleration is left at any speed".into(),
+            })?;
     }
     if !a.is_finite() {
         a = options.idle_rotary[1];
@@ -720,13 +763,20 @@ const REFERENCE_CHANGE: f64 = 0.25;
 /// plus, at each end, what a jerk-limited ramp of `REFERENCE_CHANGE`·V costs over cruising
 /// (half its duration times the change's share of V). `None` if no speed leaves room for
 /// acceleration.
-fn best_split(top: f64, length: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
+fn best_split(
+    top: f64,
+    length: f64,
+    change: f64,
+    budgets: &Budgets<'_>,
+) -> Option<(f64, f64, f64)> {
     let reference = length.max(REFERENCE_LENGTH);
     let mut best: Option<(f64, (f64, f64, f64))> = None;
     for beta in SPEED_FRACTIONS {
         let v = beta * top;
-        if let Some((a, j, ramp)) = at_speed(v, REFERENCE_CHANGE * v, budgets) {
-            let time = reference / v + ramp * REFERENCE_CHANGE;
+        // The acceleration is shared for a ramp through the whole speed (a group's ends are
+        // often far below its cruise: corners, stops); the speed for a change of a quarter.
+        if let Some((a, j, _)) = at_speed(v, v, budgets) {
+            let time = reference / v + ramp_time(change * v, a, j) * change;
             if best.is_none_or(|(t, _)| time < t) {
                 best = Some((time, (v, a, j)));
             }
@@ -773,16 +823,22 @@ fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
         if !(j > 0.0 && j.is_finite()) {
             continue;
         }
-        let ramp = if dv * j >= a * a {
-            dv / a + a / j
-        } else {
-            2.0 * (dv / j).sqrt()
-        };
+        let ramp = ramp_time(dv, a, j);
         if best.is_none_or(|(_, _, t)| ramp < t) {
             best = Some((a, j, ramp));
         }
     }
     best
+}
+
+/// The duration of a jerk-limited speed change `dv` from rest acceleration to rest
+/// acceleration under (A, J): dv/A + A/J, or 2√(dv/J) where A is not reached.
+fn ramp_time(dv: f64, a: f64, j: f64) -> f64 {
+    if dv * j >= a * a {
+        dv / a + a / j
+    } else {
+        2.0 * (dv / j).sqrt()
+    }
 }
 
 /// Speeds, as shares of a curved segment's cruise speed, of the steps [`ladder`] climbs by.

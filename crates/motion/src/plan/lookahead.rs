@@ -13,8 +13,8 @@ use std::sync::Arc;
 
 use super::joints::PlanMachine;
 use super::limits::{
-    analyse, has_jump, inside_group, junction_cap, ladder, segment_limits, Geometry, PlanOptions,
-    SegmentLimits,
+    analyse, cruise_limits, has_jump, inside_group, junction_cap, ladder, segment_limits, Geometry,
+    PlanOptions, SegmentLimits,
 };
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
@@ -270,13 +270,19 @@ impl Planner {
             Some(l) if !reserve => l,
             _ => segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?,
         };
+        // With speed steps at its ends, the cruise only changes speed by the last step.
+        let cruise = if geom.curved() {
+            cruise_limits(&seg, &geom, &self.machine, &self.options, reserve)?
+        } else {
+            sl
+        };
         let step = |from| {
             ladder(
                 &geom,
                 &self.machine,
                 &self.options,
                 reserve,
-                &sl.limits,
+                &cruise.limits,
                 from,
             )
         };
@@ -285,6 +291,7 @@ impl Planner {
         if up.is_empty() && down.is_empty() {
             return self.add_span(seg, (0.0, geom.length), geom, sl, end_cap);
         }
+        let sl = cruise;
         // Speed steps up at the start, the cruise, steps down at the end; each is a group of
         // its own (joined, they would share the smallest acceleration again).
         let climb: f64 = up.iter().chain(&down).map(|s| s.0).sum();
