@@ -133,4 +133,8 @@ pub struct Status {
     pub time_scale: f64,
     /// The last error, if any.
     pub error: Option<String>,
+    /// What the loaded program's interpretation warned of: a text that ended without M2, M30
+    /// or `%` (`program:line:col: …; run as if it ended with M2`).
+    #[serde(default)]
+    pub warning: Option<String>,
 }

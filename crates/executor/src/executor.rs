@@ -131,6 +131,8 @@ pub struct Executor {
     /// Where the MDI interpreter believes the machine is (the end of its last move).
     mdi_at: Pose,
     error: Option<String>,
+    /// What the loaded program's interpretation warned of (a missing program end).
+    warning: Option<String>,
     /// Where the tool is (the last sample, or a piece's exact end).
     pose: CursorPose,
     k: u64,
@@ -186,6 +188,7 @@ impl Executor {
             })?;
         let gcode = tezgah_gcode::Config {
             tool_centre_point_always: machine.tcp == TcpSwitch::Always,
+            axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
             ..tezgah_gcode::Config::default()
         };
         let n = pm.joint_count();
@@ -219,6 +222,7 @@ impl Executor {
             single_block: false,
             optional_stop: false,
             error: None,
+            warning: None,
             pose: CursorPose {
                 line: 0,
                 tip,
@@ -314,6 +318,7 @@ impl Executor {
             tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
             time_scale: self.scale.r,
             error: self.error.clone(),
+            warning: self.warning.clone(),
         }
     }
 
@@ -438,6 +443,7 @@ impl Executor {
                     return Err(self.busy("load"));
                 }
                 let program = Program::interpret(program, &self.gcode)?;
+                self.warning = (!program.warnings.is_empty()).then(|| program.warnings.join("\n"));
                 let here = self.program_pose();
                 self.built = Some(self.preflight(program.moves.clone(), here, &program.origins)?);
                 self.program = Some(program);

@@ -95,3 +95,52 @@ fn eq_and_ne_compare_within_a_ten_thousandth() {
         assert_eq!(shown, format!("{want:.6}"), "{expr}");
     }
 }
+
+/// A text that ends without M2, M30 or `%` runs every move and ends as if `M2` followed its
+/// last line (LinuxCNC's milltask runs the moves, then reports); `rs274`'s behaviour, the
+/// error, stays with `MissingEnd::Error` (`Config::linuxcnc`, what `canon` uses).
+#[test]
+fn a_missing_program_end_runs_as_m2() {
+    use tezgah_gcode::{Canon, GcodeError, Interpreter, MissingEnd, Origin};
+    let program = "G21 G90 M3 S1000\nG1 X10 F100\nG1 Y5\n";
+    let mut calls: Vec<(Origin, Canon)> = Vec::new();
+    let mut interp = Interpreter::new(Config::default());
+    interp.run(program, &mut calls).unwrap();
+    // The moves, then M2's resets: spindle stopped, feed zeroed, program end.
+    let tail: Vec<&Canon> = calls.iter().rev().take(4).map(|(_, c)| c).collect();
+    assert!(matches!(tail[0], Canon::ProgramEnd), "{tail:?}");
+    assert!(calls.iter().any(|(_, c)| matches!(c, Canon::StopSpindle)));
+    let feeds = calls
+        .iter()
+        .filter(|(_, c)| matches!(c, Canon::StraightFeed(_)))
+        .count();
+    assert_eq!(feeds, 2);
+    // The end's calls come from the last line.
+    assert_eq!(calls.last().unwrap().0.line, 3);
+    let missing: &GcodeError = interp.missing_end().unwrap();
+    assert_eq!(missing.kind, ErrorKind::NoProgramEnd);
+    assert_eq!((missing.span.line, missing.span.column), (3, 6));
+    // With M2 there is nothing to say.
+    let mut interp = Interpreter::new(Config::default());
+    interp
+        .run("G0 X1\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap();
+    assert!(interp.missing_end().is_none());
+    // rs274's behaviour.
+    let cfg = Config {
+        missing_end: MissingEnd::Error,
+        ..Config::default()
+    };
+    let err = Interpreter::new(cfg)
+        .run(program, &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "File ended with no percent sign or program end"
+    );
+    // An unclosed subroutine is still an error, M2 or not.
+    let err = Interpreter::new(Config::default())
+        .run("o100 sub\nG0 X1\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_ne!(err.kind, ErrorKind::NoProgramEnd);
+}

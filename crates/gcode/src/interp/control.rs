@@ -280,7 +280,7 @@ impl Interpreter {
     /// Read the current (lexed) control line in full, its bracketed values evaluated.
     fn read_control_line(&mut self, line: LineRef) -> Result<OWord, GcodeError> {
         let mut block = self.block.take().unwrap_or_default();
-        let read = block.read(&self.norm, &self.params);
+        let read = block.read(&self.norm, &self.params, self.cfg.axes);
         let o = block.o.take();
         self.block = Some(block);
         let at = |idx: usize| {
