@@ -375,6 +375,13 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
+    #[error("Cannot restore context from invalid stack frame - missing M70/M73?")]
+    RestoreWithoutContext,
+    /// LinuxCNC prints the (still empty) command text here.
+    #[error("M7x: restore_settings G20/G21 failed: ''")]
+    RestoreUnitsFailed,
+    #[error("M7x: restore_settings failed executing: '{0}': {1}")]
+    RestoreFailed(String, String),
 
     // --- splines: LinuxCNC's G5, G5.1, G5.2/G5.3 (its wording) ---
     #[error("Splines must be in the XY plane")]

@@ -144,3 +144,95 @@ fn a_missing_program_end_runs_as_m2() {
         .unwrap_err();
     assert_ne!(err.kind, ErrorKind::NoProgramEnd);
 }
+
+fn data(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// Every call tezgah makes for `data/<name>.ngc` with the tool table `<name>.tbl`, printed as
+/// rs274 prints them (with its driver's two closing resets), and the error, if any.
+fn our_rs274_calls(name: &str) -> (Vec<String>, Option<String>) {
+    use tezgah_gcode::{Canon, Interpreter, Origin, ToolTable};
+    let program = std::fs::read_to_string(data(&format!("{name}.ngc"))).unwrap();
+    let table = std::fs::read_to_string(data(&format!("{name}.tbl"))).unwrap();
+    let config = Config::linuxcnc(ToolTable::parse(&table).unwrap());
+    let mut calls = Vec::<(Origin, Canon)>::new();
+    let result = Interpreter::new(config).run(&program, &mut calls);
+    let mut printed: Vec<String> = calls.iter().map(|(_, c)| c.to_string()).collect();
+    printed.extend(["ON_RESET()".to_owned(), "ON_RESET()".to_owned()]);
+    (printed, result.err().map(|e| e.kind.to_string()))
+}
+
+/// `data/<name>.expected`: what LinuxCNC 2.9's `rs274` printed for the program (call number
+/// and N field dropped). With `TEZGAH_RS274` set, rs274 runs again and must still print it.
+fn rs274_expected(name: &str) -> Vec<String> {
+    let expected: Vec<String> = std::fs::read_to_string(data(&format!("{name}.expected")))
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    if let Some(rs274) = std::env::var_os("TEZGAH_RS274") {
+        let out = std::process::Command::new(rs274)
+            .arg("-t")
+            .arg(data(&format!("{name}.tbl")))
+            .arg("-g")
+            .arg(data(&format!("{name}.ngc")))
+            .stdin(std::process::Stdio::null())
+            .output()
+            .expect("run rs274");
+        let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter_map(|l| l.find(" N..... ").map(|i| l[i + 8..].to_owned()))
+            .collect();
+        assert_eq!(theirs, expected, "rs274 no longer prints {name}.expected");
+    }
+    expected
+}
+
+/// M70 saves, M71 forgets, M72 restores the modal state and M73 restores it when the
+/// subroutine returns: every canonical call (the restoring codes in rs274's order, F restored
+/// as LinuxCNC prints it, `F10.2` for 10.25) and the `#<_…>` parameters read after each
+/// restore agree with rs274 call for call.
+#[test]
+fn m70_to_m73_match_rs274_call_for_call() {
+    let expected = rs274_expected("modal_state");
+    assert_eq!(expected.len(), 107, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("modal_state");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// M72 with nothing saved at its call level, M71's invalidation, and M70 in the spindle's
+/// modal group: LinuxCNC's errors, at the M word.
+#[test]
+fn m72_without_a_saved_state_fails_as_linuxcnc() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let run = |program: &str| {
+        Interpreter::new(Config::linuxcnc(Default::default()))
+            .run(program, &mut Vec::<(Origin, Canon)>::new())
+            .unwrap_err()
+    };
+    let none = "Cannot restore context from invalid stack frame - missing M70/M73?";
+    let err = run("G21\nF10 M72\nM2\n");
+    assert_eq!(
+        (
+            err.kind.to_string().as_str(),
+            err.span.line,
+            err.span.column
+        ),
+        (none, 2, 5)
+    );
+    assert_eq!(run("M70\nM71\nM72\nM2\n").kind.to_string(), none);
+    // Saved in the caller, not at the subroutine's level.
+    let sub = "o1 sub\nM72\no1 endsub\nM70\no1 call\nM2\n";
+    assert_eq!(run(sub).kind.to_string(), none);
+    assert_eq!(
+        run("M3 M70\nM2\n").kind.to_string(),
+        "Two m codes used from same modal group"
+    );
+}

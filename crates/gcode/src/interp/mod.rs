@@ -12,6 +12,7 @@ mod comp;
 mod control;
 mod cycles;
 mod execute;
+mod modes;
 mod motion;
 mod spline;
 mod state;
@@ -137,6 +138,8 @@ pub struct Interpreter {
     /// The program ran out of text without an end and was ended as by M2: the error that
     /// would have been ([`MissingEnd::AsM2`]).
     missing_end: Option<GcodeError>,
+    /// What M70/M73 saved at each call level.
+    saved_modes: modes::ModeStack,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -202,6 +205,7 @@ impl Interpreter {
             files: Vec::new(),
             spline_memory: Default::default(),
             missing_end: None,
+            saved_modes: Default::default(),
         };
         interp.restore_parameters();
         interp
