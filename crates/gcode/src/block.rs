@@ -129,6 +129,10 @@ pub struct Block {
     pub assignments: Vec<Assignment>,
     /// The O-word, on a control-flow line (which holds nothing else but comments).
     pub o: Option<OWord>,
+    /// LinuxCNC's polar words: `@` the radius and `^` the angle (degrees) of the end point
+    /// in the XY plane. A second one on a line replaces the first, as in LinuxCNC.
+    pub radius: Option<Word>,
+    pub theta: Option<Word>,
 }
 
 /// Letters of the six axes, in [`Pose`] order.
@@ -232,6 +236,21 @@ impl Block {
         self.m[group].map(|c| c.code)
     }
 
+    /// Whether the block has a polar word (`@` or `^`).
+    #[inline]
+    pub fn polar(&self) -> bool {
+        self.radius.is_some() || self.theta.is_some()
+    }
+
+    /// Where the block's first polar word stands.
+    pub fn polar_at(&self) -> u32 {
+        match (self.radius, self.theta) {
+            (Some(r), Some(t)) => r.at.min(t.at),
+            (Some(w), None) | (None, Some(w)) => w.at,
+            (None, None) => 0,
+        }
+    }
+
     /// Whether any axis word (X Y Z A B C) is present.
     pub fn has_axis_words(&self) -> bool {
         self.axis_words().iter().any(Option::is_some)
@@ -262,6 +281,8 @@ impl Block {
         self.comment = None;
         self.assignments.clear();
         self.o = None;
+        self.radius = None;
+        self.theta = None;
     }
 
     /// Read the normalised line `line` into `self`; words of axes `axes` lacks are bad
@@ -305,6 +326,18 @@ impl Block {
                 b'#' => self.read_assignment(&mut r, at)?,
                 b'g' => self.read_g(&mut r, at)?,
                 b'm' => self.read_m(&mut r, at)?,
+                b'@' | b'^' => {
+                    r.pos += 1;
+                    let word = Some(Word {
+                        value: r.real_value()?,
+                        at,
+                    });
+                    if c == b'@' {
+                        self.radius = word;
+                    } else {
+                        self.theta = word;
+                    }
+                }
                 c if is_value_letter(c) && refused >> (c - b'a') & 1 == 0 => {
                     self.read_letter(&mut r, c, at)?
                 }

@@ -375,6 +375,21 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
+    // --- polar coordinates (`@` radius, `^` angle) ---
+    #[error("Cannot use polar coordinate except in G17 plane")]
+    PolarNotXyPlane,
+    #[error("Cannot specify both polar coordinate and {0} word")]
+    PolarWithAxisWord(char),
+    #[error("Polar coordinates can only be used for motion")]
+    PolarWithoutMotion,
+    #[error("Cannot use polar coordinates with G53")]
+    PolarWithG53,
+    #[error("Must specify angle in polar coordinate if at the origin")]
+    PolarAngleAtOrigin,
+    #[error("Incremental motion with polar coordinates is indeterminate when at the origin")]
+    PolarIncrementalAtOrigin,
+    #[error("G91 motion with polar coordinates is indeterminate when at the origin")]
+    PolarG91AtOrigin,
     #[error("Cannot restore context from invalid stack frame - missing M70/M73?")]
     RestoreWithoutContext,
     /// LinuxCNC prints the (still empty) command text here.

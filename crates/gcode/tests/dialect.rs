@@ -174,7 +174,12 @@ fn rs274_expected(name: &str) -> Vec<String> {
         .map(str::to_owned)
         .collect();
     if let Some(rs274) = std::env::var_os("TEZGAH_RS274") {
+        // rs274 writes its parameter file where it runs: a folder of its own per program.
+        let dir =
+            std::env::temp_dir().join(format!("tezgah-dialect-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
         let out = std::process::Command::new(rs274)
+            .current_dir(&dir)
             .arg("-t")
             .arg(data(&format!("{name}.tbl")))
             .arg("-g")
@@ -182,6 +187,7 @@ fn rs274_expected(name: &str) -> Vec<String> {
             .stdin(std::process::Stdio::null())
             .output()
             .expect("run rs274");
+        let _ = std::fs::remove_dir_all(&dir);
         let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
             .lines()
             .filter_map(|l| l.find(" N..... ").map(|i| l[i + 8..].to_owned()))
@@ -235,4 +241,80 @@ fn m72_without_a_saved_state_fails_as_linuxcnc() {
         run("M3 M70\nM2\n").kind.to_string(),
         "Two m codes used from same modal group"
     );
+}
+
+/// Polar coordinates (`@` radius, `^` angle): absolute and G91 lines, R and I J arcs, G81
+/// and G83 in G90 and G91 with L repeats going round a circle. Every call agrees with
+/// rs274's 147.
+#[test]
+fn polar_coordinates_match_rs274_call_for_call() {
+    let expected = rs274_expected("polar");
+    assert_eq!(expected.len(), 147, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("polar");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// Each polar-coordinate refusal with LinuxCNC's text (as rs274 printed it).
+#[test]
+fn polar_coordinate_errors_are_linuxcnc_s() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let cases = [
+        (
+            "G18\nG1 @1 F10",
+            "Cannot use polar coordinate except in G17 plane",
+        ),
+        (
+            "G1 X1 @1 F10",
+            "Cannot specify both polar coordinate and X word",
+        ),
+        (
+            "G1 Y1 ^1 F10",
+            "Cannot specify both polar coordinate and Y word",
+        ),
+        ("G92 @1", "Polar coordinates can only be used for motion"),
+        (
+            "G10 L2 P1 @1",
+            "Polar coordinates can only be used for motion",
+        ),
+        (
+            "@1",
+            "Cannot use axis values without a g code that uses them",
+        ),
+        ("G80 @1", "Cannot use axis values with g80"),
+        ("G53 G0 @1 ^3", "Cannot use polar coordinates with G53"),
+        (
+            "G1 @1 F10",
+            "Must specify angle in polar coordinate if at the origin",
+        ),
+        (
+            "G91 G1 @1 F10",
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        ),
+        (
+            "G91 G1 ^1 F10",
+            "G91 motion with polar coordinates is indeterminate when at the origin",
+        ),
+        (
+            "G0 Z2\nG91 G81 @1 R1 Z-1 F10",
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        ),
+    ];
+    for (program, text) in cases {
+        let err = Interpreter::new(Config::linuxcnc(Default::default()))
+            .run(
+                &format!("{program}\nM2\n"),
+                &mut Vec::<(Origin, Canon)>::new(),
+            )
+            .expect_err(program);
+        assert_eq!(err.kind.to_string(), text, "{program}");
+    }
+    // The place of the error: the `@` word, line 2 column 4.
+    let err = Interpreter::new(Config::default())
+        .run("G18\nG1 @1 F10\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!((err.span.line, err.span.column), (2, 4));
 }
