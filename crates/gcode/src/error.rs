@@ -375,6 +375,18 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
+    // --- probing (G38.2–G38.5) ---
+    #[error("Cannot probe with cutter radius comp on")]
+    ProbeWithComp,
+    #[error("Cannot probe with zero feed rate")]
+    ProbeZeroFeed,
+    #[error("Cannot probe with feed per rev mode")]
+    ProbeFeedPerRev,
+    #[error("Start point too close to probe point")]
+    ProbeStartAtTarget,
+    /// tezgah's own: the executor has no probe input yet (`Config::probe`).
+    #[error("G{0} probing needs a probe input, which tezgah's executor does not have yet")]
+    ProbeUnavailable(String),
     // --- polar coordinates (`@` radius, `^` angle) ---
     #[error("Cannot use polar coordinate except in G17 plane")]
     PolarNotXyPlane,

@@ -174,6 +174,9 @@ fn rs274_expected(name: &str) -> Vec<String> {
         .map(str::to_owned)
         .collect();
     if let Some(rs274) = std::env::var_os("TEZGAH_RS274") {
+        // One rs274 at a time: its tool data lives in memory shared between its processes.
+        static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        let _one = RS274.lock().unwrap_or_else(|e| e.into_inner());
         // rs274 writes its parameter file where it runs: a folder of its own per program.
         let dir =
             std::env::temp_dir().join(format!("tezgah-dialect-{name}-{}", std::process::id()));
@@ -317,4 +320,108 @@ fn polar_coordinate_errors_are_linuxcnc_s() {
         .run("G18\nG1 @1 F10\nM2\n", &mut Vec::<(Origin, Canon)>::new())
         .unwrap_err();
     assert_eq!((err.span.line, err.span.column), (2, 4));
+}
+
+/// A cutter-compensation entry move (or entry arc) exactly one tool radius long is accepted,
+/// as rs274 2.9 accepts it in LinuxCNC's `useful-subroutines.ngc` (`g41 g0` onto the edge of
+/// a hole the size of the tool): the tool centre ends on the contour's normal, and every
+/// call agrees with rs274's 48. A shorter one is still refused.
+#[test]
+fn comp_entry_one_radius_long_is_accepted_as_rs274() {
+    use tezgah_gcode::{Canon, Interpreter, Origin, ToolTable};
+    let expected = rs274_expected("comp_entry");
+    assert_eq!(expected.len(), 48, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("comp_entry");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+    let table = ToolTable::parse("T1 P1 Z0.511 D0.125\n").unwrap();
+    for entry in ["G41 G0 X0 Y0", "G41 G1 X0 Y0", "G41 G2 X0 Y0 R0.5"] {
+        let program = format!("G20 T1 M6 F10\nG0 X0.06 Y0\n{entry}\nG40 G0 X1\nM2\n");
+        let err = Interpreter::new(Config::linuxcnc(table.clone()))
+            .run(&program, &mut Vec::<(Origin, Canon)>::new())
+            .expect_err(entry);
+        assert!(
+            err.kind
+                .to_string()
+                .ends_with("is not greater than the tool radius"),
+            "{entry}: {}",
+            err.kind
+        );
+    }
+    // A hole smaller than the tool is still refused (one of its size is filled).
+    let program = "G20 T1 M6 F10\nG0 X0.2 Y0.06\nG41 G0 X0 Y0.06\nG3 X0 Y0.06 I0 J-0.06\nM2\n";
+    let err = Interpreter::new(Config::linuxcnc(table))
+        .run(program, &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "Tool radius not less than arc radius with comp"
+    );
+}
+
+/// G38.2–G38.5 under `ProbeModel::Rs274` (what `canon` uses): the probe calls, `#5061`…
+/// `#5070` and the position after each probe agree with rs274's 44 calls (its probe never
+/// trips and stops 0.01 in short of the target).
+#[test]
+fn probing_matches_rs274_call_for_call() {
+    let expected = rs274_expected("probe");
+    assert_eq!(expected.len(), 44, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("probe");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// LinuxCNC's probing errors; and where moves are made for a machine (the default
+/// `ProbeModel::Unavailable`), a probe that passes them is refused at its G38 word rather
+/// than run as a feed that never trips.
+#[test]
+fn probing_errors_are_linuxcnc_s_and_runs_refuse_probing() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let cases = [
+        ("G38.2 X1", "Cannot probe with zero feed rate"),
+        ("F10 G38.2", "All axes missing with motion code"),
+        ("F10 G38.2 X0", "Start point too close to probe point"),
+        ("F10 G38.4 X0", "Start point too close to probe point"),
+        (
+            "F10 G41.1 D0.1 G0 X1\nG38.2 X2",
+            "Cannot probe with cutter radius comp on",
+        ),
+        (
+            "G95 F10 S100 M3 G38.2 X1",
+            "Cannot probe with feed per rev mode",
+        ),
+        ("G93 G38.2 X1 F10", "Cannot probe with zero feed rate"),
+    ];
+    for (program, text) in cases {
+        for config in [Config::linuxcnc(Default::default()), Config::default()] {
+            let err = Interpreter::new(config)
+                .run(
+                    &format!("{program}\nM2\n"),
+                    &mut Vec::<(Origin, Canon)>::new(),
+                )
+                .expect_err(program);
+            assert_eq!(err.kind.to_string(), text, "{program}");
+        }
+    }
+    // G38.3 to where it stands is no error for rs274.
+    Interpreter::new(Config::linuxcnc(Default::default()))
+        .run("F10 G38.3 X0\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap();
+    let err = Interpreter::new(Config::default())
+        .run(
+            "G21 F100\nG38.2 Z-10\nM2\n",
+            &mut Vec::<(Origin, Canon)>::new(),
+        )
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "G38.2 probing needs a probe input, which tezgah's executor does not have yet"
+    );
+    assert_eq!((err.span.line, err.span.column), (2, 1));
 }

@@ -62,6 +62,22 @@ pub struct Config {
     pub axes: AxisMask,
     /// What reaching the end of the text without M2, M30 or a closing `%` does.
     pub missing_end: MissingEnd,
+    /// Where G38.2–G38.5 find out whether and where the probe tripped.
+    pub probe: ProbeModel,
+}
+
+/// What answers a probing move (G38.2–G38.5): the probe position (`#5061`…), whether it
+/// tripped (`#5070`) and where the move stopped. The program after a probe depends on the
+/// answer, so a run on a machine needs the executor's; until that hand-off exists, passes
+/// that make moves refuse probing rather than guess.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ProbeModel {
+    /// Refused with [`ErrorKind::ProbeUnavailable`], after LinuxCNC's own checks.
+    #[default]
+    Unavailable,
+    /// LinuxCNC's standalone `rs274`: the probe never trips (`#5070` = 0), `#5061`… hold the
+    /// target, and the move stops 0.01 in (0.254 mm) short of it, as its canon layer reports.
+    Rs274,
 }
 
 /// What the end of the text without M2, M30 or a closing `%` does.
@@ -90,6 +106,7 @@ impl Config {
             tool_centre_point_always: false,
             axes: AxisMask::XYZABC,
             missing_end: MissingEnd::Error,
+            probe: ProbeModel::Rs274,
         }
     }
 }

@@ -41,6 +41,7 @@ impl Interpreter {
                 return Ok(());
             }
             62 => self.g62_line(block, at, sink)?,
+            382..=385 => self.probe(block, g, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);
@@ -142,6 +143,60 @@ impl Interpreter {
         };
         self.emit(sink, call);
         self.state.pos = end;
+        Ok(())
+    }
+
+    /// G38.2 (toward the point until the probe trips, an error if it does not), G38.3 (no
+    /// error), G38.4 / G38.5 (until it clears), with LinuxCNC's checks (`convert_probe`);
+    /// the answer comes from `cfg.probe`.
+    fn probe(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if self.comp.side.is_some() {
+            return Err((ErrorKind::ProbeWithComp, at));
+        }
+        if self.state.feed_rate == 0.0 {
+            return Err((ErrorKind::ProbeZeroFeed, at));
+        }
+        if self.state.feed_mode == FeedMode::UnitsPerRevolution {
+            return Err((ErrorKind::ProbeFeedPerRev, at));
+        }
+        let end = self.find_ends(block).map_err(|k| (k, at))?;
+        let start = self.state.pos;
+        // G38.3 and G38.5 do not fail, so they may start where they end.
+        if matches!(g, 382 | 384) && end == start {
+            return Err((ErrorKind::ProbeStartAtTarget, at));
+        }
+        if self.cfg.probe == super::ProbeModel::Unavailable {
+            return Err((
+                ErrorKind::ProbeUnavailable(format!("{}.{}", g / 10, g % 10)),
+                at,
+            ));
+        }
+        self.emit(sink, Canon::TurnProbeOn);
+        self.emit(sink, Canon::StraightProbe(end));
+        self.emit(sink, Canon::TurnProbeOff);
+        // rs274's canon: never tripped, the target as the probe position, and the machine
+        // 0.01 in short of it along the XYZ direction of the move.
+        let d = [
+            start.0[0] - end.0[0],
+            start.0[1] - end.0[1],
+            start.0[2] - end.0[2],
+        ];
+        let distance = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let mut stop = end;
+        if distance != 0.0 {
+            let backoff = if self.state.inches() { 0.01 } else { 0.254 };
+            for (i, di) in d.iter().enumerate() {
+                stop.0[i] = end.0[i] + backoff * (di / distance);
+            }
+        }
+        for (i, v) in end.0.iter().enumerate() {
+            self.params.set(params::PROBE_POSITION + i, *v);
+        }
+        for i in 6..9 {
+            self.params.set(params::PROBE_POSITION + i, 0.0);
+        }
+        self.params.set(params::PROBE_TRIPPED, 0.0);
+        self.state.pos = stop;
         Ok(())
     }
 
