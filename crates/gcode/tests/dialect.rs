@@ -216,6 +216,17 @@ fn m70_to_m73_match_rs274_call_for_call() {
     assert_eq!(ours.len(), expected.len());
 }
 
+/// M72 also restores whether the G92/G52 offsets are applied (G92.2 / G92.3, as rs274 2.9
+/// does): `data/m7_g92.ngc` agrees with rs274's 30 calls and its `#5210`, `#5211`.
+#[test]
+fn m72_restores_the_g92_state_as_rs274() {
+    let expected = rs274_expected("m7_g92");
+    assert_eq!(expected.len(), 30, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("m7_g92");
+    assert_eq!(error, None);
+    assert_eq!(ours, expected);
+}
+
 /// M72 with nothing saved at its call level, M71's invalidation, and M70 in the spindle's
 /// modal group: LinuxCNC's errors, at the M word.
 #[test]

@@ -21,8 +21,9 @@ use super::{Interpreter, LineRef};
 
 /// G-code slots of LinuxCNC's `active_g_codes` that a restore sets (ten times the code; -1
 /// none), in its order: plane, cutter compensation, units, distance, feed mode, coordinate
-/// system, tool length, retract, path control, arc distance, lathe diameter.
-const G_SLOTS: usize = 11;
+/// system, tool length, retract, path control, arc distance, lathe diameter, and whether the
+/// G92/G52 offsets are applied (G92.3) or not (G92.2), which rs274 2.9 restores too.
+const G_SLOTS: usize = 12;
 const UNITS: usize = 2;
 const PATH_CONTROL: usize = 8;
 
@@ -107,6 +108,11 @@ impl Interpreter {
             },
             if s.ijk_incremental { 911 } else { 901 },
             if s.lathe_diameter { 70 } else { 80 },
+            if self.params.get(crate::params::G92_ENABLED) != 0.0 {
+                923
+            } else {
+                922
+            },
         ];
         let w = &s.switches;
         let m = [
