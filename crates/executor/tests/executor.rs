@@ -982,3 +982,33 @@ fn five_axis_holds_and_override() {
     assert!((a.tip - b.tip).norm() <= 1e-9);
     assert!((a.rotary[0] - b.rotary[0]).abs() <= 1e-9 && (a.rotary[2] - b.rotary[2]).abs() <= 1e-9);
 }
+
+/// MDI blocks and loaded programs are read for the machine's axes (mill3: X Y Z), so an A word
+/// is LinuxCNC's bad character at its place rather than dropped; a program without M2 loads
+/// and the status carries the warning that names its last line.
+#[test]
+fn axes_the_machine_lacks_are_refused_in_mdi_and_load() {
+    let mut exec = executor();
+    let mdi = Command::Mdi {
+        block: "G1 X10 A90 F600".into(),
+    };
+    let load = Command::Load {
+        program: "G21 F600\nG1 X10 A90\nM2\n".into(),
+    };
+    for (command, place) in [(mdi, "MDI:1:8"), (load, "program:2:8")] {
+        let err = exec.command(command).unwrap_err().to_string();
+        assert!(
+            err.contains(place) && err.contains("Bad character 'a' used"),
+            "{err}"
+        );
+    }
+    exec.command(Command::Load {
+        program: "G21 F600\nG1 X10\n".into(),
+    })
+    .unwrap();
+    let warning = exec.status().warning.unwrap_or_default();
+    assert!(
+        warning.contains("program:2:7: File ended with no percent sign or program end"),
+        "{warning}"
+    );
+}
