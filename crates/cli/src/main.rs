@@ -152,6 +152,12 @@ fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitC
         tool_centre_point_always: machine
             .as_ref()
             .is_some_and(|m| m.tcp == tezgah_kinematics::TcpSwitch::Always),
+        // Without a machine, all six axes, as LinuxCNC's `rs274`.
+        axes: machine
+            .as_ref()
+            .map_or(tezgah_gcode::AxisMask::XYZABC, |m| {
+                tezgah_gcode::AxisMask::of(m.program_axes())
+            }),
         ..Config::default()
     };
     let pass = match machine {
@@ -166,6 +172,9 @@ fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitC
         &mut counts,
     );
     if done.errors.is_empty() {
+        for w in &done.warnings {
+            eprintln!("warning: {w}");
+        }
         if let Some(machine) = &machine {
             let tolerance = machine.motion.tolerance_mm;
             run::build_path(&done.sources, &done.keys, done.moves, machine, tolerance)?;

@@ -184,6 +184,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         ini: extra.ini.clone(),
         parameters: extra.parameters.clone(),
         tool_centre_point_always: machine.tcp == TcpSwitch::Always,
+        axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
         ..Config::default()
     };
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
@@ -197,6 +198,9 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if let Some(e) = done.errors.first() {
         eprintln!("{:?}", crate::diagnostics::report(&done.sources, e));
         return Ok(std::process::ExitCode::FAILURE);
+    }
+    for w in &done.warnings {
+        eprintln!("warning: {w}");
     }
     let period = args.period.unwrap_or(machine.motion.period_s);
     if !(period > 0.0 && period.is_finite()) {

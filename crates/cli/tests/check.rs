@@ -168,3 +168,71 @@ fn check_with_a_tcp_always_machine_reads_the_program_under_tcp() {
     let err = stderr(&refused);
     assert!(err.contains("deep.ngc:2:1: joint 2 (`z`)"), "{err}");
 }
+
+/// A word of an axis the machine lacks is refused where LinuxCNC refuses it (its axis mask):
+/// `check --machine machines/mill3.toml` and `run` name the line and the column of the `A`,
+/// while the table-ac machine, which has A, and `check` without a machine (rs274's XYZABC)
+/// pass it.
+#[test]
+fn an_axis_the_machine_lacks_is_a_bad_character_at_its_line_and_column() {
+    let dir = tmp_dir("axis-mask");
+    let program = dir.join("rotary.ngc");
+    std::fs::write(&program, "G21 G90\nG1 X10 A90 F600\nM2\n").unwrap();
+    let mill3 = concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines/mill3.toml");
+    let place = format!("{}:2:8: Bad character 'a' used", program.display());
+    for (command, machine) in [("check", mill3), ("run", "mill3")] {
+        let out = tezgah()
+            .arg(command)
+            .arg(&program)
+            .args(["--machine", machine])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{command}");
+        let err = stderr(&out);
+        assert!(err.contains(&place), "{command}: {err}");
+    }
+    for machine in [&["--machine", "table-ac"][..], &[]] {
+        let out = tezgah()
+            .arg("check")
+            .arg(&program)
+            .args(machine)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{machine:?}: {}", stderr(&out));
+    }
+}
+
+/// A program that ends without M2, M30 or `%` passes `check` and `run` with a warning that
+/// names the file and its last line; `canon` keeps rs274's error.
+#[test]
+fn a_missing_program_end_is_a_warning_naming_the_file() {
+    let dir = tmp_dir("no-end");
+    let program = dir.join("grbl.ngc");
+    std::fs::write(&program, "G21 G90\nG1 X10 F600\nG1 Y5\n").unwrap();
+    let warning = format!(
+        "warning: {}:3:6: File ended with no percent sign or program end; run as if it ended \
+         with M2",
+        program.display()
+    );
+    for (command, machine) in [
+        ("check", None),
+        ("check", Some("mill3")),
+        ("run", Some("mill3")),
+    ] {
+        let mut cmd = tezgah();
+        cmd.arg(command).arg(&program);
+        if let Some(m) = machine {
+            cmd.args(["--machine", m]);
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success(), "{command}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(&warning),
+            "{command}: {}",
+            stderr(&out)
+        );
+    }
+    let out = tezgah().arg("canon").arg(&program).output().unwrap();
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("File ended with no percent sign or program end"));
+}

@@ -140,6 +140,10 @@ pub struct Status {
     pub error: Option<String>,
     /// The MDI interpreter's modal state and offsets, and the tool tip in its work frame.
     pub work: WorkState,
+    /// What the loaded program's interpretation warned of: a text that ended without M2, M30
+    /// or `%` (`program:line:col: …; run as if it ended with M2`).
+    #[serde(default)]
+    pub warning: Option<String>,
 }
 
 /// The modal state and offsets the DRO shows (those of the MDI interpreter: zero-set by

@@ -130,6 +130,8 @@ pub struct Executor {
     /// Where the MDI interpreter believes the machine is (the end of its last move).
     mdi_at: Pose,
     error: Option<String>,
+    /// What the loaded program's interpretation warned of (a missing program end).
+    warning: Option<String>,
     /// Where the tool is (the last sample, or a piece's exact end).
     pose: CursorPose,
     k: u64,
@@ -185,6 +187,7 @@ impl Executor {
             })?;
         let gcode = tezgah_gcode::Config {
             tool_centre_point_always: machine.tcp == TcpSwitch::Always,
+            axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
             ..tezgah_gcode::Config::default()
         };
         let n = pm.joint_count();
@@ -218,6 +221,7 @@ impl Executor {
             single_block: false,
             optional_stop: false,
             error: None,
+            warning: None,
             pose: CursorPose {
                 line: 0,
                 tip,
@@ -323,6 +327,7 @@ impl Executor {
             work: self
                 .mdi
                 .work([self.pose.tip.x, self.pose.tip.y, self.pose.tip.z]),
+            warning: self.warning.clone(),
         }
     }
 
@@ -448,6 +453,7 @@ impl Executor {
                 }
                 let config = self.mdi.program_config(&self.gcode);
                 let program = Program::interpret(program, &config)?;
+                self.warning = (!program.warnings.is_empty()).then(|| program.warnings.join("\n"));
                 let here = self.program_pose();
                 self.built = Some(self.preflight(program.moves.clone(), here, &program.origins)?);
                 self.program = Some(program);

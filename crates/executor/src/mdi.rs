@@ -19,12 +19,15 @@ pub struct Mdi {
     interp: Interpreter,
     builder: Sink,
     moves: mpsc::Receiver<Move>,
+    /// The machine's program axes: the words `sync` may write.
+    axes: tezgah_gcode::AxisMask,
 }
 
 impl Mdi {
     pub fn new(config: Config) -> Mdi {
         let (tx, rx) = mpsc::channel();
         let always = config.tool_centre_point_always;
+        let axes = config.axes;
         let mut builder: Sink = MoveBuilder::new(Box::new(move |m| {
             // The receiver lives as long as the sender: sending cannot fail.
             let _ = tx.send(m);
@@ -38,6 +41,7 @@ impl Mdi {
             interp,
             builder,
             moves: rx,
+            axes,
         };
         while mdi.moves.try_recv().is_ok() {}
         mdi
@@ -53,16 +57,15 @@ impl Mdi {
             Units::Inches => 1.0 / 25.4,
             _ => 1.0,
         };
-        let p = &pose.0;
-        let line = format!(
-            "G90 G53 G0 X{:.9} Y{:.9} Z{:.9} A{:.9} B{:.9} C{:.9}",
-            p[0] * scale,
-            p[1] * scale,
-            p[2] * scale,
-            p[3],
-            p[4],
-            p[5]
-        );
+        // Only the machine's axes: another letter is a bad character (LinuxCNC's axis mask).
+        let mut line = "G90 G53 G0".to_owned();
+        for axis in tezgah_geom::Axis::ALL {
+            if self.axes.has(axis) {
+                let k = if axis.is_linear() { scale } else { 1.0 };
+                let letter = b"XYZABC"[axis.index()] as char;
+                line.push_str(&format!(" {letter}{:.9}", pose.0[axis.index()] * k));
+            }
+        }
         self.block(&line)?;
         if incremental {
             self.block("G91")?;
@@ -142,9 +145,16 @@ impl Mdi {
         }
         let line = line_at(text, LinePos::FIRST)
             .ok_or_else(|| ExecError::Gcode("empty MDI block".into()))?;
+        // Placed as every interpreter error is: `MDI:1:col`.
         self.interp
             .execute_line(line, &mut self.builder)
-            .map_err(|e| ExecError::Gcode(e.to_string()))?;
+            .map_err(|e| ExecError::At {
+                at: tezgah_gcode::sources::Located {
+                    file: "MDI".into(),
+                    span: e.span,
+                },
+                message: e.kind.to_string(),
+            })?;
         Ok(self.moves.try_iter().collect())
     }
 }

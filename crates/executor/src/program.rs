@@ -69,6 +69,8 @@ impl Origins {
 pub struct Program {
     pub moves: Vec<Move>,
     pub origins: Arc<Origins>,
+    /// The interpretation's warnings (a missing program end, run as M2).
+    pub warnings: Vec<String>,
 }
 
 impl Program {
@@ -91,6 +93,7 @@ impl Program {
             });
         }
         Ok(Program {
+            warnings: done.warnings,
             moves: done.moves,
             origins: Arc::new(Origins {
                 keys: done.keys,

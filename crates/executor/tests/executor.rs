@@ -111,7 +111,7 @@ fn five_axis_tcp_plays_the_interpolator_samples() {
 
 /// The distance a hold at period `at` travelled, the time-optimal jerk-limited stop from the
 /// hold state (speed, and acceleration by backward difference, under the path limits where it
-/// began and ended), and the allowance the bound adds: one period's travel.
+/// began and ended), and the allowance the bound adds: two periods' travel.
 struct HoldDistance {
     travelled: f64,
     optimal: f64,
@@ -128,11 +128,15 @@ fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDista
     })
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
-    let mut start = None;
+    // The path limits of every piece the stop passes through: a stop that runs into a piece
+    // of weaker limits (a short arc, a blend) brakes as that piece allows.
+    let mut crossed = vec![];
     drive(&mut exec, &mut trace, 2_000_000, |k, e| {
         if k == at {
-            start = e.path_limits();
             e.command(Command::FeedHold).unwrap();
+        }
+        if k >= at && e.state() != RunState::Held {
+            crossed.extend(e.path_limits());
         }
     });
     let mut distance = None;
@@ -142,11 +146,11 @@ fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDista
         let before = &out[at.saturating_sub(1)];
         let prev = &out[at.saturating_sub(2)];
         let a = (before.feed - prev.feed) / exec.period();
-        let end = exec.path_limits().expect("held inside a piece");
-        // Under the limits of the piece where the hold began; if it stopped in another piece,
-        // the larger of the stops under either's limits (braking as each piece allows lies
-        // between them).
-        let optimal = [start.unwrap_or(end), end]
+        crossed.push(exec.path_limits().expect("held inside a piece"));
+        // Under the limits of the piece where the hold began; if it stopped further on, the
+        // largest of the stops under the limits of each piece it crossed (braking as each
+        // allows lies between them).
+        let optimal = crossed
             .iter()
             .map(|l| {
                 tezgah_executor::stop::stopping_distance(
@@ -160,7 +164,10 @@ fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDista
         let d = HoldDistance {
             travelled: out.last().unwrap().path - before.path,
             optimal,
-            allowance: before.feed * exec.period() + 1e-9,
+            // A period's travel for the command taking hold, and one for the backward
+            // difference's view of the acceleration: a plan already braking at the hold
+            // reads a stop of zero length under its own limits.
+            allowance: 2.0 * before.feed * exec.period() + 1e-9,
         };
         distance = Some(d);
         // Standing: nothing produced while held.
@@ -1016,4 +1023,34 @@ fn zero_set_in_mdi_moves_the_work_frame_of_the_status_and_of_programs_loaded_aft
     let (out, report) = trace.report();
     assert_within_limits(&report);
     assert_continuous(&out);
+}
+
+/// MDI blocks and loaded programs are read for the machine's axes (mill3: X Y Z), so an A word
+/// is LinuxCNC's bad character at its place rather than dropped; a program without M2 loads
+/// and the status carries the warning that names its last line.
+#[test]
+fn axes_the_machine_lacks_are_refused_in_mdi_and_load() {
+    let mut exec = executor();
+    let mdi = Command::Mdi {
+        block: "G1 X10 A90 F600".into(),
+    };
+    let load = Command::Load {
+        program: "G21 F600\nG1 X10 A90\nM2\n".into(),
+    };
+    for (command, place) in [(mdi, "MDI:1:8"), (load, "program:2:8")] {
+        let err = exec.command(command).unwrap_err().to_string();
+        assert!(
+            err.contains(place) && err.contains("Bad character 'a' used"),
+            "{err}"
+        );
+    }
+    exec.command(Command::Load {
+        program: "G21 F600\nG1 X10\n".into(),
+    })
+    .unwrap();
+    let warning = exec.status().warning.unwrap_or_default();
+    assert!(
+        warning.contains("program:2:7: File ended with no percent sign or program end"),
+        "{warning}"
+    );
 }

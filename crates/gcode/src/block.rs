@@ -129,10 +129,51 @@ pub struct Block {
     pub assignments: Vec<Assignment>,
     /// The O-word, on a control-flow line (which holds nothing else but comments).
     pub o: Option<OWord>,
+    /// LinuxCNC's polar words: `@` the radius and `^` the angle (degrees) of the end point
+    /// in the XY plane. A second one on a line replaces the first, as in LinuxCNC.
+    pub radius: Option<Word>,
+    pub theta: Option<Word>,
 }
 
 /// Letters of the six axes, in [`Pose`] order.
 pub const AXIS_LETTERS: [u8; 6] = [b'x', b'y', b'z', b'a', b'b', b'c'];
+
+/// The program axes a machine has: LinuxCNC's axis mask (bit 0 X … bit 5 C; U V W are never
+/// axes here). A word of an axis the mask lacks is refused as LinuxCNC refuses it, when the
+/// line is read: "Bad character 'a' used". The default, all six, is LinuxCNC's `rs274`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct AxisMask(u8);
+
+impl AxisMask {
+    /// X Y Z A B C: the standalone `rs274`'s machine.
+    pub const XYZABC: AxisMask = AxisMask(0x3f);
+
+    /// The mask of the axes given.
+    pub fn of(axes: impl IntoIterator<Item = tezgah_geom::Axis>) -> Self {
+        AxisMask(axes.into_iter().fold(0, |m, a| m | 1 << a.index()))
+    }
+
+    /// Whether the machine has `axis`.
+    pub fn has(self, axis: tezgah_geom::Axis) -> bool {
+        self.0 >> axis.index() & 1 == 1
+    }
+
+    /// The axis letters the mask lacks, one bit per letter by its place in the alphabet (the
+    /// block's `present` layout).
+    fn refused_letters(self) -> u32 {
+        AXIS_LETTERS
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| self.0 >> i & 1 == 0)
+            .fold(0, |m, (_, &c)| m | 1 << (c - b'a'))
+    }
+}
+
+impl Default for AxisMask {
+    fn default() -> Self {
+        AxisMask::XYZABC
+    }
+}
 
 /// Letters that are words of their own (everything but G, M, N, O).
 const fn is_value_letter(c: u8) -> bool {
@@ -195,6 +236,21 @@ impl Block {
         self.m[group].map(|c| c.code)
     }
 
+    /// Whether the block has a polar word (`@` or `^`).
+    #[inline]
+    pub fn polar(&self) -> bool {
+        self.radius.is_some() || self.theta.is_some()
+    }
+
+    /// Where the block's first polar word stands.
+    pub fn polar_at(&self) -> u32 {
+        match (self.radius, self.theta) {
+            (Some(r), Some(t)) => r.at.min(t.at),
+            (Some(w), None) | (None, Some(w)) => w.at,
+            (None, None) => 0,
+        }
+    }
+
     /// Whether any axis word (X Y Z A B C) is present.
     pub fn has_axis_words(&self) -> bool {
         self.axis_words().iter().any(Option::is_some)
@@ -225,12 +281,16 @@ impl Block {
         self.comment = None;
         self.assignments.clear();
         self.o = None;
+        self.radius = None;
+        self.theta = None;
     }
 
-    /// Read the normalised line `line` into `self`. `Ok(false)` means the line is deleted by
-    /// `/` and holds nothing to execute. On error, the index into `line.text` is returned.
-    pub fn read(&mut self, line: &NormLine, params: &Params) -> ReadResult<bool> {
+    /// Read the normalised line `line` into `self`; words of axes `axes` lacks are bad
+    /// characters. `Ok(false)` means the line is deleted by `/` and holds nothing to execute.
+    /// On error, the index into `line.text` is returned.
+    pub fn read(&mut self, line: &NormLine, params: &Params, axes: AxisMask) -> ReadResult<bool> {
         self.clear();
+        let refused = axes.refused_letters();
         let text = line.text();
         let mut r = Reader::new(text, 0, params);
         if text.first() == Some(&b'/') {
@@ -266,7 +326,21 @@ impl Block {
                 b'#' => self.read_assignment(&mut r, at)?,
                 b'g' => self.read_g(&mut r, at)?,
                 b'm' => self.read_m(&mut r, at)?,
-                c if is_value_letter(c) => self.read_letter(&mut r, c, at)?,
+                b'@' | b'^' => {
+                    r.pos += 1;
+                    let word = Some(Word {
+                        value: r.real_value()?,
+                        at,
+                    });
+                    if c == b'@' {
+                        self.radius = word;
+                    } else {
+                        self.theta = word;
+                    }
+                }
+                c if is_value_letter(c) && refused >> (c - b'a') & 1 == 0 => {
+                    self.read_letter(&mut r, c, at)?
+                }
                 _ => return Err((ErrorKind::BadCharacter(c as char), r.pos)),
             }
         }
@@ -455,7 +529,7 @@ mod tests {
         l.lex(s).unwrap();
         let p = Params::default();
         let mut b = Block::default();
-        b.read(&l, &p)?;
+        b.read(&l, &p, AxisMask::XYZABC)?;
         Ok(b)
     }
 
@@ -477,6 +551,25 @@ mod tests {
         assert_eq!(read("g1.25").unwrap_err().0, ErrorKind::GCodeOutOfRange);
         assert_eq!(read("g0x1n2").unwrap_err().0, ErrorKind::BadCharacter('n'));
         assert_eq!(read("g1f-1").unwrap_err().0, ErrorKind::NegativeFeed);
+    }
+
+    #[test]
+    fn axes_the_mask_lacks_are_bad_characters() {
+        use tezgah_geom::Axis;
+        let mut l = NormLine::default();
+        l.lex("G1 X10 A90 F600").unwrap();
+        let xyz = AxisMask::of([Axis::X, Axis::Y, Axis::Z]);
+        let err = Block::default()
+            .read(&l, &Params::default(), xyz)
+            .unwrap_err();
+        // At the `a`, index 6 of "g1x10a90f600".
+        assert_eq!(err, (ErrorKind::BadCharacter('a'), 5));
+        assert_eq!(err.0.to_string(), "Bad character 'a' used");
+        let xyzc = AxisMask::of([Axis::X, Axis::Y, Axis::Z, Axis::C]);
+        assert!(Block::default().read(&l, &Params::default(), xyzc).is_err());
+        let xyza = AxisMask::of([Axis::X, Axis::Y, Axis::Z, Axis::A]);
+        assert!(Block::default().read(&l, &Params::default(), xyza).is_ok());
+        assert!(xyza.has(Axis::A) && !xyza.has(Axis::B));
     }
 
     #[test]

@@ -103,6 +103,11 @@ pub enum Canon {
     SetSpindleMode(f64),
     StraightTraverse(Pose),
     StraightFeed(Pose),
+    /// G38.2–G38.5: move toward the point until the probe input changes (LinuxCNC's
+    /// `STRAIGHT_PROBE`), between `TURN_PROBE_ON` and `TURN_PROBE_OFF`.
+    StraightProbe(Pose),
+    TurnProbeOn,
+    TurnProbeOff,
     ArcFeed {
         first_end: f64,
         second_end: f64,
@@ -236,6 +241,9 @@ impl fmt::Display for Canon {
             SetSpindleMode(v) => write!(f, "SET_SPINDLE_MODE(0 {v:.4})"),
             StraightTraverse(p) => write!(f, "STRAIGHT_TRAVERSE({})", Six(p)),
             StraightFeed(p) => write!(f, "STRAIGHT_FEED({})", Six(p)),
+            StraightProbe(p) => write!(f, "STRAIGHT_PROBE({})", Six(p)),
+            TurnProbeOn => f.write_str("TURN_PROBE_ON()"),
+            TurnProbeOff => f.write_str("TURN_PROBE_OFF()"),
             ArcFeed {
                 first_end,
                 second_end,
@@ -334,6 +342,7 @@ impl Canon {
             self,
             Canon::StraightTraverse(_)
                 | Canon::StraightFeed(_)
+                | Canon::StraightProbe(_)
                 | Canon::ArcFeed { .. }
                 | Canon::NurbsFeed(_)
                 | Canon::Dwell(_)

@@ -92,10 +92,10 @@ pub fn m_group(m: i64) -> Option<usize> {
         0 | 1 | 2 | 30 | 60 => STOP,
         62..=68 => IO,
         6 | 61 => TOOL_CHANGE,
-        3 | 4 | 5 | 19 => SPINDLE,
+        // M70–M73 share the spindle's group in LinuxCNC (`M3 M70` is two of one group).
+        3 | 4 | 5 | 19 | 70..=73 => SPINDLE,
         7..=9 => COOLANT,
         48..=53 => OVERRIDE,
-        70..=73 => IO,
         98 | 99 => SUBPROGRAM,
         100..=199 => USER,
         _ => return None,

@@ -375,6 +375,40 @@ pub enum ErrorKind {
     M61NeedsQ,
     #[error("{0} is not supported yet")]
     Unsupported(String),
+    // --- probing (G38.2–G38.5) ---
+    #[error("Cannot probe with cutter radius comp on")]
+    ProbeWithComp,
+    #[error("Cannot probe with zero feed rate")]
+    ProbeZeroFeed,
+    #[error("Cannot probe with feed per rev mode")]
+    ProbeFeedPerRev,
+    #[error("Start point too close to probe point")]
+    ProbeStartAtTarget,
+    /// tezgah's own: the executor has no probe input yet (`Config::probe`).
+    #[error("G{0} probing needs a probe input, which tezgah's executor does not have yet")]
+    ProbeUnavailable(String),
+    // --- polar coordinates (`@` radius, `^` angle) ---
+    #[error("Cannot use polar coordinate except in G17 plane")]
+    PolarNotXyPlane,
+    #[error("Cannot specify both polar coordinate and {0} word")]
+    PolarWithAxisWord(char),
+    #[error("Polar coordinates can only be used for motion")]
+    PolarWithoutMotion,
+    #[error("Cannot use polar coordinates with G53")]
+    PolarWithG53,
+    #[error("Must specify angle in polar coordinate if at the origin")]
+    PolarAngleAtOrigin,
+    #[error("Incremental motion with polar coordinates is indeterminate when at the origin")]
+    PolarIncrementalAtOrigin,
+    #[error("G91 motion with polar coordinates is indeterminate when at the origin")]
+    PolarG91AtOrigin,
+    #[error("Cannot restore context from invalid stack frame - missing M70/M73?")]
+    RestoreWithoutContext,
+    /// LinuxCNC prints the (still empty) command text here.
+    #[error("M7x: restore_settings G20/G21 failed: ''")]
+    RestoreUnitsFailed,
+    #[error("M7x: restore_settings failed executing: '{0}': {1}")]
+    RestoreFailed(String, String),
 
     // --- splines: LinuxCNC's G5, G5.1, G5.2/G5.3 (its wording) ---
     #[error("Splines must be in the XY plane")]

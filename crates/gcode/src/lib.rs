@@ -22,10 +22,11 @@ pub mod sources;
 pub mod span;
 pub mod tooltable;
 
+pub use block::AxisMask;
 pub use canon::{Canon, CanonSink, Origin, Units};
 pub use error::{ErrorKind, GcodeError};
 pub use ini::{IniError, IniFile};
-pub use interp::{check, check_into, Config, Interpreter};
+pub use interp::{check, check_into, Config, Interpreter, MissingEnd, ProbeModel};
 pub use moves::{program_moves, MoveBuilder};
 pub use span::Span;
 pub use tooltable::{Tool, ToolTable, ToolTableError};

@@ -24,6 +24,10 @@ pub const COORD_SYSTEM: usize = 5220;
 pub const G54_OFFSET: usize = 5221;
 /// Current position X…C in program coordinates (read-only for programs).
 pub const CURRENT_POSITION: usize = 5420;
+/// Where the last probing move (G38.x) found the probe: `#5061`…`#5069`, program
+/// coordinates; `#5070` is 1 when it tripped.
+pub const PROBE_POSITION: usize = 5061;
+pub const PROBE_TRIPPED: usize = 5070;
 /// Current position X…C in machine coordinates, as G53 names it (read-only for programs).
 pub const MACHINE_POSITION: usize = 5021;
 

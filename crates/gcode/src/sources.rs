@@ -242,6 +242,9 @@ pub struct Interpreted {
     pub keys: LineKeys,
     /// Every error of the pre-flight, or the first one of a run.
     pub errors: Vec<GcodeError>,
+    /// What ran but deserves a word: a text that ended without M2, M30 or `%` (run as if it
+    /// ended with M2), placed as `file:line:col: text`.
+    pub warnings: Vec<String>,
     pub sources: Sources,
 }
 
@@ -285,11 +288,21 @@ pub fn interpret(
             Pass::Run => interp.run(&text, &mut sink).err().into_iter().collect(),
         }
     };
+    let sources = sources.with_subroutines(&interp, locate);
+    let warnings = interp
+        .missing_end()
+        .map(|e| {
+            let at = sources.error_at(e);
+            format!("{}: {}; run as if it ended with M2", at.at, at.message)
+        })
+        .into_iter()
+        .collect();
     Interpreted {
         moves,
         keys,
         errors,
-        sources: sources.with_subroutines(&interp, locate),
+        warnings,
+        sources,
     }
 }
 

@@ -95,3 +95,344 @@ fn eq_and_ne_compare_within_a_ten_thousandth() {
         assert_eq!(shown, format!("{want:.6}"), "{expr}");
     }
 }
+
+/// A text that ends without M2, M30 or `%` runs every move and ends as if `M2` followed its
+/// last line (LinuxCNC's milltask runs the moves, then reports); `rs274`'s behaviour, the
+/// error, stays with `MissingEnd::Error` (`Config::linuxcnc`, what `canon` uses).
+#[test]
+fn a_missing_program_end_runs_as_m2() {
+    use tezgah_gcode::{Canon, GcodeError, Interpreter, MissingEnd, Origin};
+    let program = "G21 G90 M3 S1000\nG1 X10 F100\nG1 Y5\n";
+    let mut calls: Vec<(Origin, Canon)> = Vec::new();
+    let mut interp = Interpreter::new(Config::default());
+    interp.run(program, &mut calls).unwrap();
+    // The moves, then M2's resets: spindle stopped, feed zeroed, program end.
+    let tail: Vec<&Canon> = calls.iter().rev().take(4).map(|(_, c)| c).collect();
+    assert!(matches!(tail[0], Canon::ProgramEnd), "{tail:?}");
+    assert!(calls.iter().any(|(_, c)| matches!(c, Canon::StopSpindle)));
+    let feeds = calls
+        .iter()
+        .filter(|(_, c)| matches!(c, Canon::StraightFeed(_)))
+        .count();
+    assert_eq!(feeds, 2);
+    // The end's calls come from the last line.
+    assert_eq!(calls.last().unwrap().0.line, 3);
+    let missing: &GcodeError = interp.missing_end().unwrap();
+    assert_eq!(missing.kind, ErrorKind::NoProgramEnd);
+    assert_eq!((missing.span.line, missing.span.column), (3, 6));
+    // With M2 there is nothing to say.
+    let mut interp = Interpreter::new(Config::default());
+    interp
+        .run("G0 X1\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap();
+    assert!(interp.missing_end().is_none());
+    // rs274's behaviour.
+    let cfg = Config {
+        missing_end: MissingEnd::Error,
+        ..Config::default()
+    };
+    let err = Interpreter::new(cfg)
+        .run(program, &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "File ended with no percent sign or program end"
+    );
+    // An unclosed subroutine is still an error, M2 or not.
+    let err = Interpreter::new(Config::default())
+        .run("o100 sub\nG0 X1\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_ne!(err.kind, ErrorKind::NoProgramEnd);
+}
+
+fn data(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+/// Every call tezgah makes for `data/<name>.ngc` with the tool table `<name>.tbl`, printed as
+/// rs274 prints them (with its driver's two closing resets), and the error, if any.
+fn our_rs274_calls(name: &str) -> (Vec<String>, Option<String>) {
+    use tezgah_gcode::{Canon, Interpreter, Origin, ToolTable};
+    let program = std::fs::read_to_string(data(&format!("{name}.ngc"))).unwrap();
+    let table = std::fs::read_to_string(data(&format!("{name}.tbl"))).unwrap();
+    let config = Config::linuxcnc(ToolTable::parse(&table).unwrap());
+    let mut calls = Vec::<(Origin, Canon)>::new();
+    let result = Interpreter::new(config).run(&program, &mut calls);
+    let mut printed: Vec<String> = calls.iter().map(|(_, c)| c.to_string()).collect();
+    printed.extend(["ON_RESET()".to_owned(), "ON_RESET()".to_owned()]);
+    (printed, result.err().map(|e| e.kind.to_string()))
+}
+
+/// `data/<name>.expected`: what LinuxCNC 2.9's `rs274` printed for the program (call number
+/// and N field dropped). With `TEZGAH_RS274` set, rs274 runs again and must still print it.
+fn rs274_expected(name: &str) -> Vec<String> {
+    let expected: Vec<String> = std::fs::read_to_string(data(&format!("{name}.expected")))
+        .unwrap()
+        .lines()
+        .map(str::to_owned)
+        .collect();
+    if let Some(rs274) = std::env::var_os("TEZGAH_RS274") {
+        // One rs274 at a time: its tool data lives in memory shared between its processes.
+        static RS274: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        let _one = RS274.lock().unwrap_or_else(|e| e.into_inner());
+        // rs274 writes its parameter file where it runs: a folder of its own per program.
+        let dir =
+            std::env::temp_dir().join(format!("tezgah-dialect-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let out = std::process::Command::new(rs274)
+            .current_dir(&dir)
+            .arg("-t")
+            .arg(data(&format!("{name}.tbl")))
+            .arg("-g")
+            .arg(data(&format!("{name}.ngc")))
+            .stdin(std::process::Stdio::null())
+            .output()
+            .expect("run rs274");
+        let _ = std::fs::remove_dir_all(&dir);
+        let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .filter_map(|l| l.find(" N..... ").map(|i| l[i + 8..].to_owned()))
+            .collect();
+        assert_eq!(theirs, expected, "rs274 no longer prints {name}.expected");
+    }
+    expected
+}
+
+/// M70 saves, M71 forgets, M72 restores the modal state and M73 restores it when the
+/// subroutine returns: every canonical call (the restoring codes in rs274's order, F restored
+/// as LinuxCNC prints it, `F10.2` for 10.25) and the `#<_…>` parameters read after each
+/// restore agree with rs274 call for call.
+#[test]
+fn m70_to_m73_match_rs274_call_for_call() {
+    let expected = rs274_expected("modal_state");
+    assert_eq!(expected.len(), 107, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("modal_state");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// M72 also restores whether the G92/G52 offsets are applied (G92.2 / G92.3, as rs274 2.9
+/// does): `data/m7_g92.ngc` agrees with rs274's 30 calls and its `#5210`, `#5211`.
+#[test]
+fn m72_restores_the_g92_state_as_rs274() {
+    let expected = rs274_expected("m7_g92");
+    assert_eq!(expected.len(), 30, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("m7_g92");
+    assert_eq!(error, None);
+    assert_eq!(ours, expected);
+}
+
+/// M72 with nothing saved at its call level, M71's invalidation, and M70 in the spindle's
+/// modal group: LinuxCNC's errors, at the M word.
+#[test]
+fn m72_without_a_saved_state_fails_as_linuxcnc() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let run = |program: &str| {
+        Interpreter::new(Config::linuxcnc(Default::default()))
+            .run(program, &mut Vec::<(Origin, Canon)>::new())
+            .unwrap_err()
+    };
+    let none = "Cannot restore context from invalid stack frame - missing M70/M73?";
+    let err = run("G21\nF10 M72\nM2\n");
+    assert_eq!(
+        (
+            err.kind.to_string().as_str(),
+            err.span.line,
+            err.span.column
+        ),
+        (none, 2, 5)
+    );
+    assert_eq!(run("M70\nM71\nM72\nM2\n").kind.to_string(), none);
+    // Saved in the caller, not at the subroutine's level.
+    let sub = "o1 sub\nM72\no1 endsub\nM70\no1 call\nM2\n";
+    assert_eq!(run(sub).kind.to_string(), none);
+    assert_eq!(
+        run("M3 M70\nM2\n").kind.to_string(),
+        "Two m codes used from same modal group"
+    );
+}
+
+/// Polar coordinates (`@` radius, `^` angle): absolute and G91 lines, R and I J arcs, G81
+/// and G83 in G90 and G91 with L repeats going round a circle. Every call agrees with
+/// rs274's 147.
+#[test]
+fn polar_coordinates_match_rs274_call_for_call() {
+    let expected = rs274_expected("polar");
+    assert_eq!(expected.len(), 147, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("polar");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// Each polar-coordinate refusal with LinuxCNC's text (as rs274 printed it).
+#[test]
+fn polar_coordinate_errors_are_linuxcnc_s() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let cases = [
+        (
+            "G18\nG1 @1 F10",
+            "Cannot use polar coordinate except in G17 plane",
+        ),
+        (
+            "G1 X1 @1 F10",
+            "Cannot specify both polar coordinate and X word",
+        ),
+        (
+            "G1 Y1 ^1 F10",
+            "Cannot specify both polar coordinate and Y word",
+        ),
+        ("G92 @1", "Polar coordinates can only be used for motion"),
+        (
+            "G10 L2 P1 @1",
+            "Polar coordinates can only be used for motion",
+        ),
+        (
+            "@1",
+            "Cannot use axis values without a g code that uses them",
+        ),
+        ("G80 @1", "Cannot use axis values with g80"),
+        ("G53 G0 @1 ^3", "Cannot use polar coordinates with G53"),
+        (
+            "G1 @1 F10",
+            "Must specify angle in polar coordinate if at the origin",
+        ),
+        (
+            "G91 G1 @1 F10",
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        ),
+        (
+            "G91 G1 ^1 F10",
+            "G91 motion with polar coordinates is indeterminate when at the origin",
+        ),
+        (
+            "G0 Z2\nG91 G81 @1 R1 Z-1 F10",
+            "Incremental motion with polar coordinates is indeterminate when at the origin",
+        ),
+    ];
+    for (program, text) in cases {
+        let err = Interpreter::new(Config::linuxcnc(Default::default()))
+            .run(
+                &format!("{program}\nM2\n"),
+                &mut Vec::<(Origin, Canon)>::new(),
+            )
+            .expect_err(program);
+        assert_eq!(err.kind.to_string(), text, "{program}");
+    }
+    // The place of the error: the `@` word, line 2 column 4.
+    let err = Interpreter::new(Config::default())
+        .run("G18\nG1 @1 F10\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!((err.span.line, err.span.column), (2, 4));
+}
+
+/// A cutter-compensation entry move (or entry arc) exactly one tool radius long is accepted,
+/// as rs274 2.9 accepts it in LinuxCNC's `useful-subroutines.ngc` (`g41 g0` onto the edge of
+/// a hole the size of the tool): the tool centre ends on the contour's normal, and every
+/// call agrees with rs274's 48. A shorter one is still refused.
+#[test]
+fn comp_entry_one_radius_long_is_accepted_as_rs274() {
+    use tezgah_gcode::{Canon, Interpreter, Origin, ToolTable};
+    let expected = rs274_expected("comp_entry");
+    assert_eq!(expected.len(), 48, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("comp_entry");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+    let table = ToolTable::parse("T1 P1 Z0.511 D0.125\n").unwrap();
+    for entry in ["G41 G0 X0 Y0", "G41 G1 X0 Y0", "G41 G2 X0 Y0 R0.5"] {
+        let program = format!("G20 T1 M6 F10\nG0 X0.06 Y0\n{entry}\nG40 G0 X1\nM2\n");
+        let err = Interpreter::new(Config::linuxcnc(table.clone()))
+            .run(&program, &mut Vec::<(Origin, Canon)>::new())
+            .expect_err(entry);
+        assert!(
+            err.kind
+                .to_string()
+                .ends_with("is not greater than the tool radius"),
+            "{entry}: {}",
+            err.kind
+        );
+    }
+    // A hole smaller than the tool is still refused (one of its size is filled).
+    let program = "G20 T1 M6 F10\nG0 X0.2 Y0.06\nG41 G0 X0 Y0.06\nG3 X0 Y0.06 I0 J-0.06\nM2\n";
+    let err = Interpreter::new(Config::linuxcnc(table))
+        .run(program, &mut Vec::<(Origin, Canon)>::new())
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "Tool radius not less than arc radius with comp"
+    );
+}
+
+/// G38.2–G38.5 under `ProbeModel::Rs274` (what `canon` uses): the probe calls, `#5061`…
+/// `#5070` and the position after each probe agree with rs274's 44 calls (its probe never
+/// trips and stops 0.01 in short of the target).
+#[test]
+fn probing_matches_rs274_call_for_call() {
+    let expected = rs274_expected("probe");
+    assert_eq!(expected.len(), 44, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("probe");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// LinuxCNC's probing errors; and where moves are made for a machine (the default
+/// `ProbeModel::Unavailable`), a probe that passes them is refused at its G38 word rather
+/// than run as a feed that never trips.
+#[test]
+fn probing_errors_are_linuxcnc_s_and_runs_refuse_probing() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let cases = [
+        ("G38.2 X1", "Cannot probe with zero feed rate"),
+        ("F10 G38.2", "All axes missing with motion code"),
+        ("F10 G38.2 X0", "Start point too close to probe point"),
+        ("F10 G38.4 X0", "Start point too close to probe point"),
+        (
+            "F10 G41.1 D0.1 G0 X1\nG38.2 X2",
+            "Cannot probe with cutter radius comp on",
+        ),
+        (
+            "G95 F10 S100 M3 G38.2 X1",
+            "Cannot probe with feed per rev mode",
+        ),
+        ("G93 G38.2 X1 F10", "Cannot probe with zero feed rate"),
+    ];
+    for (program, text) in cases {
+        for config in [Config::linuxcnc(Default::default()), Config::default()] {
+            let err = Interpreter::new(config)
+                .run(
+                    &format!("{program}\nM2\n"),
+                    &mut Vec::<(Origin, Canon)>::new(),
+                )
+                .expect_err(program);
+            assert_eq!(err.kind.to_string(), text, "{program}");
+        }
+    }
+    // G38.3 to where it stands is no error for rs274.
+    Interpreter::new(Config::linuxcnc(Default::default()))
+        .run("F10 G38.3 X0\nM2\n", &mut Vec::<(Origin, Canon)>::new())
+        .unwrap();
+    let err = Interpreter::new(Config::default())
+        .run(
+            "G21 F100\nG38.2 Z-10\nM2\n",
+            &mut Vec::<(Origin, Canon)>::new(),
+        )
+        .unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "G38.2 probing needs a probe input, which tezgah's executor does not have yet"
+    );
+    assert_eq!((err.span.line, err.span.column), (2, 1));
+}

@@ -229,10 +229,7 @@ const FOLDERS_NOT_YET: &[(&str, &str)] = &[
 
 /// `bad/` programs that need the full-dialect issue (canned cycles, cutter compensation,
 /// O-words, M19), with the feature they need.
-const BAD_NOT_YET: &[(&str, &str)] = &[
-    ("g64-m19-r-ambiguous.ngc", "M19 spindle orientation"),
-    ("probe-no-axes.ngc", "probing (G38.x) is out of scope"),
-];
+const BAD_NOT_YET: &[(&str, &str)] = &[("g64-m19-r-ambiguous.ngc", "M19 spindle orientation")];
 
 /// Subroutine files `<name>.ngc` in one folder (the tests' SUBROUTINE_PATH).
 #[derive(Debug)]

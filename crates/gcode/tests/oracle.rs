@@ -254,6 +254,27 @@ enum Item {
     Comment(usize),
     /// A block both interpreters must reject (`FAULTY`), to compare the error texts.
     Faulty(usize),
+    /// G0/G1 with polar words (`@` radius, `^` angle; at least one) and maybe Z, in G17.
+    Polar {
+        rapid: bool,
+        radius: Option<f64>,
+        theta: Option<f64>,
+        z: Option<f64>,
+        f: f64,
+    },
+    /// M70 (0), M71 (1), M72 (2) or M73 (3).
+    Modes(u8),
+}
+
+/// The modes the writer tracks, as M70/M73 saved them.
+#[derive(Debug, Clone, Copy)]
+struct SavedModes {
+    incremental: bool,
+    plane: u8,
+    inverse: bool,
+    feed_set: bool,
+    inches: bool,
+    tool_offset: bool,
 }
 
 /// A closed-ish contour cut under G41/G42: vertices around a centre at increasing angles with
@@ -341,6 +362,8 @@ struct Writer {
     labels: u32,
     /// Which of `SUBROUTINES` the program calls (their bodies follow M2).
     used_subs: [bool; SUBROUTINES.len()],
+    /// What the last M70/M73 saved (`None` before one, or after M71).
+    saved_modes: Option<SavedModes>,
 }
 
 impl Writer {
@@ -360,6 +383,7 @@ impl Writer {
             rotation_used: false,
             labels: 0,
             used_subs: [false; SUBROUTINES.len()],
+            saved_modes: None,
         }
     }
 
@@ -982,6 +1006,78 @@ impl Writer {
             }
             Item::Comment(c) => self.block(deco, COMMENTS[*c]),
             Item::Faulty(k) => self.block(deco, FAULTY[*k]),
+            Item::Polar {
+                rapid,
+                radius,
+                theta,
+                z,
+                f,
+            } => {
+                // Polar words only in G17 (elsewhere both refuse them: tested in `dialect`).
+                let plane = if self.plane != 0 { "G17 " } else { "" };
+                self.plane = 0;
+                let mut words = format!("{}{plane}G{}", Self::extra(deco), u8::from(!rapid));
+                if let Some(r) = radius {
+                    words.push_str(&format!(" @{}", num(*r)));
+                }
+                if let Some(t) = theta {
+                    words.push_str(&format!(" ^{}", num(*t)));
+                }
+                if let Some(z) = z {
+                    words.push_str(&format!(" Z{}", num(*z)));
+                }
+                if !*rapid {
+                    words.push_str(&self.feed_word(*f, false));
+                }
+                self.block(deco, &words);
+                // The polar end is not tracked: arcs after it start with an absolute G0.
+                self.pos[0] = None;
+                self.pos[1] = None;
+                if let Some(z) = z {
+                    self.pos[2] = if self.incremental {
+                        self.pos[2].map(|p| p + z)
+                    } else {
+                        Some(*z)
+                    };
+                }
+            }
+            Item::Modes(m) => {
+                let now = SavedModes {
+                    incremental: self.incremental,
+                    plane: self.plane,
+                    inverse: self.inverse,
+                    feed_set: self.feed_set,
+                    inches: self.inches,
+                    tool_offset: self.tool_offset,
+                };
+                match (m, self.saved_modes) {
+                    (1, _) => {
+                        self.block(deco, "M71");
+                        self.saved_modes = None;
+                    }
+                    (2, Some(saved)) => {
+                        // A restored G43/G49, or units changed under a tool length offset,
+                        // meet the deliberate differences noted at `Item::Units`.
+                        if saved.tool_offset != now.tool_offset
+                            || (saved.inches != now.inches && now.tool_offset)
+                        {
+                            return;
+                        }
+                        self.block(deco, "M72");
+                        self.incremental = saved.incremental;
+                        self.plane = saved.plane;
+                        self.inverse = saved.inverse;
+                        self.feed_set = saved.feed_set;
+                        self.inches = saved.inches;
+                        self.forget();
+                    }
+                    // M72 with nothing saved would end the program: save instead.
+                    _ => {
+                        self.block(deco, if *m == 3 { "M73" } else { "M70" });
+                        self.saved_modes = Some(now);
+                    }
+                }
+            }
         }
     }
 }
@@ -1263,6 +1359,22 @@ fn item() -> impl Strategy<Value = Item> {
         3 => comp_contour().prop_map(Item::Comp),
         3 => spline(),
         2 => nurbs(),
+        2 => (
+            any::<bool>(),
+            proptest::option::weighted(0.7, value(20.0)),
+            proptest::option::weighted(0.7, value(360.0)),
+            proptest::option::weighted(0.3, value(5.0)),
+            feed(),
+        )
+            .prop_map(|(rapid, radius, theta, z, f)| Item::Polar {
+                rapid,
+                radius,
+                // At least one polar word.
+                theta: if radius.is_none() { theta.or(Some(45.0)) } else { theta },
+                z,
+                f,
+            }),
+        2 => (0u8..4).prop_map(Item::Modes),
     ];
     // About one program in twelve ends early on an error.
     prop_oneof![

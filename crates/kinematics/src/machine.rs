@@ -423,6 +423,16 @@ impl Machine {
         })
     }
 
+    /// The program axes the machine has (LinuxCNC's axis mask): X Y Z, the tool tip, on every
+    /// machine, and the rotary axes that carry [`Machine::tcp_axes`]. A program word of any
+    /// other axis is refused (`Bad character 'a' used`), never silently dropped. A cartesian
+    /// machine whose extra joints are not named a, b or c takes none of them.
+    pub fn program_axes(&self) -> Vec<Axis> {
+        let mut axes = vec![Axis::X, Axis::Y, Axis::Z];
+        axes.extend(self.tcp_axes().unwrap_or_default());
+        axes
+    }
+
     /// Joints at zero (or the nearest limit when zero is outside): a start for continuity.
     pub fn home(&self) -> Joints {
         let mut q = Joints::zeros(self.joints.len());

@@ -294,3 +294,15 @@ fn tcp_from_interpreter_pose() {
         Err(KinematicsError::BadInput { .. })
     ));
 }
+
+/// Which program axes each built-in machine has (the interpreter's axis mask).
+#[test]
+fn program_axes_of_the_builtin_machines() {
+    use tezgah_geom::Axis::*;
+    let axes = |name: &str| Machine::builtin(name).unwrap().program_axes();
+    assert_eq!(axes("mill3"), [X, Y, Z]);
+    assert_eq!(axes("table-ac"), [X, Y, Z, A, C]);
+    assert_eq!(axes("table-bc"), [X, Y, Z, B, C]);
+    assert_eq!(axes("yzca"), [X, Y, Z, C, A]);
+    assert_eq!(axes("linear-delta"), [X, Y, Z]);
+}

@@ -39,7 +39,22 @@ fn is_canned_cycle(g: u32) -> bool {
 pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
     let at_g = |group: usize| block.g[group].map_or(0, |c| c.at);
     let mode0 = block.g(ggroup::NON_MODAL);
-    let axes = block.has_axis_words();
+    let polar = block.polar();
+    if polar {
+        // The plane in force before the block's own G17/G18/G19, as LinuxCNC checks it.
+        if state.plane != Some(tezgah_geom::Plane::XY) {
+            return Err((ErrorKind::PolarNotXyPlane, block.polar_at()));
+        }
+        for letter in [b'x', b'y'] {
+            if let Some(w) = block.word(letter) {
+                let name = letter.to_ascii_uppercase() as char;
+                return Err((ErrorKind::PolarWithAxisWord(name), w.at));
+            }
+        }
+    }
+    // Only real axis words count where G52/G92 need one.
+    let axis_words = block.has_axis_words();
+    let axes = axis_words || polar;
     // Codes whose axis words are data, not a move (G43.1 takes its offsets from them too).
     let covets_axes = matches!(mode0, Some(100 | 280 | 300 | 520 | 920))
         || block.g(ggroup::TOOL_LENGTH) == Some(431);
@@ -54,6 +69,9 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
             if axes && !covets_axes {
                 return Err((ErrorKind::AxisValuesWithG80, at_g(ggroup::MOTION)));
             }
+            if polar && mode0 == Some(920) {
+                return Err((ErrorKind::PolarWithoutMotion, block.polar_at()));
+            }
             Some(800)
         }
         Some(m) => {
@@ -66,7 +84,10 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
             Some(m)
         }
         None if covets_axes => {
-            if !axes && matches!(mode0, Some(520 | 920)) {
+            if polar && mode0 == Some(920) {
+                return Err((ErrorKind::PolarWithoutMotion, block.polar_at()));
+            }
+            if !axis_words && matches!(mode0, Some(520 | 920)) {
                 return Err((ErrorKind::AllAxesMissingWithG92, at_g(ggroup::NON_MODAL)));
             }
             None
@@ -82,6 +103,9 @@ pub fn check(block: &Block, state: &State) -> Result<Plan, CheckError> {
         None if state.motion == Some(62) && block.has(b'k') => Some(62),
         None => None,
     };
+    if polar && motion.is_none() {
+        return Err((ErrorKind::PolarWithoutMotion, block.polar_at()));
+    }
     check_g_codes(block, state, motion)?;
     if block.m_count > MAX_M_CODES {
         return Err((ErrorKind::TooManyMCodes, 0));
@@ -94,6 +118,8 @@ fn first_axis_at(block: &Block) -> u32 {
     AXIS_LETTERS
         .iter()
         .filter_map(|&c| block.word(c))
+        .chain(block.radius)
+        .chain(block.theta)
         .map(|w| w.at)
         .min()
         .unwrap_or(0)

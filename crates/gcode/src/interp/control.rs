@@ -175,6 +175,13 @@ impl Control {
     }
 }
 
+impl Control {
+    /// How deep in calls the program is (0: the program itself, LinuxCNC's `call_level`).
+    pub(super) fn call_level(&self) -> usize {
+        self.frames.len()
+    }
+}
+
 impl Interpreter {
     /// A line met while skipping: only an O-word matching the skip's target counts.
     pub(super) fn skipped_line(
@@ -280,7 +287,7 @@ impl Interpreter {
     /// Read the current (lexed) control line in full, its bracketed values evaluated.
     fn read_control_line(&mut self, line: LineRef) -> Result<OWord, GcodeError> {
         let mut block = self.block.take().unwrap_or_default();
-        let read = block.read(&self.norm, &self.params);
+        let read = block.read(&self.norm, &self.params, self.cfg.axes);
         let o = block.o.take();
         self.block = Some(block);
         let at = |idx: usize| {
@@ -309,7 +316,7 @@ impl Interpreter {
         &mut self,
         o: &OWord,
         line: LineRef,
-        _sink: &mut impl CanonSink,
+        sink: &mut impl CanonSink,
     ) -> Exec<Flow> {
         let label = &o.label;
         let unmatched = |what| (ErrorKind::UnmatchedOWord(what, label.to_string()), o.at);
@@ -362,6 +369,12 @@ impl Interpreter {
                 self.params.system.value_returned = if value.is_some() { 1.0 } else { 0.0 };
                 self.params.leave_call(frame.saved);
                 self.control.loops.truncate(frame.loops);
+                // M73 in the subroutine: its modes are restored on return.
+                let level = self.control.frames.len() + 1;
+                if let Some(saved) = self.saved_modes.leave(level) {
+                    self.restore_modes(&saved, line, sink)
+                        .map_err(|kind| (kind, o.at))?;
+                }
                 return Ok(Flow::Jump(frame.return_to));
             }
             OKeyword::Call => match self.control.subs.get(label).copied() {
@@ -665,6 +678,7 @@ impl Interpreter {
             loops: self.control.loops.len(),
             fanuc: None,
         });
+        self.saved_modes.enter(self.control.frames.len());
         Ok(())
     }
 }

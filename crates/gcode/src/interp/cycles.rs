@@ -100,13 +100,30 @@ impl Interpreter {
         // The initial level: the height when the series of cycles began (LinuxCNC 2.9's
         // `cycle_il`). G98 retracts to it (or to R, if higher) and incremental R counts from it.
         let mut old = *self.state.cycle_initial_level.get_or_insert(height);
+        // Polar words (XY plane only, `checks` made sure): in G90 the hole's radius and
+        // angle; in G91 added to each hole's radius and angle about the origin, after the X Y
+        // steps (LinuxCNC's `CYCLE_MACRO`), so that L repeats go round a circle.
+        let (radius, theta) = (block.radius.map(|w| w.value), block.theta.map(|w| w.value));
+        let mut polar_step = (0.0, 0.0);
         let (mut a, mut b, step, r, bottom) = if self.state.incremental {
             let step = (
                 block.get(AXIS_LETTERS[first]).unwrap_or(0.0),
                 block.get(AXIS_LETTERS[second]).unwrap_or(0.0),
             );
+            polar_step = (radius.unwrap_or(0.0), theta.unwrap_or(0.0).to_radians());
             let r = r_word + old;
             (pos.0[first], pos.0[second], step, r, r + bottom_word)
+        } else if block.polar() {
+            let (x, y) = (pos.0[first], pos.0[second]);
+            let rad = radius.unwrap_or_else(|| y.hypot(x));
+            let t = theta.map_or_else(|| y.atan2(x), f64::to_radians);
+            (
+                rad * t.cos(),
+                rad * t.sin(),
+                (0.0, 0.0),
+                r_word,
+                bottom_word,
+            )
         } else {
             (
                 block.get(AXIS_LETTERS[first]).unwrap_or(pos.0[first]),
@@ -135,6 +152,20 @@ impl Interpreter {
         for repeat in 0..repeats {
             a += step.0;
             b += step.1;
+            if polar_step.0 != 0.0 {
+                if a == 0.0 && b == 0.0 {
+                    return err(ErrorKind::PolarIncrementalAtOrigin);
+                }
+                let (t, rr) = (b.atan2(a), b.hypot(a) + polar_step.0);
+                (a, b) = (rr * t.cos(), rr * t.sin());
+            }
+            if polar_step.1 != 0.0 {
+                if a == 0.0 && b == 0.0 {
+                    return err(ErrorKind::PolarIncrementalAtOrigin);
+                }
+                let (t, rr) = (b.atan2(a) + polar_step.1, b.hypot(a));
+                (a, b) = (rr * t.cos(), rr * t.sin());
+            }
             let hole = Hole {
                 plane: (first, second, normal),
                 a,

@@ -35,7 +35,7 @@ impl Interpreter {
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
         self.assign_parameters(block)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))?;
-        self.execute_words(block, plan, sink)
+        self.execute_words(block, plan, line, sink)
             .map_err(|(kind, at)| GcodeError::new(kind, line.span(at as usize)))
     }
 
@@ -43,6 +43,7 @@ impl Interpreter {
         &mut self,
         block: &Block,
         plan: checks::Plan,
+        line: LineRef,
         sink: &mut impl CanonSink,
     ) -> Exec<Flow> {
         let motion = plan.motion;
@@ -73,10 +74,10 @@ impl Interpreter {
         if let Some(m) = block.m[mgroup::TOOL_CHANGE] {
             self.tool_change(block, m.code, m.at, sink)?;
         }
-        if let Some(m) = block.m(mgroup::SPINDLE) {
-            match m {
+        if let Some(c) = block.m[mgroup::SPINDLE] {
+            match c.code {
                 3 | 4 => {
-                    let dir = if m == 3 {
+                    let dir = if c.code == 3 {
                         SpindleDir::Clockwise
                     } else {
                         SpindleDir::CounterClockwise
@@ -88,6 +89,7 @@ impl Interpreter {
                     self.state.spindle = None;
                     self.emit(sink, Canon::StopSpindle);
                 }
+                70..=73 => self.modal_state(c.code, c.at, line, sink)?,
                 _ => return Err(unsupported_m(block, mgroup::SPINDLE)),
             }
         }
@@ -427,6 +429,7 @@ impl Interpreter {
         }
         self.emit(sink, Canon::SetMotionControlMode(mode));
         if let ControlMode::Continuous(p) = mode {
+            self.state.path_tolerance = p;
             let q = block.get(b'q').unwrap_or(p);
             self.state.naivecam_tolerance = q;
             self.emit(sink, Canon::SetNaivecamTolerance(q));

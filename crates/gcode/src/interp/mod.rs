@@ -12,6 +12,7 @@ mod comp;
 mod control;
 mod cycles;
 mod execute;
+mod modes;
 mod motion;
 mod spline;
 mod state;
@@ -26,7 +27,7 @@ pub use state::{rotate_xy as state_rotate_xy, State};
 
 use tezgah_geom::Pose;
 
-use crate::block::Block;
+use crate::block::{AxisMask, Block};
 use crate::canon::{Canon, CanonSink, Origin, Units};
 use crate::error::{ErrorKind, GcodeError};
 use crate::lexer::NormLine;
@@ -56,6 +57,39 @@ pub struct Config {
     /// Tool-centre-point control whatever the program says (the machine file's
     /// `tcp = "always"`); read by [`crate::moves::program_moves`], not by the interpreter.
     pub tool_centre_point_always: bool,
+    /// The program axes the machine has (LinuxCNC's axis mask): a word of another axis
+    /// letter is refused when its line is read. Default all six, as `rs274`.
+    pub axes: AxisMask,
+    /// What reaching the end of the text without M2, M30 or a closing `%` does.
+    pub missing_end: MissingEnd,
+    /// Where G38.2–G38.5 find out whether and where the probe tripped.
+    pub probe: ProbeModel,
+}
+
+/// What answers a probing move (G38.2–G38.5): the probe position (`#5061`…), whether it
+/// tripped (`#5070`) and where the move stopped. The program after a probe depends on the
+/// answer, so a run on a machine needs the executor's; until that hand-off exists, passes
+/// that make moves refuse probing rather than guess.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ProbeModel {
+    /// Refused with [`ErrorKind::ProbeUnavailable`], after LinuxCNC's own checks.
+    #[default]
+    Unavailable,
+    /// LinuxCNC's standalone `rs274`: the probe never trips (`#5070` = 0), `#5061`… hold the
+    /// target, and the move stops 0.01 in (0.254 mm) short of it, as its canon layer reports.
+    Rs274,
+}
+
+/// What the end of the text without M2, M30 or a closing `%` does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MissingEnd {
+    /// The program ends as if its last line were followed by `M2` (LinuxCNC's milltask runs
+    /// every move before it reports the missing end); [`Interpreter::missing_end`] keeps the
+    /// error it would have been, for a warning.
+    #[default]
+    AsM2,
+    /// An error, as LinuxCNC's standalone `rs274` reports it.
+    Error,
 }
 
 impl Config {
@@ -70,6 +104,9 @@ impl Config {
             parameters: None,
             start_pocket: 1,
             tool_centre_point_always: false,
+            axes: AxisMask::XYZABC,
+            missing_end: MissingEnd::Error,
+            probe: ProbeModel::Rs274,
         }
     }
 }
@@ -115,6 +152,11 @@ pub struct Interpreter {
     files: Vec<SubroutineFile>,
     /// What spline blocks carry from block to block (G5 tangent, open G5.2 and G6.2 NURBS).
     spline_memory: spline::SplineMemory,
+    /// The program ran out of text without an end and was ended as by M2: the error that
+    /// would have been ([`MissingEnd::AsM2`]).
+    missing_end: Option<GcodeError>,
+    /// What M70/M73 saved at each call level.
+    saved_modes: modes::ModeStack,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -179,6 +221,8 @@ impl Interpreter {
             closing_percent_sought: false,
             files: Vec::new(),
             spline_memory: Default::default(),
+            missing_end: None,
+            saved_modes: Default::default(),
         };
         interp.restore_parameters();
         interp
@@ -243,6 +287,12 @@ impl Interpreter {
     /// Whether M2/M30 or the closing `%` has been reached.
     pub fn ended(&self) -> bool {
         self.ended
+    }
+
+    /// When the text ended without M2, M30 or a closing `%` and the program was ended as by
+    /// M2 ([`MissingEnd::AsM2`]): the error LinuxCNC reports there, at the end of the last line.
+    pub fn missing_end(&self) -> Option<&GcodeError> {
+        self.missing_end.as_ref()
     }
 
     /// The calls LinuxCNC makes before the first block (its `rs274` prints them all).
@@ -320,7 +370,7 @@ impl Interpreter {
             }
         }
         let last = last.and_then(|p| line_at(program, p)).unwrap_or_default();
-        if let Err(e) = self.finish(last) {
+        if let Err(e) = self.finish(last, sink) {
             on_error(e);
         }
     }
@@ -359,8 +409,10 @@ impl Interpreter {
         self.comment_call(sink, "percent sign missing from end of file".into());
     }
 
-    /// The end of the text was reached without M2/M30 or closing `%`: an error, as in LinuxCNC.
-    pub fn finish(&mut self, last: LineRef) -> Result<(), GcodeError> {
+    /// The end of the text was reached without M2/M30 or closing `%`: an error, as in LinuxCNC's
+    /// `rs274`, or (as its milltask runs every move first) the program ends as if `M2` followed
+    /// its last line, as `cfg.missing_end` says.
+    pub fn finish(&mut self, last: LineRef, sink: &mut impl CanonSink) -> Result<(), GcodeError> {
         if self.ended {
             return Ok(());
         }
@@ -372,7 +424,19 @@ impl Interpreter {
         } else {
             ErrorKind::NoProgramEnd
         };
-        Err(GcodeError::new(kind, last.span(last.text.len())))
+        let error = GcodeError::new(kind, last.span(last.text.len()));
+        if self.cfg.missing_end == MissingEnd::Error {
+            return Err(error);
+        }
+        self.missing_end = Some(error);
+        // The `M2` stands just past the last line, as the last line's.
+        let m2 = LineRef {
+            text: "M2",
+            start: last.end,
+            file: 0,
+            ..last
+        };
+        self.execute_line(m2, sink).map(|_| ())
     }
 
     /// Read, check and execute one line.
@@ -422,13 +486,15 @@ impl Interpreter {
         if self.norm.mentions_parameters {
             self.publish_system_values(line.number);
         }
-        let Self { norm, params, .. } = self;
+        let Self {
+            norm, params, cfg, ..
+        } = self;
         let to_span = |norm: &NormLine, idx: usize| {
             let byte = norm.at().get(idx).map_or(line.text.len(), |&b| b as usize);
             line.span(byte)
         };
         let live = block
-            .read(norm, params)
+            .read(norm, params, cfg.axes)
             .map_err(|(kind, idx)| GcodeError::new(kind, to_span(norm, idx)))?;
         if !live {
             return Ok(Flow::Continue);

@@ -41,18 +41,23 @@ impl Interpreter {
                 return Ok(());
             }
             62 => self.g62_line(block, at, sink)?,
+            382..=385 => self.probe(block, g, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);
         Ok(())
     }
 
-    /// End point of the block's axis words, absolute, incremental or (G53) machine.
-    pub(super) fn find_ends(&self, block: &Block) -> Pose {
+    /// End point of the block's axis and polar words, absolute, incremental or (G53) machine
+    /// (LinuxCNC's `find_ends`).
+    pub(super) fn find_ends(&self, block: &Block) -> Result<Pose, ErrorKind> {
         let s = &self.state;
         if block.g(ggroup::NON_MODAL) == Some(530) {
+            if block.polar() {
+                return Err(ErrorKind::PolarWithG53);
+            }
             let m = block.axes_over(s.to_machine(s.pos) + s.tool_offset);
-            return s.from_machine(m - s.tool_offset);
+            return Ok(s.from_machine(m - s.tool_offset));
         }
         // While compensating, axes of the compensation plane not named continue from the
         // programmed point, not from the offset tool (LinuxCNC's `comp && middle`).
@@ -70,7 +75,17 @@ impl Interpreter {
                 end.0[i] = if s.incremental { end.0[i] + v } else { v };
             }
         }
-        end
+        if block.polar() {
+            let (x, y) = polar_end(
+                (end.0[0], end.0[1]),
+                block.radius.map(|w| w.value),
+                block.theta.map(|w| w.value),
+                s.incremental,
+            )?;
+            end.0[0] = x;
+            end.0[1] = y;
+        }
+        Ok(end)
     }
 
     /// The feed checks every feed move makes; in inverse time, the F word of the block.
@@ -107,7 +122,7 @@ impl Interpreter {
 
     fn straight(&mut self, block: &Block, rapid: bool, at: u32, sink: &mut impl CanonSink) -> Exec {
         self.comp.arc_not_allowed = false;
-        let end = self.find_ends(block);
+        let end = self.find_ends(block).map_err(|k| (k, at))?;
         if !rapid {
             // The inverse-time length is the programmed one, also while compensating.
             if let Some(f) = self.feed_for_move(block, false, at)? {
@@ -131,6 +146,60 @@ impl Interpreter {
         Ok(())
     }
 
+    /// G38.2 (toward the point until the probe trips, an error if it does not), G38.3 (no
+    /// error), G38.4 / G38.5 (until it clears), with LinuxCNC's checks (`convert_probe`);
+    /// the answer comes from `cfg.probe`.
+    fn probe(&mut self, block: &Block, g: u32, at: u32, sink: &mut impl CanonSink) -> Exec {
+        if self.comp.side.is_some() {
+            return Err((ErrorKind::ProbeWithComp, at));
+        }
+        if self.state.feed_rate == 0.0 {
+            return Err((ErrorKind::ProbeZeroFeed, at));
+        }
+        if self.state.feed_mode == FeedMode::UnitsPerRevolution {
+            return Err((ErrorKind::ProbeFeedPerRev, at));
+        }
+        let end = self.find_ends(block).map_err(|k| (k, at))?;
+        let start = self.state.pos;
+        // G38.3 and G38.5 do not fail, so they may start where they end.
+        if matches!(g, 382 | 384) && end == start {
+            return Err((ErrorKind::ProbeStartAtTarget, at));
+        }
+        if self.cfg.probe == super::ProbeModel::Unavailable {
+            return Err((
+                ErrorKind::ProbeUnavailable(format!("{}.{}", g / 10, g % 10)),
+                at,
+            ));
+        }
+        self.emit(sink, Canon::TurnProbeOn);
+        self.emit(sink, Canon::StraightProbe(end));
+        self.emit(sink, Canon::TurnProbeOff);
+        // rs274's canon: never tripped, the target as the probe position, and the machine
+        // 0.01 in short of it along the XYZ direction of the move.
+        let d = [
+            start.0[0] - end.0[0],
+            start.0[1] - end.0[1],
+            start.0[2] - end.0[2],
+        ];
+        let distance = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let mut stop = end;
+        if distance != 0.0 {
+            let backoff = if self.state.inches() { 0.01 } else { 0.254 };
+            for (i, di) in d.iter().enumerate() {
+                stop.0[i] = end.0[i] + backoff * (di / distance);
+            }
+        }
+        for (i, v) in end.0.iter().enumerate() {
+            self.params.set(params::PROBE_POSITION + i, *v);
+        }
+        for i in 6..9 {
+            self.params.set(params::PROBE_POSITION + i, 0.0);
+        }
+        self.params.set(params::PROBE_TRIPPED, 0.0);
+        self.state.pos = stop;
+        Ok(())
+    }
+
     /// An inverse-time move's rate becomes the feed rate in force, as in LinuxCNC.
     fn set_inverse_time_rate(&mut self, rate: f64, sink: &mut impl CanonSink) {
         self.state.feed_rate = rate;
@@ -140,7 +209,8 @@ impl Interpreter {
     /// G28/G30: rapid to the point the axis words give, then to the stored home position of
     /// those axes (all axes when none is given).
     pub(super) fn go_home(&mut self, block: &Block, g: u32, sink: &mut impl CanonSink) -> Exec {
-        let intermediate = self.find_ends(block);
+        // Polar words never reach here (`checks`: not a motion), so this cannot fail.
+        let intermediate = self.find_ends(block).map_err(|k| (k, block.polar_at()))?;
         self.emit(sink, Canon::StraightTraverse(intermediate));
         self.state.pos = intermediate;
         let base = if g == 280 {
@@ -195,7 +265,9 @@ impl Interpreter {
             let letter = (forbidden as char).to_ascii_uppercase();
             return Err((ErrorKind::ArcWrongOffsetWord(letter, name), at));
         }
-        let in_plane_end = block.has(AXIS_LETTERS[first]) || block.has(AXIS_LETTERS[second]);
+        let in_plane_end = block.has(AXIS_LETTERS[first])
+            || block.has(AXIS_LETTERS[second])
+            || (plane == Plane::XY && block.polar());
         if radius.is_some() && !in_plane_end {
             return Err((
                 ErrorKind::ArcMissingEndWords(missing_ends.0, missing_ends.1, name),
@@ -205,7 +277,7 @@ impl Interpreter {
         // `checks` has made sure P is a whole number of at least 1.
         let turns = block.get(b'p').map_or(1, |p| p.round() as i32);
         let start = self.comp_start();
-        let end = self.find_ends(block);
+        let end = self.find_ends(block).map_err(|k| (k, at))?;
         let s2 = [start.0[first], start.0[second]];
         let e2 = [end.0[first], end.0[second]];
         let tol = ArcTolerance::for_units(self.state.inches());
@@ -281,6 +353,43 @@ const STILL: f64 = 1e-7;
 
 /// Length of a straight move for its inverse-time rate: the XYZ distance if X, Y or Z moves,
 /// else the rotary distance in degrees (LinuxCNC's `find_straight_length`).
+/// LinuxCNC's polar end point in XY: from `(x, y)` (where the axis words left it), `@ radius`
+/// and `^ angle` (degrees) absolute, or in G91 added to the current point's radius and angle.
+pub(super) fn polar_end(
+    (x, y): (f64, f64),
+    radius: Option<f64>,
+    theta: Option<f64>,
+    incremental: bool,
+) -> Result<(f64, f64), ErrorKind> {
+    let at_origin = x == 0.0 && y == 0.0;
+    if !incremental {
+        let (r, t) = match (radius, theta) {
+            (Some(r), Some(t)) => (r, t.to_radians()),
+            (Some(_), None) if at_origin => return Err(ErrorKind::PolarAngleAtOrigin),
+            (Some(r), None) => (r, y.atan2(x)),
+            (None, Some(t)) => (y.hypot(x), t.to_radians()),
+            (None, None) => return Ok((x, y)),
+        };
+        return Ok((r * t.cos(), r * t.sin()));
+    }
+    let (mut x, mut y) = (x, y);
+    if let Some(dr) = radius {
+        if x == 0.0 && y == 0.0 {
+            return Err(ErrorKind::PolarIncrementalAtOrigin);
+        }
+        let (t, r) = (y.atan2(x), y.hypot(x) + dr);
+        (x, y) = (r * t.cos(), r * t.sin());
+    }
+    if let Some(dt) = theta {
+        if x == 0.0 && y == 0.0 {
+            return Err(ErrorKind::PolarG91AtOrigin);
+        }
+        let (t, r) = (y.atan2(x) + dt.to_radians(), y.hypot(x));
+        (x, y) = (r * t.cos(), r * t.sin());
+    }
+    Ok((x, y))
+}
+
 fn straight_length(d: Pose) -> f64 {
     if d.0[..3].iter().any(|v| v.abs() > STILL) {
         d.linear_norm()

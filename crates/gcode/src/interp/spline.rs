@@ -122,7 +122,7 @@ impl Interpreter {
                 return Err((ErrorKind::G51NeedsIJ, at));
             };
             points.push([x0 + i, y0 + j]);
-            let end = self.find_ends(block);
+            let end = self.find_ends(block).map_err(|k| (k, at))?;
             points.push([end.0[0], end.0[1]]);
         } else {
             let [i, j] = match (i, j) {
@@ -131,7 +131,7 @@ impl Interpreter {
                 _ => return Err((ErrorKind::G5IJBothOrNeither, at)),
             };
             points.push([x0 + i, y0 + j]);
-            let end = self.find_ends(block);
+            let end = self.find_ends(block).map_err(|k| (k, at))?;
             let (Some(p), Some(q)) = (block.get(b'p'), block.get(b'q')) else {
                 return Err((ErrorKind::G5NeedsPQ, at));
             };
@@ -185,7 +185,10 @@ impl Interpreter {
             }
             _ => None,
         };
-        let end = (!bare).then(|| self.find_ends(block));
+        let end = match bare {
+            true => None,
+            false => Some(self.find_ends(block).map_err(|k| (k, at))?),
+        };
         let series = self.state.motion == Some(52);
         let memory = &mut self.spline_memory;
         if !series {

@@ -56,6 +56,8 @@ pub struct State {
     pub cycle_initial_level: Option<f64>,
     /// Tolerance of G64 Q (naive CAM detector), program units.
     pub naivecam_tolerance: f64,
+    /// The last G64's P (LinuxCNC's `tolerance`), kept while G61 or G61.1 is in force.
+    pub path_tolerance: f64,
 }
 
 impl Default for State {
@@ -89,6 +91,7 @@ impl Default for State {
             cycle: Default::default(),
             cycle_initial_level: None,
             naivecam_tolerance: 0.0,
+            path_tolerance: 0.0,
         }
     }
 }

@@ -74,7 +74,8 @@ impl Interpreter {
         }
         let (a, b, _) = plane_axes(self.state.plane);
         let c = self.comp_current();
-        if distance([end.0[a], end.0[b]], [c[0], c[1]]) <= self.comp.radius {
+        // As for entry lines, only shorter is refused (rs274 2.9 accepts equal).
+        if distance([end.0[a], end.0[b]], [c[0], c[1]]) < self.comp.radius {
             return Err(CompError::EntryArcTooSmall.into());
         }
         self.check_tool_fits(radius_word.map(f64::abs), turn)
@@ -97,7 +98,8 @@ impl Interpreter {
     fn check_tool_fits(&self, arc_radius: Option<f64>, turn: i32) -> Result<(), ErrorKind> {
         let inside = self.comp.side.is_some_and(|s| s.inside_arc(turn));
         match arc_radius {
-            Some(r) if inside && r <= self.comp.radius => {
+            // rs274 2.9 refuses only a smaller arc: the tool may fill a hole of its size.
+            Some(r) if inside && r < self.comp.radius => {
                 Err(CompError::ToolNotSmallerThanArc.into())
             }
             _ => Ok(()),
@@ -179,7 +181,8 @@ impl Interpreter {
         }
         let inside = side.inside_arc(arc.turn);
         let gamma = if inside {
-            if arc_radius <= radius {
+            // Only a smaller arc is refused, as rs274 2.9 does (equal: the tool fills it).
+            if arc_radius < radius {
                 return Err(CompError::ToolNotSmallerThanArc.into());
             }
             angle_to(end, arc.center)

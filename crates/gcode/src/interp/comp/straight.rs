@@ -46,7 +46,10 @@ impl Interpreter {
         let side = self.comp.side.ok_or(CompError::Bug)?;
         let radius = self.comp.radius;
         let c = self.comp_current();
-        if (p[0] - c[0]).hypot(p[1] - c[1]) <= radius {
+        // rs274 2.9 refuses only a shorter move, whatever its message says: an entry exactly
+        // one radius long (LinuxCNC's useful-subroutines.ngc, `g41 g0` onto the hole's edge)
+        // ends with the tool centre on the start of the contour's normal.
+        if (p[0] - c[0]).hypot(p[1] - c[1]) < radius {
             return Err(CompError::EntryMoveTooShort.into());
         }
         let alpha = (p[1] - c[1]).atan2(p[0] - c[0]) + side.normal_angle();
