@@ -216,14 +216,19 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // the 1.005 and 1.05 below cover it and the change between samples.
             // The turning is estimated on a first coarse pass too: a curvature spike away
             // from the ends and the middle (a tight bend inside a spline) needs the samples.
+            // (Lines, arcs and helices turn evenly: the ends and the middle tell it.)
             const COARSE: usize = 64;
             let dc = (ub - ua) / COARSE as f64;
-            let coarse: f64 = (0..COARSE)
-                .map(|c| {
-                    let u = ua + dc * (c as f64 + 0.5);
-                    frame(curve, u)[1].norm() * curve.speed(u) * dc
-                })
-                .sum();
+            let coarse: f64 = if constant_speed(curve) {
+                0.0
+            } else {
+                (0..COARSE)
+                    .map(|c| {
+                        let u = ua + dc * (c as f64 + 0.5);
+                        frame(curve, u)[1].norm() * curve.speed(u) * dc
+                    })
+                    .sum()
+            };
             let turning = (k0.norm().max(k1.norm()).max(km.norm()) * seg.length).max(coarse);
             let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
             let du = (ub - ua) / samples as f64;
@@ -746,8 +751,8 @@ struct Budgets<'a> {
 
 /// Fractions of the top speed [`best_split`] tries (a speed just under the curvature limit
 /// leaves almost no acceleration; the finest steps are near 1, where a long arc runs).
-const SPEED_FRACTIONS: [f64; 14] = [
-    1.0, 0.995, 0.99, 0.98, 0.97, 0.95, 0.92, 0.9, 0.85, 0.8, 0.7, 0.6, 0.45, 0.3,
+const SPEED_FRACTIONS: [f64; 12] = [
+    1.0, 0.99, 0.97, 0.95, 0.92, 0.89, 0.85, 0.8, 0.74, 0.66, 0.5, 0.33,
 ];
 /// Fractions of the acceleration left at a speed that [`best_split`] tries (the rest of the
 /// jerk budget then goes to the path jerk through the cross term 3|q''|·V·A).

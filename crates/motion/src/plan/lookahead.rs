@@ -271,7 +271,7 @@ impl Planner {
             _ => segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?,
         };
         // With speed steps at its ends, the cruise only changes speed by the last step.
-        let cruise = if geom.curved() {
+        let cruise = if may_step(&geom, &sl.limits, &self.machine, start_cap.min(end_speed)) {
             cruise_limits(&seg, &geom, &self.machine, &self.options, reserve)?
         } else {
             sl
@@ -286,7 +286,11 @@ impl Planner {
                 from,
             )
         };
-        let (up, down) = (step(start_cap), step(end_speed));
+        let (up, down) = if may_step(&geom, &sl.limits, &self.machine, start_cap.min(end_speed)) {
+            (step(start_cap), step(end_speed))
+        } else {
+            (vec![], vec![])
+        };
         let seg = Arc::new(seg);
         if up.is_empty() && down.is_empty() {
             return self.add_span(seg, (0.0, geom.length), geom, sl, end_cap);
@@ -514,6 +518,23 @@ impl Planner {
         })));
         Ok(())
     }
+}
+
+/// Whether a curved segment entered or left at `slowest` may get speed steps
+/// ([`ladder`]): it must be entered or left below the highest step, and long enough that
+/// the first step — to 55 % of its speed at no more than the straight line's acceleration —
+/// takes at most an eighth of it. A quick test before the steps are worked out.
+fn may_step(geom: &Geometry, limits: &Limits, machine: &PlanMachine, slowest: f64) -> bool {
+    let v = limits.max_velocity();
+    if !geom.curved() || geom.rotary_only || slowest >= 0.9 * v {
+        return false;
+    }
+    let straight = (0..machine.joint_count().min(geom.g1.len()))
+        .filter(|&i| geom.g1[i] > 0.0)
+        .map(|i| machine.max_acceleration[i] / geom.g1[i])
+        .fold(f64::INFINITY, f64::min);
+    let first = 0.55 * v;
+    first * first / (2.0 * straight) <= geom.length / 8.0
 }
 
 /// Plans a whole list of path items.
