@@ -1,0 +1,344 @@
+//! The programmed path `verify` measures against: the program's own moves (lines, arcs,
+//! helices, NURBS) as the interpreter emits them — work offsets and tool length applied, before
+//! compression, blending or smoothing — laid end to end by arc length `σ`, so that a cursor
+//! can follow the samples and measure each one against the program *near where it is*.
+
+use std::sync::Arc as Shared;
+
+use tezgah_geom::deviation::closest_point;
+use tezgah_geom::{Arc, Curve, Move, MoveKind, Nurbs, Pose, ToolControl, Vec3};
+
+/// Table steps per NURBS knot span for the `σ ↔ u` table (Gauss-Legendre per step).
+const NURBS_STEPS_PER_SPAN: usize = 8;
+
+/// The geometry of one programmed move.
+enum Geo {
+    /// Start and unit direction (zero for a move that turns only rotary axes); `u = s`.
+    Line { start: Vec3, dir: Vec3 },
+    /// Constant parametric speed (circular arcs, helices, spirals): `u = s / length`.
+    Arc(Arc),
+    /// A NURBS move with its `(s, u)` table.
+    Nurbs {
+        curve: Shared<Nurbs>,
+        table: Vec<(f64, f64)>,
+    },
+}
+
+/// One programmed move, placed along the program.
+struct Piece {
+    geo: Geo,
+    /// Arc length along the program at the piece's start, mm.
+    start: f64,
+    /// Arc length of the piece, mm.
+    length: f64,
+}
+
+/// The nearest programmed point found for a query: distance (mm) and where it is (`σ`, mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nearest {
+    pub distance: f64,
+    pub sigma: f64,
+}
+
+/// The program's tip path: every move's geometry in order, and where the tool control switches
+/// to another reading of the program point (the take-up moves run there, outside the program).
+pub struct ProgramPath {
+    pieces: Vec<Piece>,
+    /// `σ` of the switches between readings (TCP on/off, a new TCP tool length).
+    switches: Vec<f64>,
+}
+
+impl ProgramPath {
+    /// The moves from `start` under the machine's `initial` tool control. Moves whose geometry
+    /// cannot be built are skipped (the path builder reports them).
+    pub fn new(start: Pose, initial: ToolControl, moves: &[Move]) -> Self {
+        let mut pos = start;
+        let mut control = initial;
+        let mut sigma = 0.0;
+        let mut pieces = Vec::new();
+        let mut switches = Vec::new();
+        for m in moves {
+            let (geo, length, end) = match &m.kind {
+                &MoveKind::Rapid { end } | &MoveKind::Feed { end } => {
+                    let (a, b) = (Vec3::from(pos.xyz()), Vec3::from(end.xyz()));
+                    let length = (b - a).norm();
+                    let dir = if length > 0.0 {
+                        (b - a) / length
+                    } else {
+                        Vec3::zeros()
+                    };
+                    (Geo::Line { start: a, dir }, length, end)
+                }
+                MoveKind::Arc(a) => match Arc::from_move(&pos, a) {
+                    Ok(arc) => {
+                        let length = arc.length();
+                        (Geo::Arc(arc), length, a.end)
+                    }
+                    Err(_) => continue,
+                },
+                MoveKind::Nurbs(n) => {
+                    let table = arc_length_table(n.curve.as_ref());
+                    let length = table.last().map_or(0.0, |t| t.0);
+                    let geo = Geo::Nurbs {
+                        curve: n.curve.clone(),
+                        table,
+                    };
+                    (geo, length, n.end)
+                }
+                // Nothing moves: the next move starts from the point read anew.
+                &MoveKind::ToolControl { control: c, at } => {
+                    if !c.same_reading(&control) {
+                        switches.push(sigma);
+                    }
+                    control = c;
+                    pos = at;
+                    continue;
+                }
+                _ => continue,
+            };
+            pieces.push(Piece {
+                geo,
+                start: sigma,
+                length,
+            });
+            sigma += length;
+            pos = end;
+        }
+        ProgramPath { pieces, switches }
+    }
+
+    /// Arc length of the whole program, mm.
+    pub fn length(&self) -> f64 {
+        self.pieces.last().map_or(0.0, |p| p.start + p.length)
+    }
+
+    /// Whether a switch between readings of the program point lies in `[lo, hi]`.
+    pub fn switch_within(&self, lo: f64, hi: f64) -> bool {
+        let i = self.switches.partition_point(|&s| s < lo);
+        self.switches.get(i).is_some_and(|&s| s <= hi)
+    }
+
+    /// The nearest point to `q` of the program between arc lengths `lo` and `hi` (the union of
+    /// the moves' parts there: at a blended corner, both legs). `hint` is a piece index near
+    /// the window (the last answer's), updated. Infinite distance for an empty program.
+    pub fn nearest(&self, q: &Vec3, lo: f64, hi: f64, hint: &mut usize) -> Nearest {
+        let mut best = Nearest {
+            distance: f64::INFINITY,
+            sigma: lo.max(0.0),
+        };
+        if self.pieces.is_empty() {
+            return best;
+        }
+        let mut i = (*hint).min(self.pieces.len() - 1);
+        while i > 0 && self.pieces[i].start > lo {
+            i -= 1;
+        }
+        while i + 1 < self.pieces.len() && self.pieces[i].start + self.pieces[i].length < lo {
+            i += 1;
+        }
+        let mut best_i = i;
+        while i < self.pieces.len() && self.pieces[i].start <= hi {
+            let p = &self.pieces[i];
+            let s0 = (lo - p.start).clamp(0.0, p.length);
+            let s1 = (hi - p.start).clamp(0.0, p.length);
+            let (d, s) = p.nearest(q, s0, s1);
+            if d < best.distance {
+                best = Nearest {
+                    distance: d,
+                    sigma: p.start + s,
+                };
+                best_i = i;
+            }
+            i += 1;
+        }
+        *hint = best_i;
+        best
+    }
+}
+
+impl Piece {
+    /// Distance from `q` to the piece's part `s ∈ [s0, s1]` and the `s` where it is reached.
+    fn nearest(&self, q: &Vec3, s0: f64, s1: f64) -> (f64, f64) {
+        match &self.geo {
+            Geo::Line { start, dir } => {
+                let s = (q - start).dot(dir).clamp(s0, s1);
+                ((start + dir * s - q).norm(), s)
+            }
+            Geo::Arc(a) => {
+                let (u0, u1) = (s0 / self.length, s1 / self.length);
+                let (d, u) = plane_arc_nearest(a, q, u0, u1).unwrap_or_else(|| {
+                    // Helices and spirals: no closed form; a sample per 22.5° of the part
+                    // starts the refinement in the right basin.
+                    let turns = a.sweep().abs() * (u1 - u0);
+                    let n = (turns / (std::f64::consts::PI / 8.0)).ceil() as usize;
+                    let c = closest_point(a, q, u0, u1, n.clamp(4, 64));
+                    (c.distance, c.u)
+                });
+                (d, u * self.length)
+            }
+            Geo::Nurbs { curve, table } => {
+                let (u0, u1) = (param_at(table, s0), param_at(table, s1));
+                let c = closest_point(curve.as_ref(), q, u0, u1, 8);
+                (c.distance, length_at(table, c.u))
+            }
+        }
+    }
+}
+
+/// Distance from `q` to the part `u ∈ [u0, u1]` of a plane arc of constant radius and the
+/// parameter where it is reached, in closed form: `q`'s own angle if the part holds it
+/// (on a part of more than a turn, the turn nearest the part's middle), else the nearer end.
+/// `None` for helices and spirals.
+fn plane_arc_nearest(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<(f64, f64)> {
+    use std::f64::consts::TAU;
+    if a.rise() != 0.0 || (a.radius() - a.end_radius()).abs() > 1e-12 * a.radius() {
+        return None;
+    }
+    let (c, n, r, sweep) = (a.center(), a.normal(), a.radius(), a.sweep().abs());
+    let e1 = (a.point(0.0) - c) / r;
+    let e2 = n.cross(&e1);
+    let d = q - c;
+    let (x, y, h) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
+    let rho = x.hypot(y);
+    let ends = || {
+        let (p0, p1) = ((a.point(u0) - q).norm(), (a.point(u1) - q).norm());
+        if p0 <= p1 {
+            (p0, u0)
+        } else {
+            (p1, u1)
+        }
+    };
+    if rho == 0.0 || sweep == 0.0 {
+        // On the axis every point of the arc is as near.
+        return Some((r.hypot(h), 0.5 * (u0 + u1)));
+    }
+    // The angle of q in the arc's own sense, in [0, 2π).
+    let theta = (y.atan2(x) * a.sweep().signum()).rem_euclid(TAU);
+    let (t0, t1) = (sweep * u0, sweep * u1);
+    let mid = 0.5 * (t0 + t1);
+    let k = ((mid - theta) / TAU).round();
+    let mut t = theta + k * TAU;
+    if t < t0 {
+        t += TAU;
+    } else if t > t1 {
+        t -= TAU;
+    }
+    if (t0..=t1).contains(&t) {
+        Some(((rho - r).hypot(h), t / sweep))
+    } else {
+        Some(ends())
+    }
+}
+
+/// `(s, u)` at every knot span's ends and `NURBS_STEPS_PER_SPAN` steps inside, by Gauss
+/// quadrature of the speed (geom's `Curve::speed_integral`).
+fn arc_length_table<C: Curve + ?Sized>(c: &C) -> Vec<(f64, f64)> {
+    let (a, b) = c.domain();
+    let mut cuts = vec![a];
+    cuts.extend(c.breakpoints().into_iter().filter(|&x| x > a && x < b));
+    cuts.push(b);
+    let mut table = vec![(0.0, a)];
+    let mut s = 0.0;
+    for w in cuts.windows(2) {
+        for k in 1..=NURBS_STEPS_PER_SPAN {
+            let (p, q) = (
+                w[0] + (w[1] - w[0]) * (k - 1) as f64 / NURBS_STEPS_PER_SPAN as f64,
+                w[0] + (w[1] - w[0]) * k as f64 / NURBS_STEPS_PER_SPAN as f64,
+            );
+            s += c.speed_integral(p, q);
+            table.push((s, q));
+        }
+    }
+    table
+}
+
+/// Linear interpolation in a monotone table, by the first (`by_s`) or second column.
+fn interpolate(table: &[(f64, f64)], x: f64, by_s: bool) -> f64 {
+    let key = |e: &(f64, f64)| if by_s { e.0 } else { e.1 };
+    let val = |e: &(f64, f64)| if by_s { e.1 } else { e.0 };
+    let i = table.partition_point(|e| key(e) < x);
+    if i == 0 {
+        return val(&table[0]);
+    }
+    if i >= table.len() {
+        return val(&table[table.len() - 1]);
+    }
+    let (a, b) = (&table[i - 1], &table[i]);
+    let w = key(b) - key(a);
+    let f = if w > 0.0 { (x - key(a)) / w } else { 0.0 };
+    val(a) + f * (val(b) - val(a))
+}
+
+fn param_at(table: &[(f64, f64)], s: f64) -> f64 {
+    interpolate(table, s, true)
+}
+
+fn length_at(table: &[(f64, f64)], u: f64) -> f64 {
+    interpolate(table, u, false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tezgah_geom::{ArcMove, Plane};
+
+    fn feed(line: u32, x: f64, y: f64) -> Move {
+        Move {
+            line,
+            kind: MoveKind::Feed {
+                end: Pose([x, y, 0.0, 0.0, 0.0, 0.0]),
+            },
+        }
+    }
+
+    /// An L: the nearest point of a point inside the corner is on either leg within the
+    /// window, and a window that holds only the first leg measures from it alone.
+    #[test]
+    fn the_window_restricts_the_union() {
+        let moves = [feed(1, 10.0, 0.0), feed(2, 10.0, 10.0)];
+        let p = ProgramPath::new(Pose::ZERO, ToolControl::OFF, &moves);
+        assert_eq!(p.length(), 20.0);
+        let q = Vec3::new(9.0, 0.5, 0.0);
+        let mut h = 0;
+        let n = p.nearest(&q, 0.0, 20.0, &mut h);
+        assert!((n.distance - 0.5).abs() < 1e-15 && (n.sigma - 9.0).abs() < 1e-15);
+        // Near the second leg's start.
+        let q = Vec3::new(9.8, 3.0, 0.0);
+        let n = p.nearest(&q, 5.0, 20.0, &mut h);
+        assert!((n.distance - 0.2).abs() < 1e-12 && (n.sigma - 13.0).abs() < 1e-12);
+        // Only the first leg: the distance to its end.
+        let n = p.nearest(&q, 0.0, 9.0, &mut h);
+        assert!((n.distance - (1.0f64 + 9.0).sqrt()).abs() < 1e-12, "{n:?}");
+    }
+
+    /// A full circle of radius 5: the closed form gives the radial distance and the angle,
+    /// and a window over a quarter of it the distance to the nearer end otherwise.
+    #[test]
+    fn arcs_in_closed_form() {
+        let moves = [
+            feed(1, 5.0, 0.0),
+            Move {
+                line: 2,
+                kind: MoveKind::Arc(ArcMove {
+                    plane: Plane::XY,
+                    end: Pose([5.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+                    center: [0.0, 0.0],
+                    turn: 1,
+                }),
+            },
+        ];
+        let p = ProgramPath::new(Pose::ZERO, ToolControl::OFF, &moves);
+        let quarter = 2.5 * std::f64::consts::PI;
+        assert!((p.length() - 5.0 - 4.0 * quarter).abs() < 1e-9);
+        let q = Vec3::new(0.0, 6.0, 0.0);
+        let mut h = 0;
+        let n = p.nearest(&q, 5.0, 5.0 + 4.0 * quarter, &mut h);
+        assert!((n.distance - 1.0).abs() < 1e-12, "{n:?}");
+        assert!((n.sigma - (5.0 + quarter)).abs() < 1e-9, "{n:?}");
+        // The part after the first quarter only: the nearest is its start (0, 5).
+        let n = p.nearest(&q, 5.0 + quarter, 5.0 + 2.0 * quarter, &mut h);
+        assert!((n.distance - 1.0).abs() < 1e-9, "{n:?}");
+        let n = p.nearest(&q, 5.0 + 2.0 * quarter, 5.0 + 3.0 * quarter, &mut h);
+        assert!((n.distance - (25.0f64 + 36.0).sqrt()).abs() < 1e-9, "{n:?}");
+    }
+}
