@@ -146,11 +146,17 @@ impl Against {
             self.last_tip = None;
             return;
         }
-        let n = self.program.nearest(&tip, lo, hi, &mut self.hint);
+        let n = self
+            .program
+            .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
         let mut d = n.distance;
         if let (true, Some(p)) = (chord, self.last_tip) {
             let mid = 0.5 * (p + tip);
-            d = d.max(self.program.nearest(&mid, lo, hi, &mut self.hint.clone()).distance);
+            let expected = self.sigma + 0.5 * step;
+            let m = self
+                .program
+                .nearest(&mid, (lo, hi), expected, &mut self.hint.clone());
+            d = d.max(m.distance);
         }
         if d.is_finite() {
             self.peak.push(d, seg.tolerance, s.line);

@@ -11,6 +11,10 @@ use tezgah_geom::{Arc, Curve, Move, MoveKind, Nurbs, Pose, ToolControl, Vec3};
 /// Table steps per NURBS knot span for the `σ ↔ u` table (Gauss-Legendre per step).
 const NURBS_STEPS_PER_SPAN: usize = 8;
 
+/// Distances this close (mm) are a tie: the program passes the same point twice (a retrace,
+/// a move back over the last), and the candidate nearer the expected `σ` wins.
+const TIE_MM: f64 = 1e-9;
+
 /// The geometry of one programmed move.
 enum Geo {
     /// Start and unit direction (zero for a move that turns only rotary axes); `u = s`.
@@ -119,9 +123,16 @@ impl ProgramPath {
     }
 
     /// The nearest point to `q` of the program between arc lengths `lo` and `hi` (the union of
-    /// the moves' parts there: at a blended corner, both legs). `hint` is a piece index near
-    /// the window (the last answer's), updated. Infinite distance for an empty program.
-    pub fn nearest(&self, q: &Vec3, lo: f64, hi: f64, hint: &mut usize) -> Nearest {
+    /// the moves' parts there: at a blended corner, both legs); of points as near (a retrace),
+    /// the one nearest `expected`. `hint` is a piece index near the window (the last
+    /// answer's), updated. Infinite distance for an empty program.
+    pub fn nearest(
+        &self,
+        q: &Vec3,
+        (lo, hi): (f64, f64),
+        expected: f64,
+        hint: &mut usize,
+    ) -> Nearest {
         let mut best = Nearest {
             distance: f64::INFINITY,
             sigma: lo.max(0.0),
@@ -142,10 +153,13 @@ impl ProgramPath {
             let s0 = (lo - p.start).clamp(0.0, p.length);
             let s1 = (hi - p.start).clamp(0.0, p.length);
             let (d, s) = p.nearest(q, s0, s1);
-            if d < best.distance {
+            let sigma = p.start + s;
+            let tie = (d - best.distance).abs() <= TIE_MM
+                && (sigma - expected).abs() < (best.sigma - expected).abs();
+            if d < best.distance - TIE_MM || tie {
                 best = Nearest {
-                    distance: d,
-                    sigma: p.start + s,
+                    distance: d.min(best.distance),
+                    sigma,
                 };
                 best_i = i;
             }
@@ -300,19 +314,35 @@ mod tests {
         assert_eq!(p.length(), 20.0);
         let q = Vec3::new(9.0, 0.5, 0.0);
         let mut h = 0;
-        let n = p.nearest(&q, 0.0, 20.0, &mut h);
+        let n = p.nearest(&q, (0.0, 20.0), 10.0, &mut h);
         assert!((n.distance - 0.5).abs() < 1e-15 && (n.sigma - 9.0).abs() < 1e-15);
         // Near the second leg's start.
         let q = Vec3::new(9.8, 3.0, 0.0);
-        let n = p.nearest(&q, 5.0, 20.0, &mut h);
+        let n = p.nearest(&q, (5.0, 20.0), 10.0, &mut h);
         assert!((n.distance - 0.2).abs() < 1e-12 && (n.sigma - 13.0).abs() < 1e-12);
         // Only the first leg: the distance to its end.
-        let n = p.nearest(&q, 0.0, 9.0, &mut h);
+        let n = p.nearest(&q, (0.0, 9.0), 5.0, &mut h);
         assert!((n.distance - (1.0f64 + 9.0).sqrt()).abs() < 1e-12, "{n:?}");
     }
 
     /// A full circle of radius 5: the closed form gives the radial distance and the angle,
     /// and a window over a quarter of it the distance to the nearer end otherwise.
+    /// Up 2 mm and back down the same line: at the bottom both ends are 0 away, and the one
+    /// the samples are heading for wins.
+    #[test]
+    fn a_retrace_is_followed_forward() {
+        let up = Move {
+            line: 1,
+            kind: MoveKind::Rapid {
+                end: Pose([0.0, 0.0, 2.0, 0.0, 0.0, 0.0]),
+            },
+        };
+        let p = ProgramPath::new(Pose::ZERO, ToolControl::OFF, &[up, feed(2, 0.0, 0.0)]);
+        let (q, mut h) = (Vec3::zeros(), 0);
+        assert_eq!(p.nearest(&q, (0.0, 4.0), 3.9, &mut h).sigma, 4.0);
+        assert_eq!(p.nearest(&q, (0.0, 4.0), 0.1, &mut h).sigma, 0.0);
+    }
+
     #[test]
     fn arcs_in_closed_form() {
         let moves = [
@@ -332,13 +362,13 @@ mod tests {
         assert!((p.length() - 5.0 - 4.0 * quarter).abs() < 1e-9);
         let q = Vec3::new(0.0, 6.0, 0.0);
         let mut h = 0;
-        let n = p.nearest(&q, 5.0, 5.0 + 4.0 * quarter, &mut h);
+        let n = p.nearest(&q, (5.0, 5.0 + 4.0 * quarter), 5.0, &mut h);
         assert!((n.distance - 1.0).abs() < 1e-12, "{n:?}");
         assert!((n.sigma - (5.0 + quarter)).abs() < 1e-9, "{n:?}");
         // The part after the first quarter only: the nearest is its start (0, 5).
-        let n = p.nearest(&q, 5.0 + quarter, 5.0 + 2.0 * quarter, &mut h);
+        let n = p.nearest(&q, (5.0 + quarter, 5.0 + 2.0 * quarter), 5.0, &mut h);
         assert!((n.distance - 1.0).abs() < 1e-9, "{n:?}");
-        let n = p.nearest(&q, 5.0 + 2.0 * quarter, 5.0 + 3.0 * quarter, &mut h);
+        let n = p.nearest(&q, (5.0 + 2.0 * quarter, 5.0 + 3.0 * quarter), 5.0, &mut h);
         assert!((n.distance - (25.0f64 + 36.0).sqrt()).abs() < 1e-9, "{n:?}");
     }
 }
