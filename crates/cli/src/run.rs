@@ -568,7 +568,13 @@ fn summary(
         r.deviation_ratio <= 1.0
     );
     let s = &r.slack;
-    let share = |t: f64| if s.moving > 0.0 { 100.0 * t / s.moving } else { 0.0 };
+    let share = |t: f64| {
+        if s.moving > 0.0 {
+            100.0 * t / s.moving
+        } else {
+            0.0
+        }
+    };
     println!(
         "slack {:.1} % of the cycle (below the feed, no joint within {:.0} % of a limit); \
          time at the feed {:.1} %",

@@ -17,7 +17,8 @@ use tezgah_motion::verify::{Report, Verifier};
 use tezgah_motion::{PathItem, Segment};
 
 /// Square corners (90°) 20 mm apart at 50 mm/s under `G64 P0.5`.
-const CORNERS: &str = "G21 G90 G17\nG64 P0.5\nG1 F3000 X20 Y0\nX20 Y20\nX0 Y20\nX0 Y40\nX20 Y40\nM2\n";
+const CORNERS: &str =
+    "G21 G90 G17\nG64 P0.5\nG1 F3000 X20 Y0\nX20 Y20\nX0 Y20\nX0 Y40\nX20 Y40\nM2\n";
 
 struct Out {
     report: Report,
@@ -29,12 +30,8 @@ struct Out {
 /// against `program` (the moves themselves unless another program is given).
 fn replay(machine: &Machine, moves: Vec<Move>, claimed: Option<f64>, program: &[Move]) -> Out {
     let pm = PlanMachine::from_machine(machine).unwrap();
-    let opts = SmoothOptions::for_machine(
-        &machine.path,
-        &pm,
-        machine.motion.tolerance_mm,
-        Pose::ZERO,
-    );
+    let opts =
+        SmoothOptions::for_machine(&machine.path, &pm, machine.motion.tolerance_mm, Pose::ZERO);
     let mut smoother = Smoother::new(moves.into_iter(), opts).unwrap();
     let mut items: Vec<PathItem> = smoother.by_ref().collect::<Result<_, _>>().unwrap();
     if let Some(t) = claimed {
@@ -106,7 +103,11 @@ fn a_smoothing_that_leaves_the_program_fails() {
     let out = replay(&Machine::default_machine(), m.clone(), Some(0.01), &m);
     let r = &out.report;
     let expected = apex_from_legs(out.max_blend_deviation);
-    assert!(out.max_blend_deviation > 0.15, "{}", out.max_blend_deviation);
+    assert!(
+        out.max_blend_deviation > 0.15,
+        "{}",
+        out.max_blend_deviation
+    );
     // The chord error at 0.2 × 0.01 mm is all the samples add to the blend.
     assert!(
         (r.max_deviation - expected).abs() <= 0.002 + 1e-9,
@@ -114,7 +115,11 @@ fn a_smoothing_that_leaves_the_program_fails() {
         r.max_deviation
     );
     assert!(r.deviation_ratio > 10.0, "{}", r.deviation_ratio);
-    assert!(r.max_deviation_smoothed <= 0.01, "{}", r.max_deviation_smoothed);
+    assert!(
+        r.max_deviation_smoothed <= 0.01,
+        "{}",
+        r.max_deviation_smoothed
+    );
     assert!(r.max_deviation > 50.0 * r.max_deviation_smoothed);
 }
 
@@ -144,10 +149,19 @@ fn a_shifted_program_reads_the_shift() {
     let text = "G21 G90 G17\nG61\nG1 F3000 X30 Y0\nX30 Y10\nM2\n";
     let m = moves(text);
     let d = Vec3::new(0.0, 0.0, 0.05);
-    let out = replay(&Machine::default_machine(), m.clone(), None, &shifted(&m, d));
+    let out = replay(
+        &Machine::default_machine(),
+        m.clone(),
+        None,
+        &shifted(&m, d),
+    );
     let r = &out.report;
     assert!((r.max_deviation - 0.05).abs() < 1e-9, "{}", r.max_deviation);
-    assert!(r.max_deviation_smoothed < 1e-6, "{}", r.max_deviation_smoothed);
+    assert!(
+        r.max_deviation_smoothed < 1e-6,
+        "{}",
+        r.max_deviation_smoothed
+    );
 }
 
 /// Five axes under TCP on the table-ac trunnion (G43.4 switched on and off again, take-ups

@@ -6,6 +6,7 @@
 use std::sync::Arc;
 
 use tezgah_geom::{Line, ToolControl, Vec3};
+use tezgah_geom::{Move, MoveKind, PathMode, Pose};
 use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::interpolate::{run, Sample};
 use tezgah_motion::path::direct::{build, DirectOptions};
@@ -13,7 +14,6 @@ use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::verify::slack::BINS;
 use tezgah_motion::verify::{Report, Verifier};
 use tezgah_motion::{Junction, Segment, SegmentFeed};
-use tezgah_geom::{Move, MoveKind, PathMode, Pose};
 
 const TS: f64 = 0.001;
 
@@ -38,7 +38,10 @@ impl Ramp {
         } else if t <= tr {
             let r = tr - t;
             // The S-curve is symmetric: half way in time is half the average speed's distance.
-            (0.5 * f * tr - (f * r - j * r * r * r / 6.0), f - 0.5 * j * r * r)
+            (
+                0.5 * f * tr - (f * r - j * r * r * r / 6.0),
+                f - 0.5 * j * r * r,
+            )
         } else {
             (0.5 * f * tr + f * (t - tr), f)
         }
@@ -113,16 +116,28 @@ fn slack_is_the_ramps_when_no_joint_is_near_a_limit() {
     assert!((tr / TS).fract() > 0.1, "the ramp ends between samples");
     let (r, n) = synthetic(&ramp, 1.0, SegmentFeed::Feed(50.0));
     let per_ramp = (tr / TS).ceil();
-    assert!((r.slack.slack - 2.0 * per_ramp * TS).abs() < 1e-12, "{:?}", r.slack);
+    assert!(
+        (r.slack.slack - 2.0 * per_ramp * TS).abs() < 1e-12,
+        "{:?}",
+        r.slack
+    );
     assert!((r.slack.moving - n as f64 * TS).abs() < 1e-12);
     assert!((r.slack.share(r.cycle_time) - 2.0 * per_ramp * TS / r.cycle_time).abs() < 1e-12);
     for i in 0..BINS - 1 {
-        let dt = ramp.time_at_fraction((i + 1) as f64 / 10.0) - ramp.time_at_fraction(i as f64 / 10.0);
+        let dt =
+            ramp.time_at_fraction((i + 1) as f64 / 10.0) - ramp.time_at_fraction(i as f64 / 10.0);
         let got = r.slack.histogram[i];
-        assert!((got - 2.0 * dt).abs() <= 2.0 * TS + 1e-12, "bin {i}: {got} against {}", 2.0 * dt);
+        assert!(
+            (got - 2.0 * dt).abs() <= 2.0 * TS + 1e-12,
+            "bin {i}: {got} against {}",
+            2.0 * dt
+        );
     }
     let cruise = r.slack.histogram[BINS - 1];
-    assert!((cruise - (n as f64 - 2.0 * per_ramp) * TS).abs() < 1e-12, "{cruise}");
+    assert!(
+        (cruise - (n as f64 - 2.0 * per_ramp) * TS).abs() < 1e-12,
+        "{cruise}"
+    );
 }
 
 /// The same samples as a rapid: the nominal speed is where the first joint reaches its
@@ -135,9 +150,17 @@ fn a_rapid_is_measured_against_the_joint_velocity_limit() {
         j: 25_000.0,
     };
     let (r, n) = synthetic(&ramp, 1.0, SegmentFeed::Rapid);
-    assert!((r.slack.slack - n as f64 * TS).abs() < 1e-12, "{:?}", r.slack);
+    assert!(
+        (r.slack.slack - n as f64 * TS).abs() < 1e-12,
+        "{:?}",
+        r.slack
+    );
     // 1 s of cruise at 0.25: bin [0.2, 0.3).
-    assert!(r.slack.histogram[2] >= 1.0 - 1e-9, "{:?}", r.slack.histogram);
+    assert!(
+        r.slack.histogram[2] >= 1.0 - 1e-9,
+        "{:?}",
+        r.slack.histogram
+    );
     assert_eq!(r.slack.histogram[BINS - 1], 0.0);
 }
 
@@ -152,9 +175,7 @@ fn planned(feed_mm_min: f64) -> Report {
         },
         Move {
             line: 2,
-            kind: MoveKind::FeedRate {
-                value: feed_mm_min,
-            },
+            kind: MoveKind::FeedRate { value: feed_mm_min },
         },
         Move {
             line: 3,
@@ -187,7 +208,10 @@ fn a_slow_feed_has_slack_only_at_the_jerk_switches() {
     let below: f64 = r.slack.histogram[..BINS - 1].iter().sum();
     // Two ramps of 2√(F/J) = 28.3 ms each: below the feed that long, ±2 samples.
     let ramps = 4.0 * (10.0f64 / 50_000.0).sqrt();
-    assert!((below - ramps).abs() <= 2.0 * TS + 1e-9, "{below} against {ramps}");
+    assert!(
+        (below - ramps).abs() <= 2.0 * TS + 1e-9,
+        "{below} against {ramps}"
+    );
     assert!(r.slack.slack <= 6.0 * 3.0 * TS + 1e-12, "{:?}", r.slack);
 }
 
@@ -197,6 +221,10 @@ fn a_slow_feed_has_slack_only_at_the_jerk_switches() {
 fn a_feed_above_the_joints_has_no_slack() {
     let r = planned(60_000.0);
     let below: f64 = r.slack.histogram[..BINS - 1].iter().sum();
-    assert!(below > 0.7, "the whole cycle is below the feed: {below} of {}", r.cycle_time);
+    assert!(
+        below > 0.7,
+        "the whole cycle is below the feed: {below} of {}",
+        r.cycle_time
+    );
     assert!(r.slack.slack <= 8.0 * 3.0 * TS + 1e-12, "{:?}", r.slack);
 }

@@ -149,8 +149,14 @@ mod tests {
     /// from a guess a little off finds it, and a bracket that excludes it gives the nearer end.
     #[test]
     fn newton_on_a_circle() {
-        let c = Circle::new(Vec3::zeros(), Vec3::new(10.0, 0.0, 0.0), Vec3::z(), 1.0, 0.0)
-            .unwrap();
+        let c = Circle::new(
+            Vec3::zeros(),
+            Vec3::new(10.0, 0.0, 0.0),
+            Vec3::z(),
+            1.0,
+            0.0,
+        )
+        .unwrap();
         let sweep = c.sweep();
         for k in 1..20 {
             let t = k as f64 * 0.3;

@@ -263,9 +263,7 @@ impl Verifier {
                 p.jerk_line = line;
             }
             worst_v = worst_v.max(v / p.max_velocity);
-            worst = worst
-                .max(a / p.max_acceleration)
-                .max(j / p.max_jerk);
+            worst = worst.max(a / p.max_acceleration).max(j / p.max_jerk);
         }
         worst = worst.max(worst_v);
         let e = self.per_line.entry(line).or_insert(0.0);
