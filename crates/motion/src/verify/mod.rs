@@ -15,6 +15,7 @@ pub mod slack;
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use tezgah_geom::deviation::point_segment_distance;
 use tezgah_geom::{ToolControl, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, Model, Tool};
 
@@ -58,8 +59,9 @@ pub struct Report {
     pub cycle_time: f64,
     pub joints: Vec<JointPeaks>,
     /// Largest distance of a sample's tip, or of the midpoint of the chord between two
-    /// samples, from the programmed path near it (mm; [`Verifier::against`]); without a
-    /// program, from the smoothed path (as `max_deviation_smoothed`).
+    /// samples, from the programmed path near it, or of a programmed vertex (a move's end)
+    /// from the sampled path near it (mm; [`Verifier::against`]); without a program, from
+    /// the smoothed path (as `max_deviation_smoothed`).
     pub max_deviation: f64,
     pub max_deviation_line: u32,
     /// The same from the smoothed path the planner followed (mm): the chord error alone.
@@ -102,8 +104,21 @@ impl Peak {
     }
 }
 
+/// A programmed vertex the samples are passing: the nearest the sampled path (tips and the
+/// chords between them) has come to it, with the tolerance and line of the sample there.
+#[derive(Debug, Clone, Copy)]
+struct Pending {
+    point: Vec3,
+    sigma: f64,
+    distance: f64,
+    tolerance: f64,
+    line: u32,
+}
+
 /// Following the programmed path: the program, a cursor on it (arc length `sigma` and a
-/// piece index), and the last sample measured.
+/// piece index), and the last sample measured. Both directions are measured: every sample
+/// (and chord midpoint) to the program near it, and every programmed vertex to the sampled
+/// path near it — a smoothing that cuts a corner or skips a feature shows in the second.
 struct Against {
     program: ProgramPath,
     model: Model,
@@ -113,14 +128,97 @@ struct Against {
     last_distance: f64,
     peak: Peak,
     unmeasured: u64,
+    /// The next vertex to enter the window, and those in it.
+    next_vertex: usize,
+    pending: std::collections::VecDeque<Pending>,
 }
 
 impl Against {
+    fn new(machine: &PlanMachine, program: ProgramPath) -> Self {
+        Against {
+            program,
+            model: machine.model.clone(),
+            hint: 0,
+            sigma: 0.0,
+            last_tip: None,
+            last_distance: 0.0,
+            peak: Peak::default(),
+            unmeasured: 0,
+            next_vertex: 0,
+            pending: std::collections::VecDeque::new(),
+        }
+    }
+
+    /// The vertices in `[lo, hi]` against the sample `tip` and the chord from `previous`;
+    /// those left behind `lo` are done.
+    fn vertices(
+        &mut self,
+        (lo, hi): (f64, f64),
+        tip: &Vec3,
+        previous: Option<&Vec3>,
+        seg: &Segment,
+        line: u32,
+    ) {
+        let vs = self.program.vertices();
+        while self.next_vertex < vs.len() && vs[self.next_vertex].0 <= hi {
+            let (sigma, point) = vs[self.next_vertex];
+            self.pending.push_back(Pending {
+                point,
+                sigma,
+                distance: f64::INFINITY,
+                tolerance: seg.tolerance,
+                line,
+            });
+            self.next_vertex += 1;
+        }
+        for v in self.pending.iter_mut() {
+            let d = match previous {
+                Some(p) => point_segment_distance(&v.point, p, tip),
+                None => (v.point - tip).norm(),
+            };
+            if d < v.distance {
+                v.distance = d;
+                v.tolerance = seg.tolerance;
+                v.line = line;
+            }
+        }
+        while self.pending.front().is_some_and(|v| v.sigma < lo) {
+            if let Some(v) = self.pending.pop_front() {
+                self.peak.push(v.distance, v.tolerance, v.line);
+            }
+        }
+    }
+
+    /// A sample standing still off any segment (a dwell, the final row) under `control`:
+    /// the vertices in the window are measured against it.
+    fn rest(&mut self, s: &Sample, control: ToolControl) {
+        if self.last_tip.is_none() {
+            return;
+        }
+        let tip = self.tip(s, control);
+        for v in self.pending.iter_mut() {
+            let d = (v.point - tip).norm();
+            if d < v.distance {
+                v.distance = d;
+                v.line = s.line;
+            }
+        }
+    }
+
+    /// Every vertex still in the window, at the end of the replay.
+    fn finish(&mut self) {
+        for v in self.pending.drain(..) {
+            if v.distance.is_finite() {
+                self.peak.push(v.distance, v.tolerance, v.line);
+            }
+        }
+    }
+
     /// The tip to measure: under TCP the tool tip in the workpiece frame by forward
     /// kinematics of the sample's joints (what the machine holds, not what the interpolator
     /// aimed at); with TCP off the program point, which the program's X Y Z give there.
-    fn tip(&self, s: &Sample, seg: &Segment) -> Vec3 {
-        match seg.control {
+    fn tip(&self, s: &Sample, control: ToolControl) -> Vec3 {
+        match control {
             ToolControl::CentrePoint { tool_length } => self
                 .model
                 .forward(&s.joints, &Tool::with_length(tool_length))
@@ -133,22 +231,36 @@ impl Against {
     /// cursor: `w` covers the step from the last sample and both samples' distances from the
     /// program (the nearest points are at most that far apart) twice over, and the tolerance.
     fn push(&mut self, s: &Sample, seg: &Segment, chord: bool) {
-        let tip = self.tip(s, seg);
+        let tip = self.tip(s, seg.control);
         let step = self.last_tip.map_or(0.0, |p| (tip - p).norm());
         let w = 2.0 * (step + self.last_distance + seg.tolerance);
         let (lo, hi) = (self.sigma - w, self.sigma + w);
+        // With the moves around the cursor's whole: where the program runs ahead of the
+        // samples (a feature the path leaves out) the cursor catches up at once.
+        let (before, after) = self.program.around(self.hint);
+        let (lo, hi) = (lo.min(before), hi.max(after));
+        let n = self
+            .program
+            .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
+        // A take-up at a tool-control switch (a rapid straight in joint space, TCP off, ending
+        // at rest) runs between two readings of the program point and is not the program's:
+        // such a sample off the program at the switch is not measured (one on it, a
+        // programmed G0 after G49, is).
+        let local = (self.sigma - w, self.sigma + w);
         let take_up = seg.control.is_joints()
             && matches!(seg.feed, SegmentFeed::Rapid)
             && matches!(seg.end, Junction::Stop)
-            && self.program.switch_within(lo, hi);
+            && self.program.switch_within(local.0, local.1)
+            && !(self
+                .program
+                .nearest(&tip, local, self.sigma + step, &mut self.hint.clone())
+                .distance
+                <= seg.tolerance);
         if take_up {
             self.unmeasured += 1;
             self.last_tip = None;
             return;
         }
-        let n = self
-            .program
-            .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
         let mut d = n.distance;
         if let (true, Some(p)) = (chord, self.last_tip) {
             let mid = 0.5 * (p + tip);
@@ -161,6 +273,8 @@ impl Against {
         if d.is_finite() {
             self.peak.push(d, seg.tolerance, s.line);
         }
+        let previous = if chord { self.last_tip } else { None };
+        self.vertices((lo, hi), &tip, previous.as_ref(), seg, s.line);
         self.sigma = n.sigma;
         self.last_tip = Some(tip);
         self.last_distance = if n.distance.is_finite() {
@@ -220,16 +334,7 @@ impl Verifier {
     /// Measures the samples against `program` too (the moves the path was built from):
     /// the report's `max_deviation` is then the distance from the program.
     pub fn against(mut self, machine: &PlanMachine, program: ProgramPath) -> Self {
-        self.against = Some(Against {
-            program,
-            model: machine.model.clone(),
-            hint: 0,
-            sigma: 0.0,
-            last_tip: None,
-            last_distance: 0.0,
-            peak: Peak::default(),
-            unmeasured: 0,
-        });
+        self.against = Some(Against::new(machine, program));
         self
     }
 
@@ -280,6 +385,9 @@ impl Verifier {
         let seg = path.last();
         self.slack
             .push(self.period, seg.map(|g| &**g), s.feed, worst, velocity);
+        if let (None, Some(a), Some(c)) = (seg, self.against.as_mut(), self.last_control) {
+            a.rest(s, c);
+        }
         if let Some(seg) = seg {
             // Across a tool-control switch (at rest) the tip is read two ways: no chord there.
             let same_reading = self
@@ -317,6 +425,9 @@ impl Verifier {
         let mut worst: Vec<(u32, f64)> = self.per_line.into_iter().collect();
         worst.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
         worst.truncate(5);
+        if let Some(a) = self.against.as_mut() {
+            a.finish();
+        }
         let (main, unmeasured) = match &self.against {
             Some(a) => (a.peak, a.unmeasured),
             None => (self.smoothed, 0),

@@ -50,6 +50,8 @@ pub struct ProgramPath {
     pieces: Vec<Piece>,
     /// `σ` of the switches between readings (TCP on/off, a new TCP tool length).
     switches: Vec<f64>,
+    /// The moves' end points (and a start where the point is read anew), in order of `σ`.
+    vertices: Vec<(f64, Vec3)>,
 }
 
 impl ProgramPath {
@@ -61,6 +63,7 @@ impl ProgramPath {
         let mut sigma = 0.0;
         let mut pieces = Vec::new();
         let mut switches = Vec::new();
+        let mut vertices: Vec<(f64, Vec3)> = vec![(0.0, Vec3::from(start.xyz()))];
         for m in moves {
             let (geo, length, end) = match &m.kind {
                 &MoveKind::Rapid { end } | &MoveKind::Feed { end } => {
@@ -93,6 +96,11 @@ impl ProgramPath {
                 &MoveKind::ToolControl { control: c, at } => {
                     if !c.same_reading(&control) {
                         switches.push(sigma);
+                        // The machine leaves the old reading's point by a take-up, which is
+                        // not measured: the point is the new reading's from here.
+                        if vertices.last().is_some_and(|v| v.0 == sigma) {
+                            vertices.pop();
+                        }
                     }
                     control = c;
                     pos = at;
@@ -100,6 +108,10 @@ impl ProgramPath {
                 }
                 _ => continue,
             };
+            let from = Vec3::from(pos.xyz());
+            if vertices.last().is_none_or(|v| v.1 != from) {
+                vertices.push((sigma, from));
+            }
             pieces.push(Piece {
                 geo,
                 start: sigma,
@@ -107,13 +119,40 @@ impl ProgramPath {
             });
             sigma += length;
             pos = end;
+            let to = Vec3::from(pos.xyz());
+            if vertices.last().is_none_or(|v| v.1 != to) {
+                vertices.push((sigma, to));
+            }
         }
-        ProgramPath { pieces, switches }
+        ProgramPath {
+            pieces,
+            switches,
+            vertices,
+        }
     }
 
     /// Arc length of the whole program, mm.
     pub fn length(&self) -> f64 {
         self.pieces.last().map_or(0.0, |p| p.start + p.length)
+    }
+
+    /// The programmed vertices (`σ`, point): where one move ends and the next begins.
+    pub fn vertices(&self) -> &[(f64, Vec3)] {
+        &self.vertices
+    }
+
+    /// The arc lengths from the start of the move before piece `i` to the end of the move
+    /// after it: the moves around the current one.
+    pub fn around(&self, i: usize) -> (f64, f64) {
+        let n = self.pieces.len();
+        if n == 0 {
+            return (0.0, 0.0);
+        }
+        let (a, b) = (i.saturating_sub(1).min(n - 1), (i + 1).min(n - 1));
+        (
+            self.pieces[a].start,
+            self.pieces[b].start + self.pieces[b].length,
+        )
     }
 
     /// Whether a switch between readings of the program point lies in `[lo, hi]`.
@@ -191,8 +230,25 @@ impl Piece {
                 (d, u * self.length)
             }
             Geo::Nurbs { curve, table } => {
+                // Span by span: over a whole neighbour, samples spread over the domain can
+                // start the refinement in the wrong basin.
                 let (u0, u1) = (param_at(table, s0), param_at(table, s1));
-                let c = closest_point(curve.as_ref(), q, u0, u1, 8);
+                let mut cuts = vec![u0];
+                cuts.extend(
+                    curve
+                        .breakpoints()
+                        .into_iter()
+                        .filter(|&b| b > u0 && b < u1),
+                );
+                cuts.push(u1);
+                let c = cuts
+                    .windows(2)
+                    .map(|w| closest_point(curve.as_ref(), q, w[0], w[1], 8))
+                    .min_by(|a, b| a.distance.total_cmp(&b.distance))
+                    .unwrap_or(tezgah_geom::deviation::Deviation {
+                        distance: (curve.point(u0) - q).norm(),
+                        u: u0,
+                    });
                 (c.distance, length_at(table, c.u))
             }
         }
