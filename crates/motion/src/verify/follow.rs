@@ -145,7 +145,7 @@ mod tests {
     use super::*;
     use tezgah_geom::Arc as Circle;
 
-    /// On a circle of radius 10 the closest point of any point off the axis is radial: Newton
+    /// On a 6 rad arc of radius 10 the closest point of any point off the axis over it is radial: Newton
     /// from a guess a little off finds it, and a bracket that excludes it gives the nearer end.
     #[test]
     fn newton_on_a_circle() {
@@ -153,7 +153,7 @@ mod tests {
             Vec3::zeros(),
             Vec3::new(10.0, 0.0, 0.0),
             Vec3::z(),
-            1.0,
+            6.0,
             0.0,
         )
         .unwrap();

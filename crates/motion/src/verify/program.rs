@@ -376,9 +376,9 @@ mod tests {
         let q = Vec3::new(9.8, 3.0, 0.0);
         let n = p.nearest(&q, (5.0, 20.0), 10.0, &mut h);
         assert!((n.distance - 0.2).abs() < 1e-12 && (n.sigma - 13.0).abs() < 1e-12);
-        // Only the first leg: the distance to its end.
+        // Only the first leg up to σ = 9: the distance to (9, 0).
         let n = p.nearest(&q, (0.0, 9.0), 5.0, &mut h);
-        assert!((n.distance - (1.0f64 + 9.0).sqrt()).abs() < 1e-12, "{n:?}");
+        assert!((n.distance - (0.64f64 + 9.0).sqrt()).abs() < 1e-12, "{n:?}");
     }
 
     /// A full circle of radius 5: the closed form gives the radial distance and the angle,
