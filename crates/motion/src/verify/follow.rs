@@ -1,7 +1,7 @@
-//! Following the smoothed path sample by sample: a sample lies on its own segment just past
-//! the previous one, so its parameter is found by a few safeguarded Newton steps from there
-//! (never a search over the whole segment), and the chord between two samples is measured
-//! against the part of the path between their two parameters.
+//! Following the smoothed path sample by sample: the midpoint of the chord between two samples
+//! lies next to the path just past the previous midpoint, so its closest point is found by a
+//! few safeguarded Newton steps from there, on the segments passed between the two samples
+//! (never a search over a whole segment).
 
 use std::sync::Arc;
 
@@ -13,105 +13,94 @@ use crate::path::Segment;
 /// Newton steps before falling back to a bracketed search.
 const NEWTON_STEPS: usize = 8;
 
-/// A step this small (mm along the curve) ends Newton's iteration.
-const CONVERGED_MM: f64 = 1e-13;
+/// A Newton step this small (mm along the curve) ends the iteration: the distance, stationary
+/// there, is then off by about `|C′|²·step²`, far below a nanometre.
+const CONVERGED_MM: f64 = 1e-9;
 
-/// The cursor: the last sample's segment and parameter on it.
-#[derive(Default)]
-pub(crate) struct Follow {
-    last: Option<(Arc<Segment>, f64)>,
+/// Where the last chord's midpoint fell on the last sample's segment: a lower bound for the
+/// next chord's, and the curve's speed there for the next first guess.
+struct Last {
+    seg: Arc<Segment>,
+    u: f64,
+    speed: f64,
 }
 
-/// Distances (mm) of one sample from the smoothed path.
-pub(crate) struct Measured {
-    /// The sample's tip from its own segment.
-    pub tip: f64,
-    /// The midpoint of the chord from the previous sample from the path between the two.
-    pub chord: Option<f64>,
+/// The cursor on the smoothed path.
+#[derive(Default)]
+pub(crate) struct Follow {
+    last: Option<Last>,
 }
 
 impl Follow {
-    /// Measures the sample at `tip` on `path` (the segments passed since the previous
-    /// sample, ending with its own: not empty); `chord` asks for the chord from `previous`.
+    /// The distance (mm) of the midpoint of the chord from `previous` to `tip` from the path
+    /// between the two samples: `path` is the segments passed since the previous sample,
+    /// ending with the sample's own (none while standing still: `None`). The tip itself lies
+    /// on its segment by construction (the interpolator's point of the curve). `chord: false`
+    /// (across a tool-control switch) only moves the cursor.
     pub(crate) fn push(
         &mut self,
         tip: &Vec3,
         previous: Option<&Vec3>,
         path: &[Arc<Segment>],
         chord: bool,
-    ) -> Measured {
-        let Some(seg) = path.last() else {
-            return Measured {
-                tip: 0.0,
-                chord: None,
-            };
-        };
-        let (a, b) = seg.curve.domain();
-        let same = self.last.as_ref().filter(|(s, _)| Arc::ptr_eq(s, seg));
-        let (lo, guess) = match (same, previous) {
-            (Some((_, u)), Some(p)) => (*u, advance(&*seg.curve, *u, (tip - p).norm(), b)),
-            (Some((_, u)), None) => (*u, *u),
-            (None, _) => {
-                let d = (tip - seg.curve.point(a)).norm();
-                (a, advance(&*seg.curve, a, d, b))
-            }
-        };
-        let (d_tip, u) = if seg.rotary_only() {
-            ((seg.curve.point(a) - tip).norm(), a)
-        } else {
-            local(&*seg.curve, tip, lo, b, guess)
+    ) -> Option<f64> {
+        let seg = path.last()?;
+        let (a, _) = seg.curve.domain();
+        let mut next = match self.last.as_ref() {
+            Some(l) if Arc::ptr_eq(&l.seg, seg) => (l.u, l.speed),
+            _ => (a, seg.curve.speed(a)),
         };
         let mut d_chord = None;
-        if let (true, Some(p), Some((pseg, pu))) = (chord, previous, self.last.as_ref()) {
+        if let (true, Some(p), Some(last)) = (chord, previous, self.last.as_ref()) {
             let mid = 0.5 * (p + tip);
-            let n = path.len();
+            let half = 0.5 * (tip - p).norm();
             let mut best = f64::INFINITY;
-            for (k, s) in path.iter().enumerate() {
+            let mut measure = |s: &Arc<Segment>| {
                 let (sa, sb) = s.curve.domain();
-                let lo = if Arc::ptr_eq(s, pseg) { *pu } else { sa };
-                let hi = if k + 1 == n { u } else { sb };
-                best = best.min(part(s, &mid, lo, hi));
+                if s.rotary_only() {
+                    return (s.curve.point(sa) - mid).norm();
+                }
+                let (lo, start) = if Arc::ptr_eq(s, &last.seg) {
+                    let step = if last.speed > 0.0 {
+                        half / last.speed
+                    } else {
+                        0.0
+                    };
+                    (last.u, last.u + step)
+                } else {
+                    (sa, sa)
+                };
+                let (d, u, speed) = local(&*s.curve, &mid, lo, sb, start);
+                if Arc::ptr_eq(s, seg) {
+                    next = (u, speed);
+                }
+                d
+            };
+            for s in path {
+                best = best.min(measure(s));
             }
             // After a dwell the previous sample's segment is no longer in `path`.
-            if !path.iter().any(|s| Arc::ptr_eq(s, pseg)) {
-                best = best.min(part(pseg, &mid, *pu, pseg.curve.domain().1));
+            if !path.iter().any(|s| Arc::ptr_eq(s, &last.seg)) {
+                best = best.min(measure(&last.seg.clone()));
             }
             d_chord = Some(best);
         }
-        self.last = Some((seg.clone(), u));
-        Measured {
-            tip: d_tip,
-            chord: d_chord,
-        }
+        self.last = Some(Last {
+            seg: seg.clone(),
+            u: next.0,
+            speed: next.1,
+        });
+        d_chord
     }
 }
 
-/// The parameter `distance` mm on from `u` at the curve's speed there (a first guess).
-fn advance(c: &dyn Curve, u: f64, distance: f64, hi: f64) -> f64 {
-    let v = c.speed(u);
-    if v > 0.0 {
-        (u + distance / v).min(hi)
-    } else {
-        u
-    }
-}
-
-/// Distance from `q` to the part `[lo, hi]` of a segment (its start point if rotary-only).
-fn part(s: &Segment, q: &Vec3, lo: f64, hi: f64) -> f64 {
-    if s.rotary_only() {
-        return (s.curve.point(s.curve.domain().0) - q).norm();
-    }
-    let (lo, hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
-    local(&*s.curve, q, lo, hi, 0.5 * (lo + hi)).0
-}
-
-/// Closest point of `c` on `[lo, hi]` to `q` (distance, parameter), from `u`: Newton on
-/// `g(u) = (C(u) − q)·C′(u) = 0`, each step clamped to the bracket, and the bracket's ends;
-/// where Newton stalls (`g′ ≤ 0`, a point beyond the centre of curvature) or does not
-/// converge, geom's sampled golden-section search over the bracket.
-pub(crate) fn local(c: &dyn Curve, q: &Vec3, lo: f64, hi: f64, mut u: f64) -> (f64, f64) {
+/// Closest point of `c` on `[lo, hi]` to `q` (distance, parameter, the curve's speed there),
+/// from `u`: Newton on `g(u) = (C(u) − q)·C′(u) = 0`, each step clamped to the bracket; where
+/// Newton stalls (`g′ ≤ 0`, a point beyond the centre of curvature) or does not converge,
+/// geom's sampled golden-section search over the bracket.
+pub(crate) fn local(c: &dyn Curve, q: &Vec3, lo: f64, hi: f64, mut u: f64) -> (f64, f64, f64) {
     if hi <= lo {
-        return ((c.point(lo) - q).norm(), lo);
+        return ((c.point(lo) - q).norm(), lo, c.speed(lo));
     }
     u = u.clamp(lo, hi);
     for _ in 0..NEWTON_STEPS {
@@ -123,21 +112,14 @@ pub(crate) fn local(c: &dyn Curve, q: &Vec3, lo: f64, hi: f64, mut u: f64) -> (f
             break;
         }
         let next = (u - g / h).clamp(lo, hi);
-        let step = (next - u).abs() * d1.norm();
-        u = next;
-        if step <= CONVERGED_MM {
-            let mut best = ((c.point(u) - q).norm(), u);
-            for e in [lo, hi] {
-                let d = (c.point(e) - q).norm();
-                if d < best.0 {
-                    best = (d, e);
-                }
-            }
-            return best;
+        let speed = d1.norm();
+        if (next - u).abs() * speed <= CONVERGED_MM {
+            return (r.norm(), next, speed);
         }
+        u = next;
     }
     let d = closest_point(c, q, lo, hi, 4);
-    (d.distance, d.u)
+    (d.distance, d.u, c.speed(d.u))
 }
 
 #[cfg(test)]
@@ -161,12 +143,12 @@ mod tests {
         for k in 1..20 {
             let t = k as f64 * 0.3;
             let q = Vec3::new(12.0 * t.cos(), 12.0 * t.sin(), 1.0);
-            let (d, u) = local(&c, &q, 0.0, 1.0, t / sweep + 0.02);
+            let (d, u, _) = local(&c, &q, 0.0, 1.0, t / sweep + 0.02);
             assert!((d - 5f64.sqrt()).abs() < 1e-12, "{d}");
             assert!((u * sweep - t).abs() < 1e-9, "{u}");
         }
         let q = Vec3::new(0.0, 12.0, 0.0);
-        let (d, u) = local(&c, &q, 0.0, 0.1, 0.05);
+        let (d, u, _) = local(&c, &q, 0.0, 0.1, 0.05);
         let end = c.point(0.1);
         assert!((d - (end - q).norm()).abs() < 1e-12 && u == 0.1);
     }

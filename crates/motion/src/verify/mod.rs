@@ -301,6 +301,7 @@ pub struct Verifier {
     against: Option<Against>,
     slack: Slack,
     per_line: HashMap<u32, f64>,
+    line_worst: Option<(u32, f64)>,
 }
 
 impl Verifier {
@@ -328,6 +329,7 @@ impl Verifier {
             against: None,
             slack: Slack::default(),
             per_line: HashMap::new(),
+            line_worst: None,
         }
     }
 
@@ -371,8 +373,17 @@ impl Verifier {
             worst = worst.max(a / p.max_acceleration).max(j / p.max_jerk);
         }
         worst = worst.max(worst_v);
-        let e = self.per_line.entry(line).or_insert(0.0);
-        *e = e.max(worst);
+        // The worst of the current line is kept aside and filed when the line changes.
+        match &mut self.line_worst {
+            Some((l, w)) if *l == line => *w = w.max(worst),
+            other => {
+                if let Some((l, w)) = other.take() {
+                    let e = self.per_line.entry(l).or_insert(0.0);
+                    *e = e.max(w);
+                }
+                *other = Some((line, worst));
+            }
+        }
         self.history.remove(0);
         self.history.push(q);
         (worst, worst_v)
@@ -398,11 +409,12 @@ impl Verifier {
             // samples — every segment passed, not only the two ends: at speed, short segments
             // and blends are entered and left within one period and the chord runs past them.
             let previous = self.last.as_ref().map(|p| p.tip);
-            let m = self
+            if let Some(d) = self
                 .follow
-                .push(&s.tip, previous.as_ref(), path, same_reading);
-            let d = m.tip.max(m.chord.unwrap_or(0.0));
-            self.smoothed.push(d, seg.tolerance, s.line);
+                .push(&s.tip, previous.as_ref(), path, same_reading)
+            {
+                self.smoothed.push(d, seg.tolerance, s.line);
+            }
             if let Some(a) = self.against.as_mut() {
                 if !same_reading {
                     a.last_tip = None;
@@ -421,6 +433,10 @@ impl Verifier {
             for _ in 0..3 {
                 self.differences(s.joints, s.line);
             }
+        }
+        if let Some((l, w)) = self.line_worst.take() {
+            let e = self.per_line.entry(l).or_insert(0.0);
+            *e = e.max(w);
         }
         let mut worst: Vec<(u32, f64)> = self.per_line.into_iter().collect();
         worst.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
