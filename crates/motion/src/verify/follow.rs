@@ -13,9 +13,10 @@ use crate::path::Segment;
 /// Newton steps before falling back to a bracketed search.
 const NEWTON_STEPS: usize = 8;
 
-/// A Newton step this small (mm along the curve) ends the iteration: the distance, stationary
-/// there, is then off by about `|C′|²·step²`, far below a nanometre.
-const CONVERGED_MM: f64 = 1e-9;
+/// A Newton step this small (mm along the curve) ends the iteration: its point is taken from
+/// the Taylor expansion `C + C′·Δu + C″·Δu²/2` already at hand, off by `|C‴|·Δu³/6`, about
+/// 1e-18 mm, and the step leaves a residual of order `κ·step²` to the foot of the normal.
+const CONVERGED_MM: f64 = 1e-6;
 
 /// Where the last chord's midpoint fell on the last sample's segment: a lower bound for the
 /// next chord's, and the curve's speed there for the next first guess.
@@ -113,8 +114,10 @@ pub(crate) fn local(c: &dyn Curve, q: &Vec3, lo: f64, hi: f64, mut u: f64) -> (f
         }
         let next = (u - g / h).clamp(lo, hi);
         let speed = d1.norm();
-        if (next - u).abs() * speed <= CONVERGED_MM {
-            return (r.norm(), next, speed);
+        let du = next - u;
+        if du.abs() * speed <= CONVERGED_MM {
+            let at = r + d1 * du + d2 * (0.5 * du * du);
+            return (at.norm(), next, speed);
         }
         u = next;
     }

@@ -288,7 +288,8 @@ impl Against {
 /// The streaming replay.
 pub struct Verifier {
     period: f64,
-    history: Vec<Joints>,
+    /// The last three samples' joints, oldest first.
+    history: Option<[Joints; 3]>,
     peaks: Vec<JointPeaks>,
     samples: u64,
     last: Option<Sample>,
@@ -318,7 +319,7 @@ impl Verifier {
             .collect();
         Verifier {
             period,
-            history: Vec::with_capacity(4),
+            history: None,
             peaks,
             samples: 0,
             last: None,
@@ -343,13 +344,8 @@ impl Verifier {
     /// Takes the sample's finite differences; returns the worst peak/limit ratio over every
     /// joint and v, a, j, and the largest velocity ratio.
     fn differences(&mut self, q: Joints, line: u32) -> (f64, f64) {
-        if self.history.is_empty() {
-            // At rest before the first sample.
-            self.history = vec![q; 3];
-        }
-        let h = &self.history;
-        let n = h.len();
-        let (q1, q2, q3) = (h[n - 1], h[n - 2], h[n - 3]);
+        // At rest before the first sample.
+        let [q3, q2, q1] = *self.history.get_or_insert([q; 3]);
         let ts = self.period;
         let mut worst: f64 = 0.0;
         let mut worst_v: f64 = 0.0;
@@ -384,8 +380,7 @@ impl Verifier {
                 *other = Some((line, worst));
             }
         }
-        self.history.remove(0);
-        self.history.push(q);
+        self.history = Some([q2, q1, q]);
         (worst, worst_v)
     }
 
