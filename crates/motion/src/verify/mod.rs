@@ -251,11 +251,12 @@ impl Against {
             && matches!(seg.feed, SegmentFeed::Rapid)
             && matches!(seg.end, Junction::Stop)
             && self.program.switch_within(local.0, local.1)
-            && !(self
+            && self
                 .program
                 .nearest(&tip, local, self.sigma + step, &mut self.hint.clone())
                 .distance
-                <= seg.tolerance);
+                .partial_cmp(&seg.tolerance)
+                .is_none_or(|o| o == std::cmp::Ordering::Greater);
         if take_up {
             self.unmeasured += 1;
             self.last_tip = None;

@@ -8,6 +8,8 @@ use std::sync::Arc as Shared;
 use tezgah_geom::deviation::closest_point;
 use tezgah_geom::{Arc, Curve, Move, MoveKind, Nurbs, Pose, ToolControl, Vec3};
 
+use crate::path::deviation::arc_nearest;
+
 /// Table steps per NURBS knot span for the `σ ↔ u` table (Gauss-Legendre per step).
 const NURBS_STEPS_PER_SPAN: usize = 8;
 
@@ -219,7 +221,7 @@ impl Piece {
             }
             Geo::Arc(a) => {
                 let (u0, u1) = (s0 / self.length, s1 / self.length);
-                let (d, u) = plane_arc_nearest(a, q, u0, u1).unwrap_or_else(|| {
+                let (d, u) = arc_nearest(a, q, u0, u1).unwrap_or_else(|| {
                     // Helices and spirals: no closed form; a sample per 22.5° of the part
                     // starts the refinement in the right basin.
                     let turns = a.sweep().abs() * (u1 - u0);
@@ -252,51 +254,6 @@ impl Piece {
                 (c.distance, length_at(table, c.u))
             }
         }
-    }
-}
-
-/// Distance from `q` to the part `u ∈ [u0, u1]` of a plane arc of constant radius and the
-/// parameter where it is reached, in closed form: `q`'s own angle if the part holds it
-/// (on a part of more than a turn, the turn nearest the part's middle), else the nearer end.
-/// `None` for helices and spirals.
-fn plane_arc_nearest(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<(f64, f64)> {
-    use std::f64::consts::TAU;
-    if a.rise() != 0.0 || (a.radius() - a.end_radius()).abs() > 1e-12 * a.radius() {
-        return None;
-    }
-    let (c, n, r, sweep) = (a.center(), a.normal(), a.radius(), a.sweep().abs());
-    let e1 = (a.point(0.0) - c) / r;
-    let e2 = n.cross(&e1);
-    let d = q - c;
-    let (x, y, h) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
-    let rho = x.hypot(y);
-    let ends = || {
-        let (p0, p1) = ((a.point(u0) - q).norm(), (a.point(u1) - q).norm());
-        if p0 <= p1 {
-            (p0, u0)
-        } else {
-            (p1, u1)
-        }
-    };
-    if rho == 0.0 || sweep == 0.0 {
-        // On the axis every point of the arc is as near.
-        return Some((r.hypot(h), 0.5 * (u0 + u1)));
-    }
-    // The angle of q in the arc's own sense, in [0, 2π).
-    let theta = (y.atan2(x) * a.sweep().signum()).rem_euclid(TAU);
-    let (t0, t1) = (sweep * u0, sweep * u1);
-    let mid = 0.5 * (t0 + t1);
-    let k = ((mid - theta) / TAU).round();
-    let mut t = theta + k * TAU;
-    if t < t0 {
-        t += TAU;
-    } else if t > t1 {
-        t -= TAU;
-    }
-    if (t0..=t1).contains(&t) {
-        Some(((rho - r).hypot(h), t / sweep))
-    } else {
-        Some(ends())
     }
 }
 
