@@ -226,7 +226,7 @@ impl Piece {
                     // starts the refinement in the right basin.
                     let turns = a.sweep().abs() * (u1 - u0);
                     let n = (turns / (std::f64::consts::PI / 8.0)).ceil() as usize;
-                    let c = closest_point(a, q, u0, u1, n.clamp(4, 64));
+                    let c = closest_point(a, q, u0, u1, n.clamp(4, 256));
                     (c.distance, c.u)
                 });
                 (d, u * self.length)
@@ -354,6 +354,37 @@ mod tests {
         let (q, mut h) = (Vec3::zeros(), 0);
         assert_eq!(p.nearest(&q, (0.0, 4.0), 3.9, &mut h).sigma, 4.0);
         assert_eq!(p.nearest(&q, (0.0, 4.0), 0.1, &mut h).sigma, 0.0);
+    }
+
+    /// A helix of three turns (radius 5, 2 mm a turn): a point 0.3 mm outside the second turn
+    /// is 0.3 mm from the whole move, but from the first turn alone at least the pitch less
+    /// that away — the window keeps the other turns out.
+    #[test]
+    fn a_helix_is_measured_within_the_window() {
+        let helix = Move {
+            line: 2,
+            kind: MoveKind::Arc(ArcMove {
+                plane: Plane::XY,
+                end: Pose([5.0, 0.0, -6.0, 0.0, 0.0, 0.0]),
+                center: [0.0, 0.0],
+                turn: 3,
+            }),
+        };
+        let p = ProgramPath::new(Pose::ZERO, ToolControl::OFF, &[feed(1, 5.0, 0.0), helix]);
+        let turn = (std::f64::consts::TAU * 5.0).hypot(2.0);
+        assert!(
+            (p.length() - 5.0 - 3.0 * turn).abs() < 1e-9,
+            "{}",
+            p.length()
+        );
+        // Half way round the second turn: (-5, 0, -3), pushed out to radius 5.3.
+        let q = Vec3::new(-5.3, 0.0, -3.0);
+        let mut h = 0;
+        let n = p.nearest(&q, (5.0, p.length()), 5.0 + 1.5 * turn, &mut h);
+        assert!((n.distance - 0.3).abs() < 1e-9, "{n:?}");
+        assert!((n.sigma - (5.0 + 1.5 * turn)).abs() < 1e-6, "{n:?}");
+        let n = p.nearest(&q, (5.0, 5.0 + turn), 5.0, &mut h);
+        assert!(n.distance > 2.0 - 0.3, "{n:?}");
     }
 
     #[test]
