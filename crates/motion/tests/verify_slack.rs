@@ -18,7 +18,9 @@ use tezgah_motion::{Junction, Segment, SegmentFeed};
 const TS: f64 = 0.001;
 
 /// A jerk-limited ramp from rest to `f` at constant jerk `j` (no constant-acceleration
-/// phase): duration `T = 2√(f/j)`, position and speed at `t`.
+/// phase: the double-S velocity profile of Biagiotti & Melchiorri, *Trajectory Planning for
+/// Automatic Machines and Robots*, 2008, §3.4, with `a_max` not reached): duration
+/// `T = 2√(f/j)`, position and speed at `t`.
 struct Ramp {
     f: f64,
     j: f64,

@@ -96,7 +96,8 @@ impl Follow {
 }
 
 /// Closest point of `c` on `[lo, hi]` to `q` (distance, parameter, the curve's speed there),
-/// from `u`: Newton on `g(u) = (C(u) − q)·C′(u) = 0`, each step clamped to the bracket; where
+/// from `u`: Newton on `g(u) = (C(u) − q)·C′(u) = 0` (point inversion, Piegl & Tiller, *The
+/// NURBS Book*, 2nd ed., §6.1, eq. 6.3), each step clamped to the bracket; where
 /// Newton stalls (`g′ ≤ 0`, a point beyond the centre of curvature) or does not converge,
 /// geom's sampled golden-section search over the bracket.
 pub(crate) fn local(c: &dyn Curve, q: &Vec3, lo: f64, hi: f64, mut u: f64) -> (f64, f64, f64) {
