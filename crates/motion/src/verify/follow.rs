@@ -131,8 +131,9 @@ mod tests {
     use super::*;
     use tezgah_geom::Arc as Circle;
 
-    /// On a 6 rad arc of radius 10 the closest point of any point off the axis over it is radial: Newton
-    /// from a guess a little off finds it, and a bracket that excludes it gives the nearer end.
+    /// On a 6 rad arc of radius 10 the closest point of a point off the axis, at an angle the
+    /// arc holds, is radial: Newton from a guess a little off finds it, and a bracket that
+    /// excludes it gives the nearer end.
     #[test]
     fn newton_on_a_circle() {
         let c = Circle::new(
