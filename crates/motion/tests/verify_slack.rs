@@ -142,6 +142,28 @@ fn slack_is_the_ramps_when_no_joint_is_near_a_limit() {
     );
 }
 
+/// The same samples under G93: the segment's nominal speed is its length over its time, here
+/// chosen 50 mm/s, so the slack and the histogram are those of the feed's.
+#[test]
+fn inverse_time_is_measured_against_length_over_time() {
+    let ramp = Ramp {
+        f: 50.0,
+        j: 25_000.0,
+    };
+    let (by_feed, _) = synthetic(&ramp, 1.0, SegmentFeed::Feed(50.0));
+    let length = ramp.f * (ramp.duration() + 1.0);
+    let (by_time, _) = synthetic(&ramp, 1.0, SegmentFeed::InverseTime(length / 50.0));
+    assert_eq!(by_feed.slack, by_time.slack);
+    // At half the feed in time, the cruise falls in [0.5, 0.6).
+    let (slow, n) = synthetic(&ramp, 1.0, SegmentFeed::InverseTime(length / 100.0));
+    assert!((slow.slack.slack - n as f64 * TS).abs() < 1e-12);
+    assert!(
+        slow.slack.histogram[5] >= 1.0 - 1e-9,
+        "{:?}",
+        slow.slack.histogram
+    );
+}
+
 /// The same samples as a rapid: the nominal speed is where the first joint reaches its
 /// velocity limit (200 mm/s for X), so the cruise at 50 mm/s is at a quarter of it, and with
 /// no joint near a limit the whole cycle is slack.
