@@ -239,9 +239,27 @@ impl Against {
         // samples (a feature the path leaves out) the cursor catches up at once.
         let (before, after) = self.program.around(self.hint);
         let (lo, hi) = (lo.min(before), hi.max(after));
-        let n = self
-            .program
-            .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
+        // The tip and the chord's midpoint, in one pass over the window.
+        let mid = match (chord, self.last_tip) {
+            (true, Some(p)) => Some(0.5 * (p + tip)),
+            _ => None,
+        };
+        let (n, m) = match &mid {
+            Some(mid) => {
+                let [n, m] = self.program.nearest_all(
+                    [(&tip, self.sigma + step), (mid, self.sigma + 0.5 * step)],
+                    (lo, hi),
+                    &mut self.hint,
+                );
+                (n, Some(m))
+            }
+            None => {
+                let n = self
+                    .program
+                    .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
+                (n, None)
+            }
+        };
         // A take-up at a tool-control switch (a rapid straight in joint space, TCP off, ending
         // at rest) runs between two readings of the program point and is not the program's:
         // such a sample off the program at the switch is not measured (one on it, a
@@ -262,15 +280,7 @@ impl Against {
             self.last_tip = None;
             return;
         }
-        let mut d = n.distance;
-        if let (true, Some(p)) = (chord, self.last_tip) {
-            let mid = 0.5 * (p + tip);
-            let expected = self.sigma + 0.5 * step;
-            let m = self
-                .program
-                .nearest(&mid, (lo, hi), expected, &mut self.hint.clone());
-            d = d.max(m.distance);
-        }
+        let d = m.map_or(n.distance, |m| n.distance.max(m.distance));
         if d.is_finite() {
             self.peak.push(d, seg.tolerance, s.line);
         }

@@ -170,14 +170,26 @@ impl ProgramPath {
     pub fn nearest(
         &self,
         q: &Vec3,
-        (lo, hi): (f64, f64),
+        window: (f64, f64),
         expected: f64,
         hint: &mut usize,
     ) -> Nearest {
-        let mut best = Nearest {
+        let [n] = self.nearest_all([(q, expected)], window, hint);
+        n
+    }
+
+    /// [`ProgramPath::nearest`] for several points over one window in one pass over its
+    /// pieces (a sample's tip and its chord's midpoint); `hint` follows the first point.
+    pub fn nearest_all<const N: usize>(
+        &self,
+        queries: [(&Vec3, f64); N],
+        (lo, hi): (f64, f64),
+        hint: &mut usize,
+    ) -> [Nearest; N] {
+        let mut best = [Nearest {
             distance: f64::INFINITY,
             sigma: lo.max(0.0),
-        };
+        }; N];
         if self.pieces.is_empty() {
             return best;
         }
@@ -193,16 +205,21 @@ impl ProgramPath {
             let p = &self.pieces[i];
             let s0 = (lo - p.start).clamp(0.0, p.length);
             let s1 = (hi - p.start).clamp(0.0, p.length);
-            let (d, s) = p.nearest(q, s0, s1);
-            let sigma = p.start + s;
-            let tie = (d - best.distance).abs() <= TIE_MM
-                && (sigma - expected).abs() < (best.sigma - expected).abs();
-            if d < best.distance - TIE_MM || tie {
-                best = Nearest {
-                    distance: d.min(best.distance),
-                    sigma,
-                };
-                best_i = i;
+            for (k, (q, expected)) in queries.iter().enumerate() {
+                let (d, s) = p.nearest(q, s0, s1);
+                let sigma = p.start + s;
+                let b = &mut best[k];
+                let tie = (d - b.distance).abs() <= TIE_MM
+                    && (sigma - expected).abs() < (b.sigma - expected).abs();
+                if d < b.distance - TIE_MM || tie {
+                    *b = Nearest {
+                        distance: d.min(b.distance),
+                        sigma,
+                    };
+                    if k == 0 {
+                        best_i = i;
+                    }
+                }
             }
             i += 1;
         }
