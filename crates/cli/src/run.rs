@@ -13,6 +13,8 @@ use tezgah_motion::interpolate::{run as run_items, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::tool_pose::SampleTool;
+use tezgah_motion::verify::program::ProgramPath;
+use tezgah_motion::verify::slack::{BINS, NEAR_LIMIT};
 use tezgah_motion::verify::{Report, Verifier};
 
 use crate::diagnostics::report_line;
@@ -210,6 +212,11 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
+    // The program as the interpreter emitted it, which `verify` measures the samples against.
+    let initial = PlanMachine::from_machine(&machine)
+        .map_err(|e| miette!("{e}"))?
+        .initial;
+    let program = ProgramPath::new(Pose::ZERO, initial, &done.moves);
     let BuiltPath {
         items,
         pm,
@@ -253,7 +260,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let scales: Vec<f64> = (0..machine.joints.len())
         .map(|i| unit(&machine, i).1)
         .collect();
-    let mut verifier = Verifier::new(&pm, period);
+    let mut verifier = Verifier::new(&pm, period).against(&pm, program);
     let mut tracker = match args.drive {
         DriveKind::Ideal => None,
         DriveKind::Servo => {
@@ -380,7 +387,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         tracking_summary(&machine, t);
     }
     let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
-        || report.max_deviation > tolerance
+        || report.deviation_ratio > 1.0
         || tracking.as_ref().is_some_and(|t| t.fault.is_some());
     Ok(if over {
         std::process::ExitCode::FAILURE
@@ -494,10 +501,42 @@ fn report_json(
         "samples": r.samples,
         "max_deviation_mm": r.max_deviation,
         "max_deviation_line": r.max_deviation_line,
+        "max_deviation_over_tolerance": r.deviation_ratio,
+        "max_deviation_over_tolerance_line": r.deviation_ratio_line,
+        "max_deviation_smoothed_mm": r.max_deviation_smoothed,
+        "max_deviation_smoothed_line": r.max_deviation_smoothed_line,
+        "unmeasured_samples": r.unmeasured,
+        "slack": slack_json(r),
         "axis_tolerance_deg": axis.tolerance_deg,
         "max_axis_deviation_deg": axis.deviation_deg,
         "joints": joints,
         "worst_lines": r.worst_lines.iter().map(|(l, x)| serde_json::json!({"line": l, "peak_over_limit": x})).collect::<Vec<_>>(),
+    })
+}
+
+/// The report's `slack` section: seconds, and the histogram by tenths of the nominal speed.
+fn slack_json(r: &Report) -> serde_json::Value {
+    let s = &r.slack;
+    let bins: Vec<serde_json::Value> = s
+        .histogram
+        .iter()
+        .enumerate()
+        .map(|(i, t)| {
+            let to = if i + 1 == BINS {
+                serde_json::Value::Null
+            } else {
+                serde_json::json!((i + 1) as f64 / 10.0)
+            };
+            serde_json::json!({ "from": i as f64 / 10.0, "to": to, "time_s": t })
+        })
+        .collect();
+    serde_json::json!({
+        "near_limit": NEAR_LIMIT,
+        "slack_s": s.slack,
+        "slack_share": s.share(r.cycle_time),
+        "moving_s": s.moving,
+        "dwell_s": s.dwell,
+        "feed_fraction": bins,
     })
 }
 
@@ -535,10 +574,27 @@ fn summary(
         );
     }
     println!(
-        "max deviation {:.2e} mm (line {}), within tolerance: {}",
+        "max deviation from the program {:.2e} mm (line {}), from the smoothed path {:.2e} mm, \
+         within tolerance: {}",
         r.max_deviation,
         r.max_deviation_line,
-        r.max_deviation <= tolerance
+        r.max_deviation_smoothed,
+        r.deviation_ratio <= 1.0
+    );
+    let s = &r.slack;
+    let share = |t: f64| {
+        if s.moving > 0.0 {
+            100.0 * t / s.moving
+        } else {
+            0.0
+        }
+    };
+    println!(
+        "slack {:.1} % of the cycle (below the feed, no joint within {:.0} % of a limit); \
+         time at the feed {:.1} %",
+        100.0 * s.share(r.cycle_time),
+        100.0 * NEAR_LIMIT,
+        share(s.histogram[BINS - 1]),
     );
     if axis.deviation_deg > 0.0 {
         println!(

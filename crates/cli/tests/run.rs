@@ -464,3 +464,48 @@ fn samples_tip_is_the_program_tip_under_tcp_and_the_tool_tip_under_g43() {
         "mill3 end",
     );
 }
+
+/// The report measures against the program: square corners under `G64 P0.5` are blended up to
+/// 0.4 × 0.5 mm away from them, which `max_deviation_mm` shows (within the 0.5 mm in force:
+/// success) while the smoothed-path figure is the chord error alone; the slack section's
+/// histogram accounts for every moving second, and a straight G1 far below every limit is at
+/// the feed but for its two ramps (2·2√(F/J) = 56.6 ms at F600 on mill3, ± 2 samples).
+#[test]
+fn the_report_measures_against_the_program_and_gives_the_slack() {
+    let (prog, json) = (tmp("p05.ngc"), tmp("p05.json"));
+    std::fs::write(
+        &prog,
+        "G21 G90 G17\nG64 P0.5\nG1 F3000 X20\nY20\nX0\nY40\nX20\nG61.1\nG1 F600 X170\nM2\n",
+    )
+    .unwrap();
+    let out = tezgah()
+        .args(["run"])
+        .arg(&prog)
+        .arg("--report")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let r = succeeded_with_report(&out, &json);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("slack"), "{stdout}");
+    let d = r["max_deviation_mm"].as_f64().unwrap();
+    assert!((0.15..=0.3).contains(&d), "{d}");
+    let over = r["max_deviation_over_tolerance"].as_f64().unwrap();
+    assert!((d / 0.5 - over).abs() < 1e-12 && over <= 1.0, "{over}");
+    let smoothed = r["max_deviation_smoothed_mm"].as_f64().unwrap();
+    assert!(smoothed <= 0.2 * 0.5 && smoothed < d / 10.0, "{smoothed}");
+    let slack = &r["slack"];
+    let bins: Vec<f64> = slack["feed_fraction"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b["time_s"].as_f64().unwrap())
+        .collect();
+    assert_eq!(bins.len(), 11);
+    let moving = slack["moving_s"].as_f64().unwrap();
+    assert!((bins.iter().sum::<f64>() - moving).abs() < 1e-6, "{bins:?}");
+    let share = slack["slack_share"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&share), "{share}");
+    // The last move alone: 150 mm at 10 mm/s, 15 s at the feed.
+    assert!(bins[10] > 15.0 - 0.06 && bins[10] < moving, "{bins:?}");
+}

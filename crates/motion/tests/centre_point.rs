@@ -12,6 +12,7 @@ use tezgah_kinematics::{Joints, Kinematics, Machine, Tool};
 use tezgah_motion::interpolate::{run, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::verify::program::ProgramPath;
 use tezgah_motion::verify::{Report, Verifier};
 use tezgah_motion::Segment;
 
@@ -35,8 +36,10 @@ fn run_program(program: &str) -> Out {
         orientation: Some(smooth::Orientation(Arc::new(pm.clone()))),
         ..SmoothOptions::default()
     };
+    // Measured against the program (take-ups at the switches are not the program's).
+    let program = ProgramPath::new(tezgah_geom::Pose::ZERO, pm.initial, &moves);
     let items = smooth::build(moves, &opts).unwrap();
-    let mut verifier = Verifier::new(&pm, machine.motion.period_s);
+    let mut verifier = Verifier::new(&pm, machine.motion.period_s).against(&pm, program);
     let mut samples = vec![];
     run(
         items,

@@ -9,6 +9,7 @@ use tezgah_kinematics::Machine;
 use tezgah_motion::interpolate::{run, Sample};
 use tezgah_motion::path::direct::{build, DirectOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::verify::program::ProgramPath;
 use tezgah_motion::verify::{Report, Verifier};
 use tezgah_motion::{solve, Limits};
 
@@ -48,7 +49,9 @@ fn run_under(machine: &Machine, moves: &[Move], control: ToolControl) -> Out {
         },
     )
     .unwrap();
-    let mut verifier = Verifier::new(&pm, machine.motion.period_s);
+    // Against the program: the direct path keeps it, so only the chord error shows.
+    let program = ProgramPath::new(Pose::ZERO, control, moves);
+    let mut verifier = Verifier::new(&pm, machine.motion.period_s).against(&pm, program);
     let mut samples = vec![];
     let duration = run(
         items,

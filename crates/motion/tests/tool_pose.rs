@@ -13,6 +13,7 @@ use tezgah_motion::interpolate::{run, Sample};
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::tool_pose::SampleTool;
+use tezgah_motion::verify::program::ProgramPath;
 use tezgah_motion::verify::{Report, Verifier};
 use tezgah_motion::Segment;
 
@@ -36,8 +37,10 @@ fn run_program(machine: &Machine, program: &str) -> (Vec<Row>, Report) {
         orientation: Some(smooth::Orientation(Arc::new(pm.clone()))),
         ..SmoothOptions::default()
     };
+    // Measured against the program (take-ups at the switches are not the program's).
+    let program = ProgramPath::new(tezgah_geom::Pose::ZERO, pm.initial, &moves);
     let items = smooth::build(moves, &opts).unwrap();
-    let mut verifier = Verifier::new(&pm, machine.motion.period_s);
+    let mut verifier = Verifier::new(&pm, machine.motion.period_s).against(&pm, program);
     let mut tool = SampleTool::new(&pm);
     let mut rows = vec![];
     run(

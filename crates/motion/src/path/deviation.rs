@@ -124,37 +124,54 @@ fn prog_distance(p: &Prog, q: &Vec3) -> f64 {
 }
 
 /// Distance from `q` to the part `u ∈ [u0, u1]` of a plane arc of constant radius, in closed
-/// form: the nearest point is at `q`'s own angle if that lies in the part, else an end.
-/// `None` for helices and arcs of changing radius (no closed form; callers sample).
+/// form ([`arc_nearest`]). `None` for helices and arcs of changing radius (no closed form;
+/// callers sample).
 pub(crate) fn arc_distance(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<f64> {
+    arc_nearest(a, q, u0, u1).map(|(d, _)| d)
+}
+
+/// Distance from `q` to the part `u ∈ [u0, u1]` of a plane arc of constant radius and the
+/// parameter where it is reached, in closed form: `q`'s own angle if the part holds it
+/// (on a part of more than a turn, the turn nearest the part's middle), else the nearer end.
+/// `None` for helices and spirals.
+pub(crate) fn arc_nearest(a: &Arc, q: &Vec3, u0: f64, u1: f64) -> Option<(f64, f64)> {
+    use std::f64::consts::TAU;
     // A radius mismatch at rounding level (arc ends computed by the program's author) is no
     // spiral: the closed form is off by at most the mismatch.
     if a.rise() != 0.0 || (a.radius() - a.end_radius()).abs() > 1e-12 * a.radius() {
         return None;
     }
-    let (c, n, r, sweep) = (a.center(), a.normal(), a.radius(), a.sweep());
+    let (c, n, r, sweep) = (a.center(), a.normal(), a.radius(), a.sweep().abs());
     let e1 = (a.point(0.0) - c) / r;
     let e2 = n.cross(&e1);
     let d = q - c;
     let (x, y, h) = (d.dot(&e1), d.dot(&e2), d.dot(&n));
-    let ends = || {
-        let p0 = (a.point(u0) - q).norm();
-        let p1 = (a.point(u1) - q).norm();
-        p0.min(p1)
-    };
     let rho = x.hypot(y);
-    if rho == 0.0 {
-        return Some(r.hypot(h));
+    let ends = || {
+        let (p0, p1) = ((a.point(u0) - q).norm(), (a.point(u1) - q).norm());
+        if p0 <= p1 {
+            (p0, u0)
+        } else {
+            (p1, u1)
+        }
+    };
+    if rho == 0.0 || sweep == 0.0 {
+        // On the axis every point of the arc is as near.
+        return Some((r.hypot(h), 0.5 * (u0 + u1)));
     }
-    // Angle of q measured in the arc's own sense, in [0, 2π).
-    let theta = y.atan2(x) * sweep.signum();
-    let theta = theta.rem_euclid(std::f64::consts::TAU);
-    let (t0, t1) = (sweep.abs() * u0, sweep.abs() * u1);
-    let inside = (t0..=t1).contains(&theta)
-        || (t0..=t1).contains(&(theta + std::f64::consts::TAU))
-        || t1 - t0 >= std::f64::consts::TAU;
-    if inside {
-        Some((rho - r).hypot(h))
+    // The angle of q in the arc's own sense, in [0, 2π).
+    let theta = (y.atan2(x) * a.sweep().signum()).rem_euclid(TAU);
+    let (t0, t1) = (sweep * u0, sweep * u1);
+    let mid = 0.5 * (t0 + t1);
+    let k = ((mid - theta) / TAU).round();
+    let mut t = theta + k * TAU;
+    if t < t0 {
+        t += TAU;
+    } else if t > t1 {
+        t -= TAU;
+    }
+    if (t0..=t1).contains(&t) {
+        Some(((rho - r).hypot(h), t / sweep))
     } else {
         Some(ends())
     }
