@@ -2,12 +2,14 @@
 //! length, the profile's limits (V, A, J), entry, peak and exit speed, and duration, so a user
 //! sees where a plan runs below the feed and what limits it there.
 //!
-//! `cargo run --release -p tezgah-motion --example pieces -- PROGRAM.ngc [MACHINE.toml]`
+//! `cargo run --release -p tezgah-motion --example pieces -- PROGRAM.ngc [MACHINE.toml [TOOLS.tbl]]`
 
 #[path = "../benches/common/mod.rs"]
 mod common;
 
+use tezgah_geom::Pose;
 use tezgah_kinematics::Machine;
+use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::lookahead::plan_all;
 use tezgah_motion::plan::{PlanMachine, Planned};
 
@@ -19,14 +21,20 @@ fn main() {
             .expect("machine file"),
         None => Machine::default_machine(),
     };
-    let moves = common::parse(&text);
-    let items = common::smooth_items(&moves, &machine);
-    let planned = plan_all(
-        items,
-        PlanMachine::from_machine(&machine).unwrap(),
-        common::plan_options(&machine),
-    )
-    .expect("plan");
+    let config = tezgah_gcode::Config {
+        tool_table: match args.get(2) {
+            Some(p) => tezgah_gcode::ToolTable::parse(&std::fs::read_to_string(p).expect("tools"))
+                .expect("tool table"),
+            None => Default::default(),
+        },
+        ..tezgah_gcode::Config::default()
+    };
+    let moves = tezgah_gcode::program_moves(&text, config).expect("program");
+    let pm = PlanMachine::from_machine(&machine).unwrap();
+    let options =
+        SmoothOptions::for_machine(&machine.path, &pm, machine.motion.tolerance_mm, Pose::ZERO);
+    let items = smooth::build(moves, &options).expect("path");
+    let planned = plan_all(items, pm, common::plan_options(&machine)).expect("plan");
     let mut total = 0.0;
     for p in planned {
         match p {

@@ -154,17 +154,22 @@ impl Geometry {
 ///   q_s = C'/s_u,  q_ss = (C'' − q_s·s_uu)/s_u²,  q_sss = (C''' − 3q_ss·s_u·s_uu − q_s·s_uuu)/s_u³.
 /// Exact at the point, whatever the parametrisation (blends and splines are not u ∝ s).
 fn frame(curve: &dyn Curve, u: f64) -> [Vec3; 3] {
+    frame_and_speed(curve, u).0
+}
+
+/// [`frame`] and the parametric speed s_u = |C'| at `u` (one evaluation of the curve).
+fn frame_and_speed(curve: &dyn Curve, u: f64) -> ([Vec3; 3], f64) {
     let [_, c1, c2, c3] = curve.derivs(u);
     let su = c1.norm();
     if su <= 0.0 {
-        return [Vec3::zeros(); 3];
+        return ([Vec3::zeros(); 3], 0.0);
     }
     let suu = c1.dot(&c2) / su;
     let suuu = (c2.dot(&c2) + c1.dot(&c3) - suu * suu) / su;
     let q1 = c1 / su;
     let q2 = (c2 - q1 * suu) / (su * su);
     let q3 = (c3 - q2 * (3.0 * su * suu) - q1 * suuu) / (su * su * su);
-    [q1, q2, q3]
+    ([q1, q2, q3], su)
 }
 
 /// Samples the tip path (tangent, curvature vector and its rate, exact at each sample, see
@@ -217,7 +222,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // The turning is estimated on a first coarse pass too: a curvature spike away
             // from the ends and the middle (a tight bend inside a spline) needs the samples.
             // (Lines, arcs and helices turn evenly: the ends and the middle tell it.)
-            const COARSE: usize = 64;
+            const COARSE: usize = 16;
             let dc = (ub - ua) / COARSE as f64;
             let coarse: f64 = if constant_speed(curve) {
                 0.0
@@ -225,7 +230,8 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 (0..COARSE)
                     .map(|c| {
                         let u = ua + dc * (c as f64 + 0.5);
-                        frame(curve, u)[1].norm() * curve.speed(u) * dc
+                        let ([_, k, _], su) = frame_and_speed(curve, u);
+                        k.norm() * su * dc
                     })
                     .sum()
             };
@@ -243,12 +249,12 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                         g2: &mut [f64; 3],
                         g3: &mut [f64; 3],
                         cells: &mut Cells| {
-                let [t, k, dk] = frame(curve, u);
+                let ([t, k, dk], su) = frame_and_speed(curve, u);
                 let f = (u - ua) / (ub - ua);
                 // Half a sample spacing in arc length: between samples a derivative strays
                 // from its sampled value by at most that times the next derivative (the
                 // whole segment's maxima have the peak refinement below; a cell does not).
-                let h = 0.5 * curve.speed(u) * du;
+                let h = 0.5 * su * du;
                 for i in 0..3 {
                     let d = [t[i].abs() * 1.005, k[i].abs() * 1.05, dk[i].abs() * 1.05];
                     g1[i] = g1[i].max(d[0]);
@@ -300,7 +306,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                     raise(&mut tip_cells, i, s as f64 * df, df, d);
                 }
             }
-            const FINE: usize = 16;
+            const FINE: usize = 8;
             // Axes often peak at the same sample: refine each sample once.
             let mut around: Vec<usize> = (0..2)
                 .flat_map(|d| {
@@ -317,7 +323,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 for i in 0..3 {
                     for o in 1..3 {
                         let (a, b, c) = (rows[s - 1][i][o], rows[s][i][o], rows[s + 1][i][o]);
-                        if b >= a && b >= c && b >= 0.5 * best[o - 1][i] && b > 0.0 {
+                        if b >= a && b >= c && b >= 0.7 * best[o - 1][i] && b > 0.0 {
                             around.push(s);
                         }
                     }
@@ -493,20 +499,18 @@ fn numeric_joints(
             let k = k.clamp(1, m - 1);
             ((x(k + 1) - 2.0 * x(k) + x(k - 1)) / (h * h)).abs()
         };
+        // The third differences likewise bound how far q'' strays from a second difference.
+        let third = |k: usize| {
+            let k = k.clamp(1, m.saturating_sub(2).max(1));
+            ((x(k + 2) - 3.0 * x(k + 1) + 3.0 * x(k) - x(k - 1)) / (h * h * h)).abs()
+        };
         for k in 0..m {
-            let d = ((x(k + 1) - x(k)) / h).abs();
+            let d = ((x(k + 1) - x(k)) / h).abs() + 0.5 * h * second(k).max(second(k + 1));
             g1 = g1.max(d);
-            let stray = 0.5 * h * second(k).max(second(k + 1));
-            raise(
-                cells,
-                i,
-                at(k as f64 + 0.5),
-                df,
-                [(d + stray) * 1.01, 0.0, 0.0],
-            );
+            raise(cells, i, at(k as f64 + 0.5), df, [d * 1.01, 0.0, 0.0]);
         }
         for k in 1..m {
-            let d = second(k);
+            let d = second(k) + 0.5 * h * third(k - 1).max(third(k));
             g2 = g2.max(d);
             raise(cells, i, at(k as f64), df, [0.0, d * 1.1, 0.0]);
         }
@@ -583,7 +587,7 @@ pub enum LimitedBy {
 /// maximum-velocity curve of the phase plane, Bobrow et al. 1985), leaves nothing to change
 /// speed with. No fixed share of the budget is set aside: among speeds V = β·V_top (V_top the
 /// least of that curve, the feed, the joints' speeds and the chord error), and accelerations up
-/// to what is left, [`best_split`] takes the (V, A, J) that would cover a reference stretch
+/// to what is left, [`best_split`] takes the (V, A, J) that would cover the segment
 /// fastest, ramps to and from it included. A long arc or helix thus runs close to its
 /// curvature limit, and a short stretch between speed changes keeps more for its ramps.
 /// The cross term 3|q''|·V·A is paid by the path acceleration, not by the speed: charging it
@@ -757,13 +761,10 @@ const SPEED_FRACTIONS: [f64; 12] = [
 /// Fractions of the acceleration left at a speed that [`best_split`] tries (the rest of the
 /// jerk budget then goes to the path jerk through the cross term 3|q''|·V·A).
 const ACCEL_FRACTIONS: [f64; 5] = [1.0, 0.7, 0.45, 0.25, 0.1];
-/// Shortest stretch the choice is made for, mm: neighbouring segments of like limits share
-/// one profile (the look-ahead's groups), so a short segment is timed as part of a longer run.
-const REFERENCE_LENGTH: f64 = 2.0;
-/// Speed change, as a share of the speed, assumed at each end of the reference stretch.
+/// Speed change, as a share of the speed, assumed at each end of the segment.
 const REFERENCE_CHANGE: f64 = 0.25;
 
-/// The (V, A, J) that covers a reference stretch fastest: V ≤ `top`, and for V and A every
+/// The (V, A, J) that covers the segment fastest: V ≤ `top`, and for V and A every
 /// point and joint within its budgets (see [`segment_limits`]). The time is the cruise L/V
 /// plus, at each end, what a jerk-limited ramp of `REFERENCE_CHANGE`·V costs over cruising
 /// (half its duration times the change's share of V). `None` if no speed leaves room for
@@ -774,8 +775,14 @@ fn best_split(
     change: f64,
     budgets: &Budgets<'_>,
 ) -> Option<(f64, f64, f64)> {
-    let reference = length.max(REFERENCE_LENGTH);
+    // The segment's own length: a short one alone between others of other limits (a tight
+    // spot, the pole of a 5-axis pass) is all ramps, and a floor of a few millimetres once
+    // left it creeping with a tenth of the acceleration it could use.
+    let reference = length.max(1e-9);
     let mut best: Option<(f64, (f64, f64, f64))> = None;
+    // Slower speeds leave more for the ramps; once two in a row cost more than the best, the
+    // rest (slower still, their cruise longer) do not pay either.
+    let mut worse = 0;
     for beta in SPEED_FRACTIONS {
         let v = beta * top;
         // The acceleration is shared for a ramp through the whole speed (a group's ends are
@@ -784,6 +791,12 @@ fn best_split(
             let time = reference / v + ramp_time(change * v, a, j) * change;
             if best.is_none_or(|(t, _)| time < t) {
                 best = Some((time, (v, a, j)));
+                worse = 0;
+            } else {
+                worse += 1;
+                if worse == 2 {
+                    break;
+                }
             }
         }
     }
@@ -794,16 +807,22 @@ fn best_split(
 /// fastest, with that ramp's duration: A takes a share of what the acceleration and the jerk
 /// (through the cross term 3|q''|·v·A) leave, J the rest of the jerk. `None` if nothing is left.
 fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
+    // Per point and joint, the path jerk left as a line in A: J ≤ (Jᵢ − |q'''|v³)/|q'| −
+    // (3|q''|v/|q'|)·A; found once, then read for each share of A.
+    let mut lines = [(0.0f64, 0.0f64); CELLS * MAX_JOINTS];
+    let mut m = 0;
     let mut a_cap = f64::INFINITY;
     for cell in budgets.cells {
         for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
             let rest_a = budgets.acceleration[i] - g2 * v * v;
             let rest_j = budgets.jerk[i] - g3 * v * v * v;
             if rest_a < 0.0 || rest_j < 0.0 {
-                a_cap = 0.0;
+                return None;
             }
             if g1 > 0.0 {
                 a_cap = a_cap.min(rest_a / g1);
+                lines[m] = (rest_j / g1, 3.0 * g2 * v / g1);
+                m += 1;
             }
             if g2 > 0.0 {
                 a_cap = a_cap.min(rest_j / (3.0 * g2 * v));
@@ -813,18 +832,14 @@ fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
     if !(a_cap > 0.0 && a_cap.is_finite()) {
         return None;
     }
+    let lines = &lines[..m];
     let mut best: Option<(f64, f64, f64)> = None;
     for alpha in ACCEL_FRACTIONS {
         let a = alpha * a_cap;
-        let mut j = f64::INFINITY;
-        for cell in budgets.cells {
-            for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
-                if g1 > 0.0 {
-                    let rest = budgets.jerk[i] - g3 * v * v * v - 3.0 * g2 * v * a;
-                    j = j.min(rest / g1);
-                }
-            }
-        }
+        let j = lines
+            .iter()
+            .map(|&(r, s)| r - s * a)
+            .fold(f64::INFINITY, f64::min);
         if !(j > 0.0 && j.is_finite()) {
             continue;
         }
