@@ -84,8 +84,7 @@ fn retime_limit_figures() {
         let n = reference(&program).len();
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         let hold = (seed as usize * 7919) % n;
         let change = (seed as usize * 104_729) % n;
         let percent = [150.0, 200.0, 30.0, 0.0, 120.0][seed as usize % 5];

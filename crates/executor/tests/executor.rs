@@ -141,8 +141,7 @@ proptest! {
         let n = full.len();
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         let mut at: Vec<(usize, f64)> = changes.iter().map(|&(f, p)| ((f * n as f64) as usize, p)).collect();
         at.sort_by_key(|c| c.0);
         // A last change back to 100 % so a program slowed to 0 % still finishes.
@@ -177,8 +176,7 @@ proptest! {
         let at = ((full.len() as f64) * frac) as usize;
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         drive(&mut exec, &mut trace, 2_000_000, |k, e| {
             if k == at {
                 e.command(Command::Abort).unwrap();
@@ -227,8 +225,7 @@ proptest! {
         at.sort_by_key(|e| e.0);
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         let mut resume_at = None;
         let mut k = 0usize;
         // Periods while held produce nothing: count them on the same clock.
@@ -542,11 +539,7 @@ fn hold_acts_at_once() {
     let program = "G21 G90 F600\nG1 X150\nM2\n";
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     let at = 3000;
     let mut scale_mid_stop = None;
     drive(&mut exec, &mut trace, 100_000, |k, e| {
@@ -606,11 +599,7 @@ fn dwell_runs_in_wall_time() {
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
         exec.command(Command::FeedOverride { percent }).unwrap();
-        exec.command(Command::Load {
-            program: program.into(),
-        })
-        .unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, program);
         let mut held = 0;
         drive(&mut exec, &mut trace, 100_000, |k, e| {
             if Some(k) == hold_at {
@@ -650,11 +639,7 @@ fn dwell_runs_in_wall_time() {
 fn run_with_override(program: &str, percent: f64, end: Vec3) -> (f64, usize) {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     drive(&mut exec, &mut trace, 100_000, |k, e| {
         if k == 200 {
             e.command(Command::FeedOverride { percent }).unwrap();
@@ -753,11 +738,7 @@ fn five_axis_holds_and_override() {
     let n = full.len();
     let mut exec = new();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     let holds = [n / 7, 2 * n / 5, 3 * n / 4];
     let mut held = 0;
     for k in 0..20 * n {

@@ -85,12 +85,17 @@ pub fn drive(
     max
 }
 
-pub fn run_program(exec: &mut Executor, trace: &mut Trace, program: &str) {
+/// Loads `program` and starts it.
+pub fn start(exec: &mut Executor, program: &str) {
     exec.command(Command::Load {
         program: program.into(),
     })
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
+}
+
+pub fn run_program(exec: &mut Executor, trace: &mut Trace, program: &str) {
+    start(exec, program);
     drive(exec, trace, 2_000_000, |_, _| {});
     assert_eq!(exec.state(), RunState::Idle);
 }
@@ -174,11 +179,7 @@ pub struct HoldDistance {
 pub fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDistance>) {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     let mut start = None;
     drive(&mut exec, &mut trace, 2_000_000, |k, e| {
         if k == at {
