@@ -355,42 +355,55 @@ fn bad_settings_are_errors() {
     assert!((step - 2.0 * (0.06f64 - 1e-4).sqrt() / 10.0).abs() < 1e-12);
 }
 
-#[test]
-fn random_surfaces_and_cutters_plan_without_failing() {
-    // Wavy patches with steep and tight spots: every plan succeeds, every emitted location is
-    // finite with a unit axis on the normal's side, and whatever gouges is listed. A coarse
-    // scallop: what is checked is each location, not their spacing.
-    for seed in 0..3u64 {
-        let s = testing::random_bicubic(seed);
-        for (spec, kind, lead, tilt) in [
-            ("ball:6", StrategyKind::IsoScallop, 0.0, 0.0),
-            ("flat:10", StrategyKind::ZigZag, 0.0, 0.0),
-            ("bull:10:2", StrategyKind::ZigZagOneWay, 0.0, 0.0),
-            ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
-        ] {
-            let cutter = Cutter::standard(spec.parse().unwrap());
-            let mut settings = Settings::new(kind, 0.3, 0.02);
-            settings.axis = ToolAxis::Surface {
-                lead_deg: lead,
-                tilt_deg: tilt,
-                max_lead_deg: 30.0,
-                match_curvature: true,
-            };
-            let p = plan(&s, &cutter, &settings).unwrap();
-            assert!(p.path.contact_count() > 0, "{seed} {spec}");
-            for cl in p.path.passes.iter().flat_map(|p| &p.points) {
-                assert!(cl.tip.iter().all(|x| x.is_finite()));
-                assert!((cl.axis.norm() - 1.0).abs() < 1e-12);
-                assert!(cl.axis.dot(&cl.normal) > 0.0);
-            }
-            println!(
-                "seed {seed} {spec} {kind}: {} points, {} refused, {} corrected",
-                p.path.contact_count(),
-                p.refused.len(),
-                p.corrected
-            );
+/// Wavy patches with steep and tight spots: every plan succeeds, every emitted location is
+/// finite with a unit axis on the normal's side, and whatever gouges is listed. A coarse
+/// scallop: what is checked is each location, not their spacing. One test per patch, so that
+/// they run side by side.
+fn random_surface_plans_without_failing(seed: u64) {
+    let s = testing::random_bicubic(seed);
+    for (spec, kind, lead, tilt) in [
+        ("ball:6", StrategyKind::IsoScallop, 0.0, 0.0),
+        ("flat:10", StrategyKind::ZigZag, 0.0, 0.0),
+        ("bull:10:2", StrategyKind::ZigZagOneWay, 0.0, 0.0),
+        ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
+    ] {
+        let cutter = Cutter::standard(spec.parse().unwrap());
+        let mut settings = Settings::new(kind, 0.3, 0.02);
+        settings.axis = ToolAxis::Surface {
+            lead_deg: lead,
+            tilt_deg: tilt,
+            max_lead_deg: 30.0,
+            match_curvature: true,
+        };
+        let p = plan(&s, &cutter, &settings).unwrap();
+        assert!(p.path.contact_count() > 0, "{seed} {spec}");
+        for cl in p.path.passes.iter().flat_map(|p| &p.points) {
+            assert!(cl.tip.iter().all(|x| x.is_finite()));
+            assert!((cl.axis.norm() - 1.0).abs() < 1e-12);
+            assert!(cl.axis.dot(&cl.normal) > 0.0);
         }
+        println!(
+            "seed {seed} {spec} {kind}: {} points, {} refused, {} corrected",
+            p.path.contact_count(),
+            p.refused.len(),
+            p.corrected
+        );
     }
+}
+
+#[test]
+fn random_surface_0_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(0);
+}
+
+#[test]
+fn random_surface_1_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(1);
+}
+
+#[test]
+fn random_surface_2_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(2);
 }
 
 /// The material a ball path leaves above the surface, measured independently of the planner:
