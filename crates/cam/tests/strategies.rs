@@ -243,8 +243,7 @@ fn worst_penetration(s: &NurbsSurface, p: &tezgah_cam::Plan) -> f64 {
 fn flat_end_in_a_trough_is_curvature_matched_and_rear_gouges_are_corrected() {
     // Flat D 10 in a trough of radius 20 (5-axis). Along the trough: the cross-feed section
     // is concave, so curvature matching leans the tool; no refusals.
-    // 15 mm long: every section across is the same circle.
-    let s = testing::trough(20.0, 15.0);
+    let s = testing::trough(20.0, 30.0);
     let flat = Cutter::standard(CutterShape::Flat { radius: 5.0 });
     let mut settings = Settings::new(StrategyKind::ZigZag, 0.02, 0.01);
     settings.direction = FeedDirection::AlongV;
