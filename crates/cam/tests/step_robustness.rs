@@ -1,17 +1,18 @@
-//! STEP input never panics: the fuzz corpus (`fuzz/corpus/step`) replayed, and deterministic
-//! mutations of the fixtures — every truncation on a stride, byte substitutions and swapped
-//! references — which reach the mappers behind the parser (the fuzzer proper is
-//! `cd fuzz && cargo fuzz run step`).
+//! STEP input never panics: the STEP fixtures (the `step` fuzz target's seeds) replayed, and
+//! deterministic mutations of them — every truncation on a stride, byte substitutions and
+//! swapped references — which reach the mappers behind the parser (the fuzzer proper is
+//! `cd fuzz && cargo fuzz run step corpus/step ../crates/cam/tests/fixtures`).
 
 use std::path::{Path, PathBuf};
 
 use tezgah_cam::step;
 
 fn corpus() -> Vec<(PathBuf, Vec<u8>)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus/step");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures");
     let mut out: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "stp"))
         .map(|p| {
             let bytes = std::fs::read(&p).unwrap();
             (p, bytes)

@@ -354,41 +354,55 @@ fn bad_settings_are_errors() {
     assert!((step - 2.0 * (0.06f64 - 1e-4).sqrt() / 10.0).abs() < 1e-12);
 }
 
-#[test]
-fn random_surfaces_and_cutters_plan_without_failing() {
-    // Wavy patches with steep and tight spots: every plan succeeds, every emitted location is
-    // finite with a unit axis on the normal's side, and whatever gouges is listed.
-    for seed in 0..3u64 {
-        let s = testing::random_bicubic(seed);
-        for (spec, kind, lead, tilt) in [
-            ("ball:6", StrategyKind::IsoScallop, 0.0, 0.0),
-            ("flat:10", StrategyKind::ZigZag, 0.0, 0.0),
-            ("bull:10:2", StrategyKind::ZigZagOneWay, 0.0, 0.0),
-            ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
-        ] {
-            let cutter = Cutter::standard(spec.parse().unwrap());
-            let mut settings = Settings::new(kind, 0.1, 0.02);
-            settings.axis = ToolAxis::Surface {
-                lead_deg: lead,
-                tilt_deg: tilt,
-                max_lead_deg: 30.0,
-                match_curvature: true,
-            };
-            let p = plan(&s, &cutter, &settings).unwrap();
-            assert!(p.path.contact_count() > 0, "{seed} {spec}");
-            for cl in p.path.passes.iter().flat_map(|p| &p.points) {
-                assert!(cl.tip.iter().all(|x| x.is_finite()));
-                assert!((cl.axis.norm() - 1.0).abs() < 1e-12);
-                assert!(cl.axis.dot(&cl.normal) > 0.0);
-            }
-            println!(
-                "seed {seed} {spec} {kind}: {} points, {} refused, {} corrected",
-                p.path.contact_count(),
-                p.refused.len(),
-                p.corrected
-            );
+/// Wavy patches with steep and tight spots: every plan succeeds, every emitted location is
+/// finite with a unit axis on the normal's side, and whatever gouges is listed. A coarse
+/// scallop: what is checked is each location, not their spacing. One test per patch, so that
+/// they run side by side.
+fn random_surface_plans_without_failing(seed: u64) {
+    let s = testing::random_bicubic(seed);
+    for (spec, kind, lead, tilt) in [
+        ("ball:6", StrategyKind::IsoScallop, 0.0, 0.0),
+        ("flat:10", StrategyKind::ZigZag, 0.0, 0.0),
+        ("bull:10:2", StrategyKind::ZigZagOneWay, 0.0, 0.0),
+        ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
+    ] {
+        let cutter = Cutter::standard(spec.parse().unwrap());
+        let mut settings = Settings::new(kind, 0.3, 0.02);
+        settings.axis = ToolAxis::Surface {
+            lead_deg: lead,
+            tilt_deg: tilt,
+            max_lead_deg: 30.0,
+            match_curvature: true,
+        };
+        let p = plan(&s, &cutter, &settings).unwrap();
+        assert!(p.path.contact_count() > 0, "{seed} {spec}");
+        for cl in p.path.passes.iter().flat_map(|p| &p.points) {
+            assert!(cl.tip.iter().all(|x| x.is_finite()));
+            assert!((cl.axis.norm() - 1.0).abs() < 1e-12);
+            assert!(cl.axis.dot(&cl.normal) > 0.0);
         }
+        println!(
+            "seed {seed} {spec} {kind}: {} points, {} refused, {} corrected",
+            p.path.contact_count(),
+            p.refused.len(),
+            p.corrected
+        );
     }
+}
+
+#[test]
+fn random_surface_0_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(0);
+}
+
+#[test]
+fn random_surface_1_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(1);
+}
+
+#[test]
+fn random_surface_2_and_cutters_plan_without_failing() {
+    random_surface_plans_without_failing(2);
 }
 
 /// The material a ball path leaves above the surface, measured independently of the planner:
@@ -428,37 +442,37 @@ fn largest_residual(s: &NurbsSurface, p: &tezgah_cam::Plan, r: f64, lattice: usi
 
 #[test]
 fn material_left_by_a_ball_path_is_the_target_scallop() {
-    // Free-form, ball D6, h = 0.05, tight chord tolerance so chords add little: the highest
-    // residual is the scallop itself — h for iso-scallop (everywhere), and at most h for
-    // zig-zag (at its binding point; less elsewhere).
+    // Free-form, ball D6, h = 0.1, tight chord tolerance (h/25) so chords add little: the
+    // highest residual is the scallop itself — h for iso-scallop (everywhere), and at most h
+    // for zig-zag (at its binding point; less elsewhere).
     let s = testing::freeform(0.0);
-    let h = 0.05;
+    let (h, tol) = (0.1, 0.004);
+    let within = |worst: f64| worst <= 1.06 * h + tol && worst >= 0.8 * h;
     for kind in [StrategyKind::IsoScallop, StrategyKind::ZigZag] {
-        let p = plan(&s, &ball(6.0), &Settings::new(kind, h, 0.002)).unwrap();
+        let p = plan(&s, &ball(6.0), &Settings::new(kind, h, tol)).unwrap();
         let worst = largest_residual(&s, &p, 3.0, 90);
         println!("{kind}: largest residual {worst:.4} mm for h = {h}");
-        assert!(worst <= 1.06 * h + 0.002, "{kind}: {worst}");
-        assert!(worst >= 0.8 * h, "{kind}: {worst}");
+        assert!(within(worst), "{kind}: {worst}");
     }
     // Feeding along u on the warped patch (passes across the distorted parametrisation).
     let s = testing::freeform(0.6);
-    let mut settings = Settings::new(StrategyKind::IsoScallop, h, 0.002);
+    let mut settings = Settings::new(StrategyKind::IsoScallop, h, tol);
     settings.direction = FeedDirection::AlongU;
     let p = plan(&s, &ball(6.0), &settings).unwrap();
     let worst = largest_residual(&s, &p, 3.0, 90);
     println!("warped free-form along u, iso-scallop: largest residual {worst:.4} mm for h = {h}");
-    assert!(worst <= 1.06 * h + 0.002 && worst >= 0.8 * h, "{worst}");
+    assert!(within(worst), "{worst}");
     // The saddle, where the iso-scallop front bends slightly on the centre line.
     let s = testing::saddle(50.0, 40.0);
     let p = plan(
         &s,
         &ball(6.0),
-        &Settings::new(StrategyKind::IsoScallop, h, 0.002),
+        &Settings::new(StrategyKind::IsoScallop, h, tol),
     )
     .unwrap();
     let worst = largest_residual(&s, &p, 3.0, 90);
     println!("saddle iso-scallop: largest residual {worst:.4} mm for h = {h}");
-    assert!(worst <= 1.06 * h + 0.002 && worst >= 0.8 * h, "{worst}");
+    assert!(within(worst), "{worst}");
 }
 
 #[test]
@@ -481,12 +495,14 @@ fn one_way_and_two_way_zigzag_differ_only_in_direction() {
 #[test]
 fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
     // 001 §4.1: a flat end mill with curvature-matched lead cuts 30–40 % less path than a ball
-    // of the same diameter. Free-form patch, D6, iso-scallop, h = 0.01, lead 5° (raised where
+    // of the same diameter. Free-form patch, D6, iso-scallop, h = 0.04, lead 5° (raised where
     // the cross-feed section is concave, and where the heel would gouge). A tight chord
-    // tolerance, so the material left below is the scallop, not the chords.
+    // tolerance (a tenth of h), so the material left below is the scallop, not the chords.
+    // (It ran at h = 0.01, with four times the locations: both steps grow as √h while h is
+    // small against the radii.)
     let s = testing::freeform(0.0);
-    let h = 0.01;
-    let mut settings = Settings::new(StrategyKind::IsoScallop, h, 0.001);
+    let (h, tolerance) = (0.04, 0.004);
+    let mut settings = Settings::new(StrategyKind::IsoScallop, h, tolerance);
     let ball_plan = plan(&s, &ball(6.0), &settings).unwrap();
     settings.axis = ToolAxis::Surface {
         lead_deg: 5.0,
@@ -568,7 +584,7 @@ fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
         }
     }
     println!("flat D6: largest residual {worst:.4} mm for h = {h}");
-    assert!(worst <= 1.1 * h + 0.001, "{worst}");
+    assert!(worst <= 1.1 * h + tolerance, "{worst}");
 }
 
 /// The rational sphere OpenCascade wrote (R 40; u the longitude with its seam at 0 = 2π,

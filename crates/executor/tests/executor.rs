@@ -10,16 +10,6 @@ use tezgah_executor::command::{Command, PauseReason, RunState};
 use tezgah_executor::executor::Produced;
 use tezgah_geom::Vec3;
 
-fn reference(program: &str) -> Vec<Produced> {
-    let mut exec = executor();
-    let mut trace = Trace::new(&exec);
-    run_program(&mut exec, &mut trace, program);
-    let (out, report) = trace.report();
-    assert_within_limits(&report);
-    assert_continuous(&out);
-    out
-}
-
 /// At 100 % the executor plays `program` on `machine` exactly as `tezgah run`'s interpolator
 /// samples it: the reference is built with the options `tezgah run` uses (the machine file's
 /// `[path]`, the tool axis carried under TCP), independently of the executor's job machinery.
@@ -109,83 +99,6 @@ fn five_axis_tcp_plays_the_interpolator_samples() {
     plays_the_interpolator_samples(&machine, program);
 }
 
-/// The distance a hold at period `at` travelled, the time-optimal jerk-limited stop from the
-/// hold state (speed, and acceleration by backward difference, under the path limits where it
-/// began and ended), and the allowance the bound adds: two periods' travel.
-struct HoldDistance {
-    travelled: f64,
-    optimal: f64,
-    allowance: f64,
-}
-
-/// Holds at period `at`, checks the stop, resumes; returns the whole trace and, if it held
-/// before the program ended, the hold's distance.
-fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDistance>) {
-    let mut exec = executor();
-    let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
-    // The path limits of every piece the stop passes through: a stop that runs into a piece
-    // of weaker limits (a short arc, a blend) brakes as that piece allows.
-    let mut crossed = vec![];
-    drive(&mut exec, &mut trace, 2_000_000, |k, e| {
-        if k == at {
-            e.command(Command::FeedHold).unwrap();
-        }
-        if k >= at && e.state() != RunState::Held {
-            crossed.extend(e.path_limits());
-        }
-    });
-    let mut distance = None;
-    // Held, or the program ended before the hold.
-    if exec.state() == RunState::Held {
-        let out = &trace.out;
-        let before = &out[at.saturating_sub(1)];
-        let prev = &out[at.saturating_sub(2)];
-        let a = (before.feed - prev.feed) / exec.period();
-        crossed.push(exec.path_limits().expect("held inside a piece"));
-        // Under the limits of the piece where the hold began; if it stopped further on, the
-        // largest of the stops under the limits of each piece it crossed (braking as each
-        // allows lies between them).
-        let optimal = crossed
-            .iter()
-            .map(|l| {
-                tezgah_executor::stop::stopping_distance(
-                    before.feed,
-                    a.clamp(-l.max_acceleration(), l.max_acceleration()),
-                    l.max_acceleration(),
-                    l.max_jerk(),
-                )
-            })
-            .fold(0.0, f64::max);
-        let d = HoldDistance {
-            travelled: out.last().unwrap().path - before.path,
-            optimal,
-            // A period's travel for the command taking hold, and one for the backward
-            // difference's view of the acceleration: a plan already braking at the hold
-            // reads a stop of zero length under its own limits.
-            allowance: 2.0 * before.feed * exec.period() + 1e-9,
-        };
-        distance = Some(d);
-        // Standing: nothing produced while held.
-        assert_eq!(exec.step().unwrap(), None);
-        exec.command(Command::Resume).unwrap();
-        drive(&mut exec, &mut trace, 2_000_000, |_, _| {});
-    }
-    assert_eq!(exec.state(), RunState::Idle);
-    assert_eq!(exec.unchecked_periods(), 0);
-    let (out, report) = trace.report();
-    assert_within(&report, RETIME_JERK);
-    assert_continuous(&out);
-    (out, distance)
-}
-
-/// Bound on a hold's distance over the optimum (plus a period's travel).
-const HOLD_RATIO: f64 = 1.2;
-
 /// The stop along the path is the optimum (up to the backward difference's view of the
 /// acceleration); where it would leave the piece the time scale brakes along the plan, which
 /// slows for what lies past the piece anyway.
@@ -228,8 +141,7 @@ proptest! {
         let n = full.len();
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         let mut at: Vec<(usize, f64)> = changes.iter().map(|&(f, p)| ((f * n as f64) as usize, p)).collect();
         at.sort_by_key(|c| c.0);
         // A last change back to 100 % so a program slowed to 0 % still finishes.
@@ -248,7 +160,7 @@ proptest! {
         prop_assert_eq!(exec.state(), RunState::Idle);
         prop_assert_eq!(exec.unchecked_periods(), 0);
         let (out, report) = trace.report();
-        assert_within(&report, RETIME_JERK);
+        assert_within_limits(&report);
         assert_continuous(&out);
         let (a, b) = (full.last().unwrap(), out.last().unwrap());
         prop_assert!((a.path - b.path).abs() <= 1e-9 * a.path.max(1.0));
@@ -264,8 +176,7 @@ proptest! {
         let at = ((full.len() as f64) * frac) as usize;
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         drive(&mut exec, &mut trace, 2_000_000, |k, e| {
             if k == at {
                 e.command(Command::Abort).unwrap();
@@ -275,7 +186,7 @@ proptest! {
         exec.command(Command::Mdi { block: "G1 X0 Y0 Z0 F3000".into() }).unwrap();
         drive(&mut exec, &mut trace, 2_000_000, |_, _| {});
         let (out, report) = trace.report();
-        assert_within(&report, RETIME_JERK);
+        assert_within_limits(&report);
         assert_continuous(&out);
         prop_assert!(out.last().unwrap().tip.norm() <= 1e-9);
     }
@@ -314,8 +225,7 @@ proptest! {
         at.sort_by_key(|e| e.0);
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program: program.clone() }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, &program);
         let mut resume_at = None;
         let mut k = 0usize;
         // Periods while held produce nothing: count them on the same clock.
@@ -545,7 +455,7 @@ fn run_at_override(program: &str, percent: f64) -> Vec<Produced> {
     exec.command(Command::FeedOverride { percent }).unwrap();
     run_program(&mut exec, &mut trace, program);
     let (out, report) = trace.report();
-    assert_within(&report, RETIME_JERK);
+    assert_within_limits(&report);
     assert_continuous(&out);
     out
 }
@@ -576,7 +486,7 @@ fn override_scales_the_programmed_feed() {
         .unwrap();
     run_program(&mut exec, &mut trace, fast);
     let (out, report) = trace.report();
-    assert_within(&report, RETIME_JERK);
+    assert_within_limits(&report);
     let top = out.iter().map(|p| p.feed).fold(0.0, f64::max);
     assert!(top <= 200.0 * (1.0 + 1e-9) && top > 150.0, "{top}");
 }
@@ -625,11 +535,7 @@ fn hold_acts_at_once() {
     let program = "G21 G90 F600\nG1 X150\nM2\n";
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     let at = 3000;
     let mut scale_mid_stop = None;
     drive(&mut exec, &mut trace, 100_000, |k, e| {
@@ -677,7 +583,7 @@ fn hold_acts_at_once() {
         "{took} s vs {optimal} s"
     );
     let (out, report) = trace.report();
-    assert_within(&report, RETIME_JERK);
+    assert_within_limits(&report);
     assert_continuous(&out);
 }
 
@@ -689,11 +595,7 @@ fn dwell_runs_in_wall_time() {
         let mut exec = executor();
         let mut trace = Trace::new(&exec);
         exec.command(Command::FeedOverride { percent }).unwrap();
-        exec.command(Command::Load {
-            program: program.into(),
-        })
-        .unwrap();
-        exec.command(Command::CycleStart).unwrap();
+        start(&mut exec, program);
         let mut held = 0;
         drive(&mut exec, &mut trace, 100_000, |k, e| {
             if Some(k) == hold_at {
@@ -727,55 +629,13 @@ fn dwell_runs_in_wall_time() {
     assert!((dh as i64 - d100 as i64).abs() <= 2, "{dh} vs {d100}");
 }
 
-/// The distribution of hold distances over the optimum on random holds (for the notes:
-/// `cargo test -p tezgah-executor --test executor hold_distance_distribution -- --ignored
-/// --nocapture`); the bound itself is asserted in every hold.
-#[test]
-#[ignore]
-fn hold_distance_distribution() {
-    let mut ratios = vec![];
-    let mut net = 0.0f64;
-    for seed in 0..40u64 {
-        let program = random_program(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15), 12);
-        let n = reference(&program).len();
-        for k in 1..=5 {
-            let at = n * k / 6;
-            if let (_, Some(d)) = hold_and_resume(&program, at) {
-                if d.optimal > 1e-4 {
-                    let ratio = (d.travelled - d.allowance) / d.optimal;
-                    net = net.max(ratio);
-                    if ratio > HOLD_RATIO {
-                        eprintln!("seed {seed} at {at}: {ratio} of {}", d.optimal);
-                    }
-                    ratios.push(d.travelled / d.optimal);
-                }
-            }
-        }
-    }
-    ratios.sort_by(f64::total_cmp);
-    let q = |p: f64| ratios[((ratios.len() - 1) as f64 * p).round() as usize];
-    eprintln!(
-        "{} holds: min {:.4} median {:.4} p90 {:.4} max {:.4}; less a period's travel, max {:.4}",
-        ratios.len(),
-        q(0.0),
-        q(0.5),
-        q(0.9),
-        q(1.0),
-        net
-    );
-}
-
 /// Runs `program` with the feed override set to `percent` 0.2 s after the start, checking
 /// every joint limit, continuity and the end at `end`: the fastest path speed and the number
 /// of periods.
 fn run_with_override(program: &str, percent: f64, end: Vec3) -> (f64, usize) {
     let mut exec = executor();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     drive(&mut exec, &mut trace, 100_000, |k, e| {
         if k == 200 {
             e.command(Command::FeedOverride { percent }).unwrap();
@@ -848,78 +708,6 @@ fn override_above_100_speeds_up_a_planned_arc() {
     assert!((n200 as f64 / want - 1.0).abs() < 0.01, "{n200} vs {want}");
 }
 
-/// Worst joint speed, acceleration and jerk over their limits in a verifier's report.
-fn worst_ratios(report: &tezgah_motion::verify::Report) -> [f64; 3] {
-    let mut w = [0.0f64; 3];
-    for j in &report.joints {
-        w[0] = w[0].max(j.velocity / j.max_velocity);
-        w[1] = w[1].max(j.acceleration / j.max_acceleration);
-        w[2] = w[2].max(j.jerk / j.max_jerk);
-    }
-    w
-}
-
-/// Figures for the notes (`cargo test -p tezgah-executor --test executor
-/// retime_limit_figures -- --ignored --nocapture`): 60 random programs, each with an override
-/// change (150, 200, 30, 0 or 120 %) back to 100 % 0.8 s later and a hold resumed 0.3 s
-/// later at deterministic pseudo-random instants; worst joint ratios by finite differences
-/// and the periods the time scale could not verify. The limits themselves are asserted by
-/// the property tests above.
-#[test]
-#[ignore]
-fn retime_limit_figures() {
-    let mut all = vec![];
-    let mut unchecked = 0;
-    for seed in 100..160u64 {
-        let program = random_program(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15), 10);
-        let n = reference(&program).len();
-        let mut exec = executor();
-        let mut trace = Trace::new(&exec);
-        exec.command(Command::Load { program }).unwrap();
-        exec.command(Command::CycleStart).unwrap();
-        let hold = (seed as usize * 7919) % n;
-        let change = (seed as usize * 104_729) % n;
-        let percent = [150.0, 200.0, 30.0, 0.0, 120.0][seed as usize % 5];
-        for k in 0..100 * n + 100_000 {
-            if k == change {
-                exec.command(Command::FeedOverride { percent }).unwrap();
-            }
-            if k == change + 800 {
-                exec.command(Command::FeedOverride { percent: 100.0 })
-                    .unwrap();
-            }
-            if k == hold {
-                exec.command(Command::FeedHold).unwrap();
-            }
-            if k == hold + 300 {
-                exec.command(Command::Resume).unwrap();
-            }
-            match exec.step().unwrap() {
-                Some(p) => trace.push(&exec, &p),
-                None if exec.state() == RunState::Idle => break,
-                None => {}
-            }
-        }
-        assert_eq!(exec.state(), RunState::Idle);
-        unchecked += exec.unchecked_periods();
-        all.push(worst_ratios(&trace.report().1));
-    }
-    let column = |i: usize| {
-        let mut c: Vec<f64> = all.iter().map(|w| w[i]).collect();
-        c.sort_by(f64::total_cmp);
-        (c[c.len() / 2], c[c.len() - 1])
-    };
-    eprintln!(
-        "{} runs: jerk/J median {:.6} max {:.6}; acceleration/A max {:.6}; speed/V max {:.5}; \
-         unchecked periods {unchecked}",
-        all.len(),
-        column(2).0,
-        column(2).1,
-        column(1).1,
-        column(0).1
-    );
-}
-
 /// On a table-tilting 5-axis machine under TCP (joints curved along every move, so no piece
 /// runs faster than planned) holds at several instants, resumed, with the override moved
 /// to 150 % and 40 % on the way: every joint within its limits, the path traced once to
@@ -946,11 +734,7 @@ fn five_axis_holds_and_override() {
     let n = full.len();
     let mut exec = new();
     let mut trace = Trace::new(&exec);
-    exec.command(Command::Load {
-        program: program.into(),
-    })
-    .unwrap();
-    exec.command(Command::CycleStart).unwrap();
+    start(&mut exec, program);
     let holds = [n / 7, 2 * n / 5, 3 * n / 4];
     let mut held = 0;
     for k in 0..20 * n {

@@ -4,7 +4,11 @@
 //! from `$TEZGAH_LINUXCNC_INTERP`, or from `../shared/data/linuxcnc-interp` beside the
 //! repository. Motion calls (and the feed rate in force) must equal LinuxCNC's expected output
 //! within 1e-4; every `bad/` program in scope must fail with LinuxCNC's exact error text.
-//! The lists below say which tests run and why the others do not yet.
+//! The lists below say which tests run and why the others do not yet. The tests are ignored by
+//! a plain `cargo test` (`--include-ignored` runs them, as `.ci/run` does) and fail when the
+//! data is not found.
+
+mod support;
 
 use std::path::{Path, PathBuf};
 
@@ -241,31 +245,6 @@ impl tezgah_gcode::interp::SubroutineLibrary for Folder {
     }
 }
 
-fn data_dir() -> Option<PathBuf> {
-    let candidates = [
-        std::env::var_os("TEZGAH_LINUXCNC_INTERP").map(PathBuf::from),
-        Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/linuxcnc-interp")),
-        Some(PathBuf::from("/work/shared/data/linuxcnc-interp")),
-    ];
-    candidates
-        .into_iter()
-        .flatten()
-        .find(|p| p.join("good").is_dir())
-}
-
-/// Skip (loudly) when the data is absent, unless the environment demands it.
-fn data_or_skip() -> Option<PathBuf> {
-    let dir = data_dir();
-    if dir.is_none() {
-        assert!(
-            std::env::var_os("TEZGAH_REQUIRE_LINUXCNC_DATA").is_none(),
-            "LinuxCNC test data not found: set TEZGAH_LINUXCNC_INTERP"
-        );
-        eprintln!("LinuxCNC interpreter tests skipped: data not found");
-    }
-    dir
-}
-
 fn config(table: Option<&Path>) -> Config {
     let table = table.map_or_else(ToolTable::default, |p| {
         ToolTable::parse(&std::fs::read_to_string(p).unwrap()).unwrap()
@@ -380,8 +359,9 @@ fn compare_motion(ours: &[String], theirs: &[String]) -> Result<usize, String> {
 }
 
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn good_programs_match_linuxcnc() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let mut checked = 0;
     for entry in std::fs::read_dir(dir.join("good")).unwrap() {
         let path = entry.unwrap().path();
@@ -400,8 +380,9 @@ fn good_programs_match_linuxcnc() {
 }
 
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn bad_programs_fail_with_linuxcnc_text() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let (mut checked, mut total) = (0, 0);
     for entry in std::fs::read_dir(dir.join("bad")).unwrap() {
         let path = entry.unwrap().path();
@@ -454,8 +435,9 @@ fn with_stderr(
 /// `m98m99/06-error-mixed-sub-styles`: four programs that mix Fanuc and rs274ngc subroutine
 /// styles, each stopped with LinuxCNC's message; the expected file holds their outputs in turn.
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn mixed_subroutine_styles_fail_as_linuxcnc() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let base = dir.join("m98m99/06-error-mixed-sub-styles");
     let expected = std::fs::read_to_string(base.join("expected")).unwrap();
     let mut theirs = expected_calls(&expected, true).into_iter().peekable();
@@ -491,8 +473,9 @@ fn awk_calls(program: &str) -> (Vec<String>, Result<(), tezgah_gcode::GcodeError
 /// LinuxCNC's output stops. The expected file holds the outputs under `Legal test NAME:` and
 /// `Illegal test NAME:` headings.
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn numbered_main_programs_run_as_linuxcnc() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let base = dir.join("m98m99/11-main-program-oword");
     let expected = std::fs::read_to_string(base.join("expected")).unwrap();
     let mut sections: Vec<(String, Vec<String>)> = Vec::new();
@@ -523,8 +506,9 @@ fn numbered_main_programs_run_as_linuxcnc() {
 /// an INI file that allows Fanuc subprograms, one that refuses them (`DISABLE_FANUC_STYLE_SUB`)
 /// and none. The expected file holds the six outputs under `program: …; INI: …` headings.
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn fanuc_subprograms_can_be_disabled() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let base = dir.join("m98m99/09-disable-fanuc-subs");
     let expected = std::fs::read_to_string(base.join("expected")).unwrap();
     let mut sections: Vec<(String, Vec<String>)> = Vec::new();
@@ -564,8 +548,9 @@ fn fanuc_subprograms_can_be_disabled() {
 /// from the start, unless the INI file sets `DISABLE_G92_PERSISTENCE`, which also clears them
 /// at the program's end. Three runs: persistence on by the INI file, by default, and off.
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn g92_offsets_persist_as_the_ini_file_says() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let base = dir.join("g52/g92-offset-persistence");
     let expected = std::fs::read_to_string(base.join("expected")).unwrap();
     // Each run's output starts again at call number 1.
@@ -607,8 +592,9 @@ fn g92_offsets_persist_as_the_ini_file_says() {
 
 /// `m98m99/13-named-program`: `O<name>` and `O42` titles before the program body.
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn named_programs_run_as_linuxcnc() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let base = dir.join("m98m99/13-named-program");
     let expected = std::fs::read_to_string(base.join("expected")).unwrap();
     let mut theirs = expected_calls(&expected, true).into_iter();
@@ -624,8 +610,9 @@ fn named_programs_run_as_linuxcnc() {
 }
 
 #[test]
+#[ignore = "needs LinuxCNC's interpreter tests: set TEZGAH_LINUXCNC_INTERP (see .ci/run)"]
 fn folder_tests_match_linuxcnc() {
-    let Some(dir) = data_or_skip() else { return };
+    let dir = support::linuxcnc_interp();
     let only = std::env::var("TEZGAH_ONLY").ok();
     for r in RUNS
         .iter()

@@ -6,7 +6,8 @@
 //! name, count and every number (to 1e-4, the precision `rs274` prints).
 //!
 //! The oracle is found through `TEZGAH_RS274`, the path of the wrapper script that
-//! `.ci/install-rs274` writes; without it the test only prints a note. Knobs for exploring:
+//! `.ci/install-rs274` writes; the test is ignored by a plain `cargo test` and fails without it
+//! when run (`--include-ignored`, as in `.ci/run`). Knobs for exploring:
 //! `TEZGAH_ORACLE_CASES` (default 64) and `TEZGAH_ORACLE_SEED` (default a fixed seed, so that CI
 //! runs the same programs every time).
 //!
@@ -15,7 +16,9 @@
 //! When an offset change makes the current point unknown, an arc is preceded by an absolute
 //! `G0` to a known start.
 
-use std::path::{Path, PathBuf};
+mod support;
+
+use std::path::Path;
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -1643,14 +1646,9 @@ fn env_or<T: std::str::FromStr>(name: &str, default: T) -> T {
 }
 
 #[test]
+#[ignore = "needs LinuxCNC's rs274: set TEZGAH_RS274 (see .ci/install-rs274)"]
 fn agrees_with_rs274() {
-    let Some(rs274) = std::env::var_os("TEZGAH_RS274").map(PathBuf::from) else {
-        eprintln!(
-            "note: TEZGAH_RS274 is not set; skipping the differential test against LinuxCNC's \
-             rs274 (install it with .ci/install-rs274)"
-        );
-        return;
-    };
+    let rs274 = support::rs274();
     let dir = std::env::temp_dir().join(format!("tezgah-oracle-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let table = dir.join("tool.tbl");

@@ -12,11 +12,6 @@ use tezgah_motion::verify::{Report, Verifier};
 
 pub const TOL: f64 = 0.01;
 
-/// Jerk margin while re-timing (hold, override, abort): the same finite-difference margin as
-/// everywhere (0.5 %), since the time scale bounds |s⃛| ≤ J at every instant of a period (it
-/// was 3 % while the bound held only at five instants of it; session 4 saw 1.023).
-pub const RETIME_JERK: f64 = 1.005;
-
 pub fn executor() -> Executor {
     let m = Machine::default_machine();
     Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap()
@@ -100,28 +95,33 @@ pub fn run_mdi(exec: &mut Executor, trace: &mut Trace, block: &str) {
     assert_eq!(exec.state(), RunState::Idle);
 }
 
-pub fn run_program(exec: &mut Executor, trace: &mut Trace, program: &str) {
+/// Loads `program` and starts it.
+pub fn start(exec: &mut Executor, program: &str) {
     exec.command(Command::Load {
         program: program.into(),
     })
     .unwrap();
     exec.command(Command::CycleStart).unwrap();
+}
+
+pub fn run_program(exec: &mut Executor, trace: &mut Trace, program: &str) {
+    start(exec, program);
     drive(exec, trace, 2_000_000, |_, _| {});
     assert_eq!(exec.state(), RunState::Idle);
 }
 
-pub fn assert_within_limits(report: &Report) {
-    assert_within(report, 1.005);
-}
+/// The finite differences' margin over a joint limit, as motion's pipeline tests.
+pub const LIMIT_MARGIN: f64 = 1.005;
 
-/// Velocity and acceleration within 0.5 % (the finite differences' margin, as motion's
-/// pipeline tests), jerk within `jerk_ratio`.
-pub fn assert_within(report: &Report, jerk_ratio: f64) {
+/// Velocity, acceleration and jerk within [`LIMIT_MARGIN`] of the joint limits, also while
+/// re-timing (hold, override, abort): the time scale bounds |s⃛| ≤ J at every instant of a
+/// period. Deviation from the planned path within [`TOL`].
+pub fn assert_within_limits(report: &Report) {
     for (i, j) in report.joints.iter().enumerate() {
         assert!(
-            j.velocity <= j.max_velocity * 1.005
-                && j.acceleration <= j.max_acceleration * 1.005
-                && j.jerk <= j.max_jerk * jerk_ratio,
+            j.velocity <= j.max_velocity * LIMIT_MARGIN
+                && j.acceleration <= j.max_acceleration * LIMIT_MARGIN
+                && j.jerk <= j.max_jerk * LIMIT_MARGIN,
             "joint {i}: v {} / {}, a {} / {}, j {} / {} (lines {} {} {})",
             j.velocity,
             j.max_velocity,
@@ -163,6 +163,91 @@ pub fn assert_continuous(out: &[Produced]) {
         assert_eq!(w[1].setpoint.index, w[0].setpoint.index + 1);
     }
 }
+
+/// The program played at 100 % without commands, within every limit and continuous.
+pub fn reference(program: &str) -> Vec<Produced> {
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    run_program(&mut exec, &mut trace, program);
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
+    out
+}
+
+/// The distance a hold at period `at` travelled, the time-optimal jerk-limited stop from the
+/// hold state (speed, and acceleration by backward difference, under the path limits where it
+/// began and ended, and of every piece between), and the allowance the bound adds: two
+/// periods' travel.
+pub struct HoldDistance {
+    pub travelled: f64,
+    pub optimal: f64,
+    pub allowance: f64,
+}
+
+/// Holds at period `at`, checks the stop, resumes; returns the whole trace and, if it held
+/// before the program ended, the hold's distance.
+pub fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldDistance>) {
+    let mut exec = executor();
+    let mut trace = Trace::new(&exec);
+    start(&mut exec, program);
+    // The path limits of every piece the stop passes through: a stop that runs into a piece
+    // of weaker limits (a short arc, a blend) brakes as that piece allows.
+    let mut crossed = vec![];
+    drive(&mut exec, &mut trace, 2_000_000, |k, e| {
+        if k == at {
+            e.command(Command::FeedHold).unwrap();
+        }
+        if k >= at && e.state() != RunState::Held {
+            crossed.extend(e.path_limits());
+        }
+    });
+    let mut distance = None;
+    // Held, or the program ended before the hold.
+    if exec.state() == RunState::Held {
+        let out = &trace.out;
+        let before = &out[at.saturating_sub(1)];
+        let prev = &out[at.saturating_sub(2)];
+        let a = (before.feed - prev.feed) / exec.period();
+        crossed.push(exec.path_limits().expect("held inside a piece"));
+        // Under the limits of the piece where the hold began; if it stopped further on, the
+        // largest of the stops under the limits of each piece it crossed (braking as each
+        // allows lies between them).
+        let optimal = crossed
+            .iter()
+            .map(|l| {
+                tezgah_executor::stop::stopping_distance(
+                    before.feed,
+                    a.clamp(-l.max_acceleration(), l.max_acceleration()),
+                    l.max_acceleration(),
+                    l.max_jerk(),
+                )
+            })
+            .fold(0.0, f64::max);
+        let d = HoldDistance {
+            travelled: out.last().unwrap().path - before.path,
+            optimal,
+            // A period's travel for the command taking hold, and one for the backward
+            // difference's view of the acceleration: a plan already braking at the hold
+            // reads a stop of zero length under its own limits.
+            allowance: 2.0 * before.feed * exec.period() + 1e-9,
+        };
+        distance = Some(d);
+        // Standing: nothing produced while held.
+        assert_eq!(exec.step().unwrap(), None);
+        exec.command(Command::Resume).unwrap();
+        drive(&mut exec, &mut trace, 2_000_000, |_, _| {});
+    }
+    assert_eq!(exec.state(), RunState::Idle);
+    assert_eq!(exec.unchecked_periods(), 0);
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
+    (out, distance)
+}
+
+/// Bound on a hold's distance over the optimum (plus two periods' travel).
+pub const HOLD_RATIO: f64 = 1.2;
 
 struct Lcg(u64);
 impl Lcg {
