@@ -11,10 +11,11 @@
 
 #[path = "../benches/common/mod.rs"]
 mod common;
+mod python_oracle;
+
+use python_oracle::{ask, python};
 
 use std::fmt::Write as _;
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
 
 use tezgah_geom::{ArcLengthMap, Curve, Pose, Vec3};
 use tezgah_kinematics::Machine;
@@ -29,44 +30,7 @@ const STEP: f64 = 0.05;
 const REST_ANGLE: f64 = 175.0;
 
 fn toppra_python() -> std::ffi::OsString {
-    let python = std::env::var_os("TEZGAH_TOPPRA_PYTHON")
-        .expect("TEZGAH_TOPPRA_PYTHON is not set: install TOPP-RA with .ci/install-toppra");
-    let probe = Command::new(&python).args(["-c", "import toppra"]).output();
-    assert!(
-        probe.is_ok_and(|o| o.status.success()),
-        "{python:?} cannot import toppra (see .ci/install-toppra)"
-    );
-    python
-}
-
-/// The issue's mill: every axis 250 mm/s, 2 500 mm/s², 50 000 mm/s³.
-fn machine() -> Machine {
-    let mut m = Machine::default_machine();
-    for j in &mut m.joints {
-        j.max_velocity = 250.0;
-        j.max_acceleration = 2500.0;
-        j.max_jerk = 50_000.0;
-    }
-    m
-}
-
-/// Runs `script` with `input` on stdin and returns its stdout lines.
-fn ask(python: &std::ffi::OsString, script: &str, input: String) -> Vec<String> {
-    let mut child = Command::new(python)
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("start the oracle");
-    let mut stdin = child.stdin.take().unwrap();
-    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let lines: Vec<String> = BufReader::new(child.stdout.take().unwrap())
-        .lines()
-        .map(|l| l.unwrap())
-        .collect();
-    writer.join().unwrap().unwrap();
-    assert!(child.wait().unwrap().success(), "oracle failed");
-    lines
+    python("TEZGAH_TOPPRA_PYTHON", "toppra", ".ci/install-toppra")
 }
 
 /// One programmed segment as points along it, with its feed and end tangents.
@@ -333,7 +297,7 @@ fn helices() -> String {
 }
 
 fn ratio(name: &str, text: &str) -> f64 {
-    let machine = machine();
+    let machine = common::issue_mill();
     let python = toppra_python();
     let b = bound(text, &machine, &python);
     let o = ours(text, &machine);

@@ -18,9 +18,9 @@
 
 #[path = "../benches/common/mod.rs"]
 mod common;
+mod python_oracle;
 
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
+use python_oracle::{ask, python};
 
 use tezgah_geom::{ArcLengthMap, Curve, Move, Vec3};
 use tezgah_kinematics::Machine;
@@ -30,40 +30,6 @@ use tezgah_motion::{Junction, PathItem, SegmentFeed};
 
 /// Waypoint spacing along the path handed to TOPP-RA, mm (at least 8 per segment).
 const STEP: f64 = 0.05;
-
-/// The python in `var`, which must import `module`: panics otherwise.
-fn python(var: &str, module: &str, install: &str) -> std::ffi::OsString {
-    let Some(python) = std::env::var_os(var) else {
-        panic!("{var} is not set: install {module} with {install}");
-    };
-    let probe = Command::new(&python)
-        .args(["-c", &format!("import {module}")])
-        .output();
-    assert!(
-        probe.is_ok_and(|o| o.status.success()),
-        "{python:?} cannot import {module} (see {install})"
-    );
-    python
-}
-
-/// Runs `script` with `input` on stdin and returns its stdout lines.
-fn ask(python: &std::ffi::OsString, script: &str, input: String) -> Vec<String> {
-    let mut child = Command::new(python)
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("start the oracle");
-    let mut stdin = child.stdin.take().unwrap();
-    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
-    let lines: Vec<String> = BufReader::new(child.stdout.take().unwrap())
-        .lines()
-        .map(|l| l.unwrap())
-        .collect();
-    writer.join().unwrap().unwrap();
-    assert!(child.wait().unwrap().success(), "oracle failed");
-    lines
-}
 
 fn moves_of(text: &str) -> Vec<Move> {
     // The demo's tool table, for the demo (the other programs use no tool).

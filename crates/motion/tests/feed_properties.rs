@@ -137,15 +137,9 @@ fn check(moves: &[Move], machine: &Machine) {
     );
 }
 
-/// The issue's mill (250 mm/s, 2 500 mm/s², 50 000 mm/s³) and the built-in one.
+/// The issue's mill and the built-in one.
 fn machines() -> [Machine; 2] {
-    let mut fast = Machine::default_machine();
-    for j in &mut fast.joints {
-        j.max_velocity = 250.0;
-        j.max_acceleration = 2500.0;
-        j.max_jerk = 50_000.0;
-    }
-    [fast, Machine::default_machine()]
+    [common::issue_mill(), Machine::default_machine()]
 }
 
 proptest! {

@@ -99,6 +99,18 @@ pub fn smooth_items(moves: &[Move], machine: &Machine) -> Vec<PathItem> {
     .unwrap()
 }
 
+/// The mill of issue 22's figures: `mill3` with every axis at 250 mm/s, 2 500 mm/s²,
+/// 50 000 mm/s³.
+pub fn issue_mill() -> Machine {
+    let mut m = Machine::default_machine();
+    for j in &mut m.joints {
+        j.max_velocity = 250.0;
+        j.max_acceleration = 2500.0;
+        j.max_jerk = 50_000.0;
+    }
+    m
+}
+
 pub fn plan_options(machine: &Machine) -> PlanOptions {
     PlanOptions {
         period: machine.motion.period_s,

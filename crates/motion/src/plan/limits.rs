@@ -66,6 +66,16 @@ impl Default for PlanOptions {
 }
 
 impl PlanOptions {
+    /// The share of each joint's acceleration and jerk a segment may use: all of it, or what
+    /// the junction reserve leaves where one is `kept`.
+    pub fn budget(&self, kept: bool) -> f64 {
+        if kept {
+            1.0 - self.junction_reserve
+        } else {
+            1.0
+        }
+    }
+
     /// Checks every option; the error names the bad one.
     pub fn validate(&self) -> Result<(), PlanError> {
         let unit = |name, v: f64, open_low: bool| {
@@ -656,11 +666,7 @@ fn limits_for_change(
     change: f64,
 ) -> Result<SegmentLimits, PlanError> {
     let n = machine.joint_count().min(MAX_JOINTS);
-    let budget = if reserve {
-        1.0 - options.junction_reserve
-    } else {
-        1.0
-    };
+    let budget = options.budget(reserve);
     let curved = geom.curved();
     let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
     let mut by = LimitedBy::JointVelocity;
@@ -717,14 +723,7 @@ fn limits_for_change(
         by = LimitedBy::Idle;
     }
     if curved && v.is_finite() {
-        let budgets = Budgets {
-            cells: &geom.cells,
-            acceleration: std::array::from_fn(|i| {
-                budget * machine.max_acceleration.get(i).copied().unwrap_or(0.0)
-            }),
-            jerk: std::array::from_fn(|i| budget * machine.max_jerk.get(i).copied().unwrap_or(0.0)),
-            n,
-        };
+        let budgets = Budgets::new(&geom.cells, machine, options, reserve);
         (v, a, j) =
             best_split(v, geom.length, change, &budgets).ok_or_else(|| PlanError::NoLimit {
                 line: seg.line,
@@ -751,6 +750,21 @@ struct Budgets<'a> {
     acceleration: [f64; MAX_JOINTS],
     jerk: [f64; MAX_JOINTS],
     n: usize,
+}
+
+impl<'a> Budgets<'a> {
+    /// The joints' acceleration and jerk, less the junction reserve where one is `kept`.
+    fn new(cells: &'a Cells, machine: &PlanMachine, options: &PlanOptions, kept: bool) -> Self {
+        let b = options.budget(kept);
+        let scaled =
+            |limits: &[f64]| std::array::from_fn(|i| b * limits.get(i).copied().unwrap_or(0.0));
+        Budgets {
+            cells,
+            acceleration: scaled(&machine.max_acceleration),
+            jerk: scaled(&machine.max_jerk),
+            n: machine.joint_count().min(MAX_JOINTS),
+        }
+    }
 }
 
 /// Fractions of the top speed [`best_split`] tries (a speed just under the curvature limit
@@ -890,19 +904,7 @@ pub fn ladder(
     if !geom.curved() || geom.rotary_only {
         return vec![];
     }
-    let budget = if reserve {
-        1.0 - options.junction_reserve
-    } else {
-        1.0
-    };
-    let budgets = Budgets {
-        cells: &geom.cells,
-        acceleration: std::array::from_fn(|i| {
-            budget * machine.max_acceleration.get(i).copied().unwrap_or(0.0)
-        }),
-        jerk: std::array::from_fn(|i| budget * machine.max_jerk.get(i).copied().unwrap_or(0.0)),
-        n: machine.joint_count().min(MAX_JOINTS),
-    };
+    let budgets = Budgets::new(&geom.cells, machine, options, reserve);
     let top = cruise.max_velocity();
     let mut steps = vec![];
     let mut from = from.max(0.0);

@@ -98,6 +98,30 @@ struct Open {
     last_end_cap: f64,
 }
 
+impl Open {
+    /// A group of one stretch `range` of `seg` (its own path coordinate) under `limits`.
+    fn new(
+        seg: Arc<Segment>,
+        range: (f64, f64),
+        limits: &Limits,
+        geom: Geometry,
+        end_cap: f64,
+        partial_end: bool,
+    ) -> Open {
+        Open {
+            segments: vec![seg],
+            starts: vec![range.0],
+            ends: vec![range.1],
+            partial_end,
+            v: limits.max_velocity(),
+            a: limits.max_acceleration(),
+            j: limits.max_jerk(),
+            last: geom,
+            last_end_cap: end_cap,
+        }
+    }
+}
+
 /// The last segment pushed, held until the next one decides its end junction.
 struct Held {
     seg: Segment,
@@ -307,21 +331,14 @@ impl Planner {
         for (k, (d, limits)) in spans.into_iter().enumerate() {
             let end = if k == last { geom.length } else { at + d };
             let cap = if k == last { end_cap } else { f64::INFINITY };
-            if let Some(o) = self.open.take() {
-                let cap = o.last_end_cap;
-                self.close(o, cap)?;
-            }
-            self.open = Some(Open {
-                segments: vec![seg.clone()],
-                starts: vec![at],
-                ends: vec![end],
-                partial_end: k != last,
-                v: limits.max_velocity(),
-                a: limits.max_acceleration(),
-                j: limits.max_jerk(),
-                last: geom,
-                last_end_cap: cap,
-            });
+            self.open_anew(Open::new(
+                seg.clone(),
+                (at, end),
+                &limits,
+                geom,
+                cap,
+                k != last,
+            ))?;
             at = end;
         }
         // The last step ends the segment: the next may join it only as any segment would.
@@ -372,27 +389,23 @@ impl Planner {
                 self.open = Some(o);
             }
             other => {
-                if let Some(o) = other {
-                    let cap = o.last_end_cap;
-                    self.close(o, cap)?;
-                }
-                self.open = Some(Open {
-                    segments: vec![seg],
-                    starts: vec![range.0],
-                    ends: vec![range.1],
-                    partial_end: false,
-                    v,
-                    a,
-                    j,
-                    last: geom,
-                    last_end_cap: end_cap,
-                });
+                self.open = other;
+                self.open_anew(Open::new(seg, range, &sl.limits, geom, end_cap, false))?;
             }
         }
         if end_cap <= 0.0 {
             if let Some(o) = self.open.take() {
                 self.close(o, 0.0)?;
             }
+        }
+        Ok(())
+    }
+
+    /// Closes the open group at its last junction's cap and opens `o` in its place.
+    fn open_anew(&mut self, o: Open) -> Result<(), PlanError> {
+        if let Some(old) = self.open.replace(o) {
+            let cap = old.last_end_cap;
+            self.close(old, cap)?;
         }
         Ok(())
     }
