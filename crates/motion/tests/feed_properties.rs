@@ -115,21 +115,7 @@ fn check(moves: &[Move], machine: &Machine) {
     )
     .unwrap();
     let report = verifier.finish();
-    for (i, j) in report.joints.iter().enumerate() {
-        assert!(
-            j.worst_ratio() <= 1.005,
-            "joint {i}: v {}/{} a {}/{} j {}/{} (lines {} {} {})",
-            j.velocity,
-            j.max_velocity,
-            j.acceleration,
-            j.max_acceleration,
-            j.jerk,
-            j.max_jerk,
-            j.velocity_line,
-            j.acceleration_line,
-            j.jerk_line
-        );
-    }
+    common::assert_joints_within(&report);
     assert!(
         report.max_deviation + off <= tolerance * (1.0 + 1e-9),
         "samples {} mm off the smoothed path, which is {off} mm off the program",

@@ -3,6 +3,9 @@
 //! tip within the tolerance, block ends hit exactly, and for G61.1 the cycle time equal to the
 //! sum of the per-block optimal profile durations.
 
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use proptest::prelude::*;
 use tezgah_geom::{ArcMove, FeedMode, Move, MoveKind, PathMode, Plane, Pose, ToolControl, Vec3};
 use tezgah_kinematics::Machine;
@@ -72,21 +75,7 @@ fn run_under(machine: &Machine, moves: &[Move], control: ToolControl) -> Out {
 }
 
 fn assert_within_limits(out: &Out) {
-    for (i, j) in out.report.joints.iter().enumerate() {
-        assert!(
-            j.worst_ratio() <= 1.005,
-            "joint {i}: v {} / {}, a {} / {}, j {} / {} (lines {} {} {})",
-            j.velocity,
-            j.max_velocity,
-            j.acceleration,
-            j.max_acceleration,
-            j.jerk,
-            j.max_jerk,
-            j.velocity_line,
-            j.acceleration_line,
-            j.jerk_line
-        );
-    }
+    common::assert_joints_within(&out.report);
     assert!(
         out.report.max_deviation <= TOL,
         "deviation {} at line {}",

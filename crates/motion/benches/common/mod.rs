@@ -111,6 +111,26 @@ pub fn issue_mill() -> Machine {
     m
 }
 
+/// Every joint's peak velocity, acceleration and jerk (finite differences at the period)
+/// within 0.5 % of its limit, else a panic naming the joint, the peaks and their lines.
+pub fn assert_joints_within(report: &tezgah_motion::verify::Report) {
+    for (i, j) in report.joints.iter().enumerate() {
+        assert!(
+            j.worst_ratio() <= 1.005,
+            "joint {i}: v {} / {}, a {} / {}, j {} / {} (lines {} {} {})",
+            j.velocity,
+            j.max_velocity,
+            j.acceleration,
+            j.max_acceleration,
+            j.jerk,
+            j.max_jerk,
+            j.velocity_line,
+            j.acceleration_line,
+            j.jerk_line
+        );
+    }
+}
+
 pub fn plan_options(machine: &Machine) -> PlanOptions {
     PlanOptions {
         period: machine.motion.period_s,
