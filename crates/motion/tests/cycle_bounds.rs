@@ -245,11 +245,21 @@ fn ours(text: &str, machine: &Machine) -> f64 {
 /// Dense surfacing as a CAM system writes it: zig-zag passes 100 mm long, 0.7 mm apart, of G1
 /// moves 0.05–0.3 mm long over a free-form surface, F6000, G64 P0.01.
 fn dense_surfacing(passes: usize) -> String {
-    let mut rng = common::Rng(0x5eed_f0f0_1234);
-    let z = |x: f64, y: f64| {
+    surfacing(passes, |x, y| {
         3.0 * (x / 13.0).sin() * (y / 17.0).cos()
             + 1.5 * (-((x - 60.0).powi(2) + (y - 40.0).powi(2)) / 300.0).exp()
-    };
+    })
+}
+
+/// The same passes over a wavy surface, z = 2 sin(x/3) cos(y/17): a crest every 19 mm, where
+/// the curvature's rate keeps the speed near 90 mm/s and the feed asks for 100.
+fn wavy_surfacing(passes: usize) -> String {
+    surfacing(passes, |x, y| 2.0 * (x / 3.0).sin() * (y / 17.0).cos())
+}
+
+/// Zig-zag passes of short G1 moves over the surface z(x, y).
+fn surfacing(passes: usize, z: impl Fn(f64, f64) -> f64) -> String {
+    let mut rng = common::Rng(0x5eed_f0f0_1234);
     let mut s = String::from("G21 G90 G94 G17\nG64 P0.01\nF6000\n");
     let _ = writeln!(s, "G1 X0 Y0 Z{:.4}", z(0.0, 0.0));
     for p in 0..passes {
@@ -311,7 +321,7 @@ fn ratio(name: &str, text: &str) -> f64 {
 fn dense_surfacing_near_the_bound() {
     let r = ratio("dense surfacing", &dense_surfacing(6));
     assert!(r >= 0.99, "below the bound: {r}");
-    // 1.112 measured (1.115 before).
+    // 1.109 measured (1.115 before the limits went point by point).
     assert!(r <= 1.15, "ratio {r}");
 }
 
@@ -320,10 +330,10 @@ fn dense_surfacing_near_the_bound() {
 fn lines_with_fillets_near_the_bound() {
     let r = ratio("lines with fillets", &lines_with_fillets());
     assert!(r >= 0.99, "below the bound: {r}");
-    // 1.100 measured (1.249 before the planner's limits went point by point and tangent
+    // 1.089 measured (1.249 before the planner's limits went point by point and tangent
     // junctions were blended); the goal is 1.06: the jerk-limited transitions into the R2 and
     // R4 fillets (a curvature step spread over ~0.5 mm) are what is left.
-    assert!(r <= 1.11, "ratio {r}");
+    assert!(r <= 1.10, "ratio {r}");
 }
 
 #[test]
@@ -331,9 +341,19 @@ fn lines_with_fillets_near_the_bound() {
 fn helices_near_the_bound() {
     let r = ratio("helices", &helices());
     assert!(r >= 0.99, "below the bound: {r}");
-    // 1.116 measured (1.225 before the speed steps); the goal is 1.02: each speed step's
+    // 1.112 measured (1.225 before the speed steps); the goal is 1.02: each speed step's
     // profile starts and ends at zero acceleration, and the cross term 3|q''|·v·a is charged
     // at the corner of the (v, a) box, so the climb to the curvature limit is slower than the
     // phase-plane bound.
     assert!(r <= 1.13, "ratio {r}");
+}
+
+#[test]
+#[ignore = "needs TOPP-RA: set TEZGAH_TOPPRA_PYTHON (.ci/install-toppra)"]
+fn wavy_surfacing_near_the_bound() {
+    let r = ratio("wavy surfacing", &wavy_surfacing(2));
+    assert!(r >= 0.99, "below the bound: {r}");
+    // 1.225 measured (1.361 when every segment kept acceleration for a quarter of its speed at
+    // each end, whatever its neighbours): the goal is 1.15 as for dense surfacing.
+    assert!(r <= 1.23, "ratio {r}");
 }

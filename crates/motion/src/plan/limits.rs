@@ -569,6 +569,10 @@ pub struct SegmentLimits {
     pub limits: Limits,
     /// What set the speed limit (for reports).
     pub by: LimitedBy,
+    /// The speed at which the segment just fits with no acceleration left (the least of the
+    /// maximum-velocity curve over it, the feed, the joints' speeds and the chord error): what
+    /// its neighbours may expect to meet it at.
+    pub top: f64,
 }
 
 /// The binding speed limit of a segment.
@@ -623,15 +627,29 @@ pub fn segment_limits_at_feed(
     reserve: bool,
     feed_scale: f64,
 ) -> Result<SegmentLimits, PlanError> {
-    limits_for_change(
-        seg,
-        geom,
-        machine,
-        options,
-        reserve,
-        feed_scale,
-        REFERENCE_CHANGE,
-    )
+    limits_for_change(seg, geom, machine, options, reserve, feed_scale, |_| {
+        (REFERENCE_CHANGE, REFERENCE_CHANGE)
+    })
+}
+
+/// [`segment_limits`] for a segment whose neighbours let it be entered at about `ends.0` and
+/// left at about `ends.1` (the junction caps and the neighbours' [`SegmentLimits::top`]): the
+/// split keeps acceleration for the speed changes those ends ask for, and no more. A segment
+/// at a minimum of the maximum-velocity curve, between faster ones, thus runs close to that
+/// curve and its neighbours change the speed (the optimum touches the limit curve at its
+/// minima; Bobrow, Dubowsky & Gibson 1985, §4).
+pub fn segment_limits_between(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+    ends: (f64, f64),
+) -> Result<SegmentLimits, PlanError> {
+    let change = |top: f64, end: f64| (1.0 - end / top).clamp(MIN_CHANGE, 1.0);
+    limits_for_change(seg, geom, machine, options, reserve, 1.0, |top| {
+        (change(top, ends.0), change(top, ends.1))
+    })
 }
 
 /// The limits of the cruise between a curved segment's speed steps ([`ladder`]): the steps
@@ -644,18 +662,14 @@ pub fn cruise_limits(
     options: &PlanOptions,
     reserve: bool,
 ) -> Result<SegmentLimits, PlanError> {
-    limits_for_change(
-        seg,
-        geom,
-        machine,
-        options,
-        reserve,
-        1.0,
-        1.0 - LADDER[LADDER.len() - 1],
-    )
+    limits_for_change(seg, geom, machine, options, reserve, 1.0, |_| {
+        let c = 1.0 - LADDER[LADDER.len() - 1];
+        (c, c)
+    })
 }
 
-/// [`segment_limits_at_feed`] with the split chosen for ramps of `change`·V at the ends.
+/// [`segment_limits_at_feed`] with the split chosen for ramps of `change(top)`·V at the start
+/// and at the end, `top` the speed at which the segment just fits.
 fn limits_for_change(
     seg: &Segment,
     geom: &Geometry,
@@ -663,8 +677,52 @@ fn limits_for_change(
     options: &PlanOptions,
     reserve: bool,
     feed_scale: f64,
-    change: f64,
+    change: impl Fn(f64) -> (f64, f64),
 ) -> Result<SegmentLimits, PlanError> {
+    let (top, mut a, mut j, by) = top_speed(seg, geom, machine, options, reserve, feed_scale);
+    let mut v = top;
+    if geom.curved() && v.is_finite() {
+        let budgets = Budgets::new(&geom.cells, machine, options, reserve);
+        (v, a, j) =
+            best_split(v, geom.length, change(v), &budgets).ok_or_else(|| PlanError::NoLimit {
+                line: seg.line,
+                reason: "no acceleration is left at any speed".into(),
+            })?;
+    }
+    if !a.is_finite() {
+        a = options.idle_rotary[1];
+    }
+    if !j.is_finite() {
+        j = options.idle_rotary[2];
+    }
+    let limits = Limits::new(v, a, j).map_err(|e| PlanError::NoLimit {
+        line: seg.line,
+        reason: e.to_string(),
+    })?;
+    Ok(SegmentLimits { limits, by, top })
+}
+
+/// The speed a segment is passed at most (see [`SegmentLimits::top`]), what set it, and on a
+/// straight segment the path acceleration and jerk (∞ where no joint moves).
+pub fn segment_top(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+) -> f64 {
+    top_speed(seg, geom, machine, options, false, 1.0).0
+}
+
+/// [`segment_top`] with the budget of `reserve` and the feed scaled by `feed_scale`: (V, A,
+/// J, what set V), A and J only for a straight segment.
+fn top_speed(
+    seg: &Segment,
+    geom: &Geometry,
+    machine: &PlanMachine,
+    options: &PlanOptions,
+    reserve: bool,
+    feed_scale: f64,
+) -> (f64, f64, f64, LimitedBy) {
     let n = machine.joint_count().min(MAX_JOINTS);
     let budget = options.budget(reserve);
     let curved = geom.curved();
@@ -722,25 +780,7 @@ fn limits_for_change(
         v = options.idle_rotary[0].min(feed);
         by = LimitedBy::Idle;
     }
-    if curved && v.is_finite() {
-        let budgets = Budgets::new(&geom.cells, machine, options, reserve);
-        (v, a, j) =
-            best_split(v, geom.length, change, &budgets).ok_or_else(|| PlanError::NoLimit {
-                line: seg.line,
-                reason: "no acceleration is left at any speed".into(),
-            })?;
-    }
-    if !a.is_finite() {
-        a = options.idle_rotary[1];
-    }
-    if !j.is_finite() {
-        j = options.idle_rotary[2];
-    }
-    let limits = Limits::new(v, a, j).map_err(|e| PlanError::NoLimit {
-        line: seg.line,
-        reason: e.to_string(),
-    })?;
-    Ok(SegmentLimits { limits, by })
+    (v, a, j, by)
 }
 
 /// The joint budgets of a curved segment, point by point.
@@ -775,18 +815,22 @@ const SPEED_FRACTIONS: [f64; 12] = [
 /// Fractions of the acceleration left at a speed that [`best_split`] tries (the rest of the
 /// jerk budget then goes to the path jerk through the cross term 3|q''|·V·A).
 const ACCEL_FRACTIONS: [f64; 5] = [1.0, 0.7, 0.45, 0.25, 0.1];
-/// Speed change, as a share of the speed, assumed at each end of the segment.
+/// Speed change, as a share of the speed, assumed at each end of a segment whose neighbours
+/// are not known.
 const REFERENCE_CHANGE: f64 = 0.25;
+/// The least speed change, as a share of the speed, a segment keeps acceleration for (the
+/// profile's own rounding, and a neighbour that turns out a little slower than expected).
+const MIN_CHANGE: f64 = 0.1;
 
 /// The (V, A, J) that covers the segment fastest: V ≤ `top`, and for V and A every
 /// point and joint within its budgets (see [`segment_limits`]). The time is the cruise L/V
-/// plus, at each end, what a jerk-limited ramp of `REFERENCE_CHANGE`·V costs over cruising
+/// plus, at each end, what a jerk-limited ramp of `change`·V (start, end) costs over cruising
 /// (half its duration times the change's share of V). `None` if no speed leaves room for
 /// acceleration.
 fn best_split(
     top: f64,
     length: f64,
-    change: f64,
+    change: (f64, f64),
     budgets: &Budgets<'_>,
 ) -> Option<(f64, f64, f64)> {
     // The segment's own length: a short one alone between others of other limits (a tight
@@ -802,7 +846,8 @@ fn best_split(
         // The acceleration is shared for a ramp through the whole speed (a group's ends are
         // often far below its cruise: corners, stops); the speed for a change of a quarter.
         if let Some((a, j, _)) = at_speed(v, v, budgets) {
-            let time = reference / v + ramp_time(change * v, a, j) * change;
+            let ramp = |c: f64| 0.5 * c * ramp_time(c * v, a, j);
+            let time = reference / v + ramp(change.0) + ramp(change.1);
             if best.is_none_or(|(t, _)| time < t) {
                 best = Some((time, (v, a, j)));
                 worse = 0;
@@ -876,7 +921,7 @@ fn ramp_time(dv: f64, a: f64, j: f64) -> f64 {
 }
 
 /// Speeds, as shares of a curved segment's cruise speed, of the steps [`ladder`] climbs by.
-const LADDER: [f64; 3] = [0.55, 0.75, 0.9];
+const LADDER: [f64; 4] = [0.55, 0.75, 0.9, 0.97];
 /// A step is kept only where it accelerates at least this many times faster than the cruise.
 const LADDER_GAIN: f64 = 2.0;
 /// A step must rise at least this share above the speed it starts from.

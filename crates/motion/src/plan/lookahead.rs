@@ -13,8 +13,8 @@ use std::sync::Arc;
 
 use super::joints::PlanMachine;
 use super::limits::{
-    analyse, cruise_limits, has_jump, inside_group, junction_cap, ladder, segment_limits, Geometry,
-    PlanOptions, SegmentLimits,
+    analyse, cruise_limits, has_jump, inside_group, junction_cap, ladder, segment_limits_between,
+    segment_top, Geometry, PlanOptions, SegmentLimits,
 };
 use super::PlanError;
 use crate::path::{Junction, PathItem, Segment};
@@ -129,11 +129,10 @@ struct Held {
     /// A jump at its start costs it a jerk reserve.
     jump: bool,
     /// The most it can be entered at: the cap of the junction at its start and the previous
-    /// segment's own speed limit (0 after a rest).
+    /// segment's top speed ([`SegmentLimits::top`]; 0 after a rest).
     start_cap: f64,
-    /// Its limits without a reserve, once computed (a junction check needs them, and `add`
-    /// can reuse them when no reserve is kept).
-    free: Option<SegmentLimits>,
+    /// Its top speed ([`SegmentLimits::top`]), once computed (a junction check needs it).
+    top: Option<f64>,
 }
 
 /// The streaming planner: `push` path items, take [`Planned`] items with `pop`.
@@ -210,11 +209,11 @@ impl Planner {
         if geom.length <= 0.0 {
             return Ok(());
         }
-        let mut free = None;
+        let mut top_here = None;
         let (start_jump, start_cap) = match self.pending.take() {
             Some(mut held) => {
                 // The junction's cap, whether it jumps, and the slower of the two segments'
-                // speed limits there (how fast the junction can be passed at most).
+                // top speeds there (how fast the junction can be passed at most).
                 let (cap, jump, through) = match held.seg.end {
                     Junction::Corner | Junction::Stop => (0.0, false, 0.0),
                     Junction::Tangent | Junction::Smooth => {
@@ -222,17 +221,11 @@ impl Planner {
                         let jump = has_jump(&held.geom, &geom, &self.machine);
                         // A jump that allows only a crawl is cheaper as a stop: no reserve
                         // is then kept on the two segments.
-                        let before = match held.free {
-                            Some(l) => l,
-                            None => self.free_limits(&held.seg, &held.geom)?,
-                        };
-                        let after = self.free_limits(&seg, &geom)?;
-                        held.free = Some(before);
-                        free = Some(after);
-                        let slower = before
-                            .limits
-                            .max_velocity()
-                            .min(after.limits.max_velocity());
+                        let before = held.top.unwrap_or_else(|| self.top(&held.seg, &held.geom));
+                        let after = self.top(&seg, &geom);
+                        held.top = Some(before);
+                        top_here = Some(after);
+                        let slower = before.min(after);
                         let floor = self.options.min_junction_share * slower;
                         if jump && cap < floor {
                             (0.0, false, 0.0)
@@ -252,7 +245,7 @@ impl Planner {
             geom,
             jump: start_jump,
             start_cap,
-            free,
+            top: top_here,
         });
         Ok(())
     }
@@ -269,13 +262,13 @@ impl Planner {
         Ok(())
     }
 
-    /// A segment's limits when no jerk reserve is kept at its junctions.
-    fn free_limits(&self, seg: &Segment, geom: &Geometry) -> Result<SegmentLimits, PlanError> {
-        segment_limits(seg, geom, &self.machine, &self.options, false)
+    /// A segment's top speed ([`SegmentLimits::top`]).
+    fn top(&self, seg: &Segment, geom: &Geometry) -> f64 {
+        segment_top(seg, geom, &self.machine, &self.options)
     }
 
     /// Adds the held segment, `end_cap` the cap of its end junction and `end_speed` the most
-    /// it can be left at (the cap, and the next segment's own limit).
+    /// it can be left at (the cap, and the next segment's top speed).
     fn add(
         &mut self,
         held: Held,
@@ -286,14 +279,17 @@ impl Planner {
         let Held {
             seg,
             geom,
-            free,
             start_cap,
             ..
         } = held;
-        let sl = match free {
-            Some(l) if !reserve => l,
-            _ => segment_limits(&seg, &geom, &self.machine, &self.options, reserve)?,
-        };
+        let sl = segment_limits_between(
+            &seg,
+            &geom,
+            &self.machine,
+            &self.options,
+            reserve,
+            (start_cap, end_speed),
+        )?;
         // With speed steps at its ends, the cruise only changes speed by the last step.
         let cruise = if may_step(&geom, &sl.limits, &self.machine, start_cap.min(end_speed)) {
             cruise_limits(&seg, &geom, &self.machine, &self.options, reserve)?
@@ -539,7 +535,7 @@ impl Planner {
 /// takes at most an eighth of it. A quick test before the steps are worked out.
 fn may_step(geom: &Geometry, limits: &Limits, machine: &PlanMachine, slowest: f64) -> bool {
     let v = limits.max_velocity();
-    if !geom.curved() || geom.rotary_only || slowest >= 0.9 * v {
+    if !geom.curved() || geom.rotary_only || slowest >= 0.97 * v {
         return false;
     }
     let straight = (0..machine.joint_count().min(geom.g1.len()))
