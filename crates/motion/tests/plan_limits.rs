@@ -139,6 +139,7 @@ fn limits_hold_every_cartesian_joint_on_random_curved_segments() {
                 .unwrap()
                 .limits;
             let (v, a, j) = (l.max_velocity(), l.max_acceleration(), l.max_jerk());
+            let p = speed_times_acceleration(v, a, j);
             assert!(v <= feed * (1.0 + 1e-12));
             let budget = if reserve {
                 1.0 - options.junction_reserve
@@ -151,9 +152,8 @@ fn limits_hold_every_cartesian_joint_on_random_curved_segments() {
                     let vel = q1[i].abs() * v / pm.max_velocity[i];
                     let acc =
                         (q2[i].abs() * v * v + q1[i].abs() * a) / (budget * pm.max_acceleration[i]);
-                    let jerk =
-                        (q3[i].abs() * v * v * v + 3.0 * q2[i].abs() * v * a + q1[i].abs() * j)
-                            / (budget * pm.max_jerk[i]);
+                    let jerk = (q3[i].abs() * v * v * v + 3.0 * q2[i].abs() * p + q1[i].abs() * j)
+                        / (budget * pm.max_jerk[i]);
                     worst = worst.max(vel).max(acc).max(jerk);
                     assert!(
                         vel <= 1.0 + 1e-9
@@ -168,6 +168,20 @@ fn limits_hold_every_cartesian_joint_on_random_curved_segments() {
     }
     // The bound is not slack everywhere: some case uses most of a limit.
     assert!(worst > 0.9, "worst use of a limit {worst}");
+}
+
+/// The largest v·|a| of a jerk-limited profile under (V, A, J) that starts and ends at zero
+/// acceleration: where |a| = α its speed is at most V − α²/(2J) (the acceleration must return
+/// to zero before the speed passes V, or left zero that much earlier on the way down). Found
+/// here by sampling α, the planner's closed form being what is checked.
+fn speed_times_acceleration(v: f64, a: f64, j: f64) -> f64 {
+    let top = a.min((2.0 * j * v).sqrt());
+    (0..=100_000)
+        .map(|k| {
+            let alpha = top * k as f64 / 100_000.0;
+            (v - alpha * alpha / (2.0 * j)) * alpha
+        })
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -205,13 +219,16 @@ fn tight_corner_blends_get_the_pure_curvature_speed() {
             v <= cap * (1.0 + 1e-12) && v >= 0.75 * cap,
             "h {h} turn {deg}°: V {v} against the curvature cap {cap}"
         );
-        // Point by point, every joint within its acceleration and jerk at the box's corner.
+        // Point by point, every joint within its acceleration and jerk where a profile under
+        // (V, A, J) is fastest with the most acceleration.
+        let p = speed_times_acceleration(v, a, j);
         for cell in &geom.cells {
             for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(3) {
                 let acc = g2 * v * v + g1 * a;
-                let jerk = g3 * v * v * v + 3.0 * g2 * v * a + g1 * j;
+                let jerk = g3 * v * v * v + 3.0 * g2 * p + g1 * j;
                 assert!(acc <= pm.max_acceleration[i] * (1.0 + 1e-12), "a {acc}");
-                assert!(jerk <= pm.max_jerk[i] * (1.0 + 1e-12), "j {jerk}");
+                // (The sampled peak is within ~1e-10 of the true one.)
+                assert!(jerk <= pm.max_jerk[i] * (1.0 + 1e-9), "j {jerk}");
             }
         }
     }

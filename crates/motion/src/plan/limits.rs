@@ -628,7 +628,11 @@ pub fn segment_limits_at_feed(
     feed_scale: f64,
 ) -> Result<SegmentLimits, PlanError> {
     limits_for_change(seg, geom, machine, options, reserve, feed_scale, |_| {
-        (REFERENCE_CHANGE, REFERENCE_CHANGE)
+        Changes {
+            start: REFERENCE_CHANGE,
+            end: REFERENCE_CHANGE,
+            ramp: 1.0,
+        }
     })
 }
 
@@ -648,7 +652,12 @@ pub fn segment_limits_between(
 ) -> Result<SegmentLimits, PlanError> {
     let change = |top: f64, end: f64| (1.0 - end / top).clamp(MIN_CHANGE, 1.0);
     limits_for_change(seg, geom, machine, options, reserve, 1.0, |top| {
-        (change(top, ends.0), change(top, ends.1))
+        let (start, end) = (change(top, ends.0), change(top, ends.1));
+        Changes {
+            start,
+            end,
+            ramp: start.max(end),
+        }
     })
 }
 
@@ -664,7 +673,11 @@ pub fn cruise_limits(
 ) -> Result<SegmentLimits, PlanError> {
     limits_for_change(seg, geom, machine, options, reserve, 1.0, |_| {
         let c = 1.0 - LADDER[LADDER.len() - 1];
-        (c, c)
+        Changes {
+            start: c,
+            end: c,
+            ramp: 1.0,
+        }
     })
 }
 
@@ -677,7 +690,7 @@ fn limits_for_change(
     options: &PlanOptions,
     reserve: bool,
     feed_scale: f64,
-    change: impl Fn(f64) -> (f64, f64),
+    change: impl Fn(f64) -> Changes,
 ) -> Result<SegmentLimits, PlanError> {
     let (top, mut a, mut j, by) = top_speed(seg, geom, machine, options, reserve, feed_scale);
     let mut v = top;
@@ -807,6 +820,16 @@ impl<'a> Budgets<'a> {
     }
 }
 
+/// The speed changes a segment's split is chosen for, as shares of its speed: at its start,
+/// at its end, and the one its acceleration and jerk are shared for (a cruise between speed
+/// steps keeps them for a stop that may follow).
+#[derive(Debug, Clone, Copy)]
+struct Changes {
+    start: f64,
+    end: f64,
+    ramp: f64,
+}
+
 /// Fractions of the top speed [`best_split`] tries (a speed just under the curvature limit
 /// leaves almost no acceleration; the finest steps are near 1, where a long arc runs).
 const SPEED_FRACTIONS: [f64; 12] = [
@@ -820,7 +843,7 @@ const ACCEL_FRACTIONS: [f64; 5] = [1.0, 0.7, 0.45, 0.25, 0.1];
 const REFERENCE_CHANGE: f64 = 0.25;
 /// The least speed change, as a share of the speed, a segment keeps acceleration for (the
 /// profile's own rounding, and a neighbour that turns out a little slower than expected).
-const MIN_CHANGE: f64 = 0.1;
+const MIN_CHANGE: f64 = 0.05;
 
 /// The (V, A, J) that covers the segment fastest: V ≤ `top`, and for V and A every
 /// point and joint within its budgets (see [`segment_limits`]). The time is the cruise L/V
@@ -830,7 +853,7 @@ const MIN_CHANGE: f64 = 0.1;
 fn best_split(
     top: f64,
     length: f64,
-    change: (f64, f64),
+    change: Changes,
     budgets: &Budgets<'_>,
 ) -> Option<(f64, f64, f64)> {
     // The segment's own length: a short one alone between others of other limits (a tight
@@ -843,11 +866,9 @@ fn best_split(
     let mut worse = 0;
     for beta in SPEED_FRACTIONS {
         let v = beta * top;
-        // The acceleration is shared for a ramp through the whole speed (a group's ends are
-        // often far below its cruise: corners, stops); the speed for a change of a quarter.
-        if let Some((a, j, _)) = at_speed(v, v, budgets) {
+        if let Some((a, j, _)) = at_speed(v, change.ramp * v, budgets) {
             let ramp = |c: f64| 0.5 * c * ramp_time(c * v, a, j);
-            let time = reference / v + ramp(change.0) + ramp(change.1);
+            let time = reference / v + ramp(change.start) + ramp(change.end);
             if best.is_none_or(|(t, _)| time < t) {
                 best = Some((time, (v, a, j)));
                 worse = 0;
@@ -863,14 +884,17 @@ fn best_split(
 }
 
 /// At path speed `v`, the (A, J) within every point's budgets that changes the speed by `dv`
-/// fastest, with that ramp's duration: A takes a share of what the acceleration and the jerk
-/// (through the cross term 3|q''|·v·A) leave, J the rest of the jerk. `None` if nothing is left.
+/// fastest, with that ramp's duration: A takes a share of what the acceleration leaves, J the
+/// most the jerk then leaves (see [`jerk_left`]). `None` if nothing is left.
 fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
-    // Per point and joint, the path jerk left as a line in A: J ≤ (Jᵢ − |q'''|v³)/|q'| −
-    // (3|q''|v/|q'|)·A; found once, then read for each share of A.
-    let mut lines = [(0.0f64, 0.0f64); CELLS * MAX_JOINTS];
+    // Per point and joint: |q'|, 3|q''| and the jerk left after the curvature's rate |q'''|v³.
+    let mut rows = [(0.0f64, 0.0f64, 0.0f64); CELLS * MAX_JOINTS];
     let mut m = 0;
+    // The most acceleration the acceleration budget leaves, and the most that leaves jerk
+    // with the cross term paid at V (a profile's acceleration peaks below V, so this leaves
+    // some jerk: shares of it are tried).
     let mut a_cap = f64::INFINITY;
+    let mut a_low = f64::INFINITY;
     for cell in budgets.cells {
         for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
             let rest_a = budgets.acceleration[i] - g2 * v * v;
@@ -880,24 +904,26 @@ fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
             }
             if g1 > 0.0 {
                 a_cap = a_cap.min(rest_a / g1);
-                lines[m] = (rest_j / g1, 3.0 * g2 * v / g1);
-                m += 1;
             }
             if g2 > 0.0 {
-                a_cap = a_cap.min(rest_j / (3.0 * g2 * v));
+                a_low = a_low.min(rest_j / (3.0 * g2 * v));
+            }
+            if g1 > 0.0 || g2 > 0.0 {
+                rows[m] = (g1, 3.0 * g2, rest_j);
+                m += 1;
             }
         }
     }
     if !(a_cap > 0.0 && a_cap.is_finite()) {
         return None;
     }
-    let lines = &lines[..m];
+    let rows = &rows[..m];
     let mut best: Option<(f64, f64, f64)> = None;
-    for alpha in ACCEL_FRACTIONS {
-        let a = alpha * a_cap;
-        let j = lines
+    let a_cap = a_low.min(a_cap);
+    for a in ACCEL_FRACTIONS.map(|alpha| alpha * a_cap) {
+        let j = rows
             .iter()
-            .map(|&(r, s)| r - s * a)
+            .map(|&(g1, g2x3, rest)| jerk_left(g1, g2x3, rest, v, a))
             .fold(f64::INFINITY, f64::min);
         if !(j > 0.0 && j.is_finite()) {
             continue;
@@ -908,6 +934,48 @@ fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
         }
     }
     best
+}
+
+/// The largest path jerk J one joint at one point allows at path speed `v` and acceleration
+/// `a`: |q'|·J + 3|q''|·P ≤ `rest` (its jerk left after |q'''|v³), `g2x3` = 3|q''|, with P
+/// the largest speed × acceleration a jerk-limited motion under (V, A, J) reaches, its
+/// acceleration zero where it starts and ends. Where |a| = α the speed is at most
+/// V − α²/(2J): the acceleration must return to zero, at jerk J at most, before the speed
+/// passes V (or left zero that much earlier on the way down). So the cross term 3|q''|·v·a
+/// is paid at P = max (V − α²/2J)·α over α ≤ A, which peaks at α = √(2JV/3), not at the
+/// corner (V, A) of the box, which no profile reaches. The left side grows with J, so the
+/// bound is where it equals `rest`, in closed form on either side of that knee.
+fn jerk_left(g1: f64, g2x3: f64, rest: f64, v: f64, a: f64) -> f64 {
+    if g2x3 <= 0.0 {
+        return if g1 > 0.0 { rest / g1 } else { f64::INFINITY };
+    }
+    // Where the knee is at `a`: J = 3a²/(2V); above it the peak is (V − a²/2J)·a.
+    let knee = 1.5 * a * a / v;
+    if g1 > 0.0 {
+        // g1·J + g2x3·(V − a²/2J)·a = rest: g1·J² − c·J − g2x3·a³/2 = 0.
+        let c = rest - g2x3 * v * a;
+        let j = (c + (c * c + 2.0 * g1 * g2x3 * a * a * a).sqrt()) / (2.0 * g1);
+        if j >= knee {
+            return j;
+        }
+        // Below the knee: g1·x² + b·x − rest = 0 with x = √J, b = g2x3·(2/3)V·√(2V/3).
+        let b = g2x3 * (2.0 / 3.0) * v * (2.0 * v / 3.0).sqrt();
+        let x = (-b + (b * b + 4.0 * g1 * rest).sqrt()) / (2.0 * g1);
+        x * x
+    } else {
+        // Only the cross term: the peak itself must stay within `rest`.
+        let peak = rest / g2x3;
+        if v * a <= peak {
+            return f64::INFINITY;
+        }
+        let j = a * a / (2.0 * (v - peak / a));
+        if j >= knee {
+            return j;
+        }
+        // (2/3)V·√(2JV/3) = peak.
+        let x = 1.5 * peak / v;
+        1.5 / v * x * x
+    }
 }
 
 /// The duration of a jerk-limited speed change `dv` from rest acceleration to rest
@@ -1037,4 +1105,57 @@ pub fn has_jump(a: &Geometry, b: &Geometry, machine: &PlanMachine) -> bool {
     (0..machine.joint_count().min(MAX_JOINTS)).any(|i| {
         (b.d1_start[i] - a.d1_end[i]).abs() > 1e-12 || (b.d2_start[i] - a.d2_end[i]).abs() > 1e-12
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::solve;
+    use proptest::prelude::*;
+
+    /// The peak of (V − α²/2J)·α over α ≤ A, by brute force (it is negative beyond √(2JV)).
+    fn peak(v: f64, a: f64, j: f64) -> f64 {
+        let top = a.min((2.0 * j * v).sqrt());
+        (0..=20_000)
+            .map(|k| {
+                let alpha = top * k as f64 / 20_000.0;
+                (v - alpha * alpha / (2.0 * j)) * alpha
+            })
+            .fold(0.0, f64::max)
+    }
+
+    proptest! {
+        /// A profile never reaches speed V and acceleration A together: where |a| = α its
+        /// speed is at most V − α²/(2J), the envelope [`jerk_left`] charges the cross term at.
+        #[test]
+        fn profiles_stay_under_the_envelope(
+            v in 1.0f64..300.0, a in 10.0f64..5000.0, j in 100.0f64..100_000.0,
+            f0 in 0.0f64..1.0, f1 in 0.0f64..1.0, len in 0.01f64..200.0,
+        ) {
+            let limits = Limits::new(v, a, j).unwrap();
+            let Ok(p) = solve(len, f0 * v, f1 * v, &limits) else { return Ok(()) };
+            let n = 2000;
+            for k in 0..=n {
+                let s = p.state_at(p.duration() * k as f64 / n as f64);
+                let bound = v - s.a * s.a / (2.0 * j);
+                prop_assert!(s.v <= bound + 1e-9 * v, "v {} > {} at a {}", s.v, bound, s.a);
+            }
+        }
+
+        /// The jerk found is the largest that keeps the joint's jerk within what is left.
+        #[test]
+        fn jerk_left_meets_the_budget(
+            g1 in 0.0f64..2.0, g2 in 0.0f64..2.0, rest in 1.0f64..100_000.0,
+            v in 1.0f64..300.0, a in 1.0f64..5000.0,
+        ) {
+            let j = jerk_left(g1, 3.0 * g2, rest, v, a);
+            if j.is_finite() {
+                prop_assert!(j > 0.0);
+                let used = g1 * j + 3.0 * g2 * peak(v, a, j);
+                prop_assert!((used - rest).abs() <= 1e-6 * rest, "used {used} of {rest}");
+            } else {
+                prop_assert!(g1 == 0.0 && 3.0 * g2 * v * a <= rest * (1.0 + 1e-12));
+            }
+        }
+    }
 }
