@@ -239,6 +239,15 @@ pub(crate) fn cuts(p: &Piece, u0: f64, u1: f64) -> Vec<f64> {
     c
 }
 
+/// Whether `a` runs into `b` without a turn (a tangent junction, where a blend only spreads a
+/// curvature jump; see [`place`]).
+pub(crate) fn tangent(a: &Piece, b: &Piece) -> bool {
+    match (a.frame(a.geo.domain().1), b.frame(b.geo.domain().0)) {
+        (Some((ta, _)), Some((tb, _))) => ta.cross(&tb).norm().atan2(ta.dot(&tb)) < TANGENT_ANGLE,
+        _ => false,
+    }
+}
+
 /// Place a blend between `a` (incoming, trimmed up to `a.u1`) and `b` (outgoing, from `b.u0`)
 /// within `share` mm of the programmed path; `max_angle` (rad) is the largest turn blended.
 pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<Placed, NoBlend> {

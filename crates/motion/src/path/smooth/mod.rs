@@ -552,7 +552,17 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
         let blendable = a.mode == Mode::Continuous
             && b.mode == Mode::Continuous
             && feeds_compatible(a.feed, b.feed);
-        let share = self.opts.blend_share * a.tolerance.min(b.tolerance);
+        // Where the program's own line runs into its own tangent arc no compression deviation
+        // is spent, so the blend may take that share too (blend + chord within ε): a longer
+        // blend spreads the curvature jump thinner, and the speed through it rises with the
+        // cube root of its length. (At a turn a longer blend is slower: its crawl is longer.)
+        let exact = |p: &Piece| matches!(p.geo, Geo::Line(_) | Geo::Arc(_));
+        let blend_share = if exact(&a) && exact(b) && blend::tangent(&a, b) {
+            self.opts.blend_share + self.opts.compression_share
+        } else {
+            self.opts.blend_share
+        };
+        let share = blend_share * a.tolerance.min(b.tolerance);
         let max_angle = if blendable {
             self.opts.blend_max_angle
         } else {
