@@ -1,6 +1,7 @@
 //! Closed forms: line, arc and helix lengths and curvature (1/r, r/(r²+c²)), arcs in every plane
-//! with the right sense of rotation (reference 000 §5 items 7–9), the exact NURBS quarter
-//! circle, Bézier = clamped B-spline, and the quintic blend values of reference 004 §5.3–5.4.
+//! with the right sense of rotation (Kelekçi, 2021, examples (2.21), (3.25), (2.24)), the exact
+//! NURBS quarter circle, Bézier = clamped B-spline, and the values of Kahraman et al.'s quintic
+//! blend (§3), worked out by hand.
 
 use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
 
@@ -27,12 +28,12 @@ fn line_is_arc_length_parameterised() {
     let m = ArcLengthMap::new(&l, 1e-12).unwrap();
     assert!((m.length() - 13.0).abs() < 1e-12);
     assert!((m.u_at(&l, 6.5) - 6.5).abs() < 1e-12);
-    // Reference 000 §2.1 examples.
+    // Kelekçi (2021), §2.1 examples.
     let l = Line::new(Vec3::new(2.0, -1.0, 3.0), Vec3::new(12.0, 7.0, -2.0)).unwrap();
     assert_close(l.length(), 13.7477, 4, "G01 X12 Y7 Z-2");
 }
 
-/// Centre of an R-form arc (reference 000 §2.2, vector form): right of the chord for CW with
+/// Centre of an R-form arc (Kelekçi, 2021, §2.2, vector form): right of the chord for CW with
 /// R > 0, left for CCW; R < 0 flips the side.
 fn r_centre(p0: (f64, f64), p1: (f64, f64), r: f64, cw: bool) -> [f64; 2] {
     let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
@@ -260,7 +261,7 @@ fn quintic_coefficients_of_reference_004() {
     .is_err());
 }
 
-/// Line–line corner blend of reference 004 §2.5: legs `ell`, speed `v`, turn `phi`.
+/// Line–line corner blend of Kahraman et al. (§3): legs `ell`, speed `v`, turn `phi`.
 fn corner(ell: f64, v: f64, phi: f64) -> (Quintic, Vec3) {
     let t0 = Vec3::new(1.0, 0.0, 0.0);
     let t1 = Vec3::new(phi.cos(), phi.sin(), 0.0);

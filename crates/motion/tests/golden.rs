@@ -1,13 +1,14 @@
-//! Golden numbers from ../shared/reference/000_jerk_limited_trajectory.md §5 (Kelekçi 2021),
-//! items 8, 10, 13 and 14, recomputed with our 7-phase profile.
+//! Golden numbers from Kelekçi (2021, ch. 3), recomputed with our 7-phase profile: the arc of
+//! (3.25) rest to rest, the line of (3.17), the end speeds reachable by braking ((3.10), (3.14))
+//! and short-move peak speeds.
 //!
 //! The source's profile has five phases and no constant-acceleration phase, so its peak
 //! acceleration is √(J·Δv) whatever A is. For these items (J = 20000 mm/s³, A = 1000 mm/s², the
-//! thesis's machine at L1626 and L1740) that peak stays ≤ A — 774.6, exactly 1000 (item 10),
+//! thesis's machine of §3.1–3.2) that peak stays ≤ A — 774.6, exactly 1000 (the line),
 //! 736.8, 560.4, 204.3, 831.6 mm/s² — so the 7-phase optimum has no plateau and reproduces the
 //! source's values; each is checked to the digits the source prints and was also confirmed with
 //! Ruckig (tests/oracle/ruckig_batch.py) to ~1e-12. The last test takes the thesis's own
-//! multi-line machine (L1661: J = 1000, A = 100, V = 50), where the five-phase profile reaches
+//! multi-line machine of (3.20) (J = 1000, A = 100, V = 50), where the five-phase profile reaches
 //! 223.6 mm/s² > A: there the source-style value and ours differ, and ours is Ruckig's.
 
 use tezgah_motion::profile::{
@@ -140,7 +141,7 @@ fn item_14_short_move_peaks() {
     assert!(close(p.end().v, 10.0, 1e-12));
 }
 
-/// The thesis's multi-line machine (L1661: J = 1000, A = 100, V = 50), first segment of (3.20)
+/// The thesis's multi-line machine (J = 1000, A = 100, V = 50), first segment of (3.20)
 /// (L = 48.2183 mm) run rest to rest. The five-phase profile would take t_a = √(50/1000) =
 /// 0.22361 s per jerk phase with a peak of 223.6 mm/s² > A, T = 1.411580 s. The 7-phase profile
 /// holds A: jerk phases 0.1 s, plateau 0.4 s, ramp 0.6 s over 15 mm, cruise 0.364366 s,
