@@ -27,7 +27,7 @@ M2
 ";
 
 #[test]
-fn listing_of_reference_000_section_1_2() {
+fn kelekci_fig_4_36_listing() {
     let mut calls: Vec<(Origin, Canon)> = Vec::new();
     Interpreter::new(Config::default())
         .run(LISTING, &mut calls)

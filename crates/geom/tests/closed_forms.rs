@@ -59,7 +59,7 @@ fn xy_arc(start: Pose, end: (f64, f64, f64), r: f64, cw: bool) -> Arc {
 }
 
 #[test]
-fn item7_g02_r5_and_major_arc() {
+fn arc_2_21_g02_r5_and_major_arc() {
     let s = Pose::new(0.24, 1.53, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (9.019, 2.975, 0.0), 5.0, true);
     assert_close(a.center().x, 5.0, 3, "cx");
@@ -75,7 +75,7 @@ fn item7_g02_r5_and_major_arc() {
 }
 
 #[test]
-fn item8_g02_r14_976() {
+fn arc_3_25_g02_r14_976() {
     let s = Pose::new(0.2407, 1.533, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (9.019, 2.975, 0.0), 14.976, true);
     assert_close(a.center().x, 6.9479, 4, "cx");
@@ -85,7 +85,7 @@ fn item8_g02_r14_976() {
 }
 
 #[test]
-fn item9_g03_helix_and_curvature() {
+fn helix_2_24_g03_and_curvature() {
     let s = Pose::new(14.32, 5.66, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (14.94, 1.749, 2.0), 14.976, false);
     assert_close(a.center().x, 29.2915, 4, "cx");
@@ -230,7 +230,7 @@ fn st(p: [f64; 3], v: [f64; 3], a: [f64; 3]) -> State {
 }
 
 #[test]
-fn quintic_coefficients_of_reference_004() {
+fn quintic_coefficients() {
     let q = Quintic::hermite(
         st([1., 0., 0.], [2., 0., 0.], [3., 0., 0.]),
         st([5., 0., 0.], [-1., 0., 0.], [0.5, 0., 0.]),
@@ -296,7 +296,7 @@ fn peaks(q: &Quintic) -> (f64, f64, f64) {
 }
 
 #[test]
-fn quintic_corner_blends_of_reference_004() {
+fn quintic_corner_blends() {
     let (q, c) = corner(1.0, 10.0, FRAC_PI_2);
     let k = q.coefficients();
     // x(τ) = −1 + 10τ − 250τ³ + 625τ⁴, y(τ) = 250τ³ − 625τ⁴.

@@ -43,7 +43,7 @@ fn set(i: usize) -> Vec<Vec3> {
 }
 
 #[test]
-fn item5_centripetal_interpolation() {
+fn centripetal_interpolation_2_66() {
     let q = set(0);
     let t = parameters(&q, Parameterisation::Centripetal, 3).unwrap();
     assert_all(&t, &[0., 0.19921, 0.37603, 0.59325, 0.83700, 1.], 5, "t");
@@ -72,7 +72,7 @@ fn item5_centripetal_interpolation() {
 }
 
 #[test]
-fn item5_chord_and_uniform_parameters_and_knots() {
+fn chord_and_uniform_parameters_and_knots() {
     let q = set(0);
     let t = parameters(&q, Parameterisation::ChordLength, 3).unwrap();
     assert_all(
@@ -102,7 +102,7 @@ fn polyline_length(q: &[Vec3]) -> f64 {
 }
 
 #[test]
-fn item6_polyline_totals() {
+fn table_2_6_polyline_totals() {
     let want = [27.698, 23.282, 12.898, 28.217];
     let got: Vec<f64> = (0..4).map(|i| polyline_length(&set(i))).collect();
     // True totals 27.69874 and 12.89726: Table 2.6 prints 27.698 (truncated) and 12.898 (one

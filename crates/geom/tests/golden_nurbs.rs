@@ -35,7 +35,7 @@ fn length(c: &Nurbs) -> f64 {
 }
 
 #[test]
-fn item1_clamped_cubic_length_19_02() {
+fn clamped_cubic_2_39_length_19_02() {
     let knots = vec![0., 0., 0., 0., 1., 2., 3., 4., 5., 6., 7., 7., 7., 7.];
     let c = Nurbs::bspline(3, &data_239(), knots).unwrap();
     assert_digits(length(&c), 19.02, 2);
@@ -44,7 +44,7 @@ fn item1_clamped_cubic_length_19_02() {
 }
 
 #[test]
-fn item1_uniform_knots_length_14_1316() {
+fn uniform_knots_2_39_length_14_1316() {
     let knots = (0..14).map(f64::from).collect();
     let c = Nurbs::bspline(3, &data_239(), knots).unwrap();
     assert_eq!(c.domain(), (3.0, 10.0));
@@ -60,7 +60,7 @@ fn curve_248(w: &[f64], scale: f64) -> Nurbs {
 }
 
 #[test]
-fn item2_weighted_lengths_table_2_4a() {
+fn weighted_lengths_table_2_4a() {
     let w1 = [1.0; 7];
     let w2 = [1., 1., 5., 5., 5., 1., 1.];
     let w3 = [1., 1., 10., 10., 10., 1., 1.];
@@ -82,7 +82,7 @@ fn curve_249(w: &[f64], planar: bool) -> Nurbs {
 }
 
 #[test]
-fn item3_table_2_4b_planar_first_eleven_weights() {
+fn table_2_4b_planar_first_eleven_weights() {
     let w1 = [1.0; 12];
     let w2 = [1., 2., 2., 1., 1., 1., 1., 1., 1., 2., 2., 1.];
     let w3 = [1., 5., 5., 1., 1., 1., 1., 1., 1., 5., 5., 1.];
@@ -102,7 +102,7 @@ fn curvature_maxima(c: &Nurbs) -> Vec<(f64, f64)> {
 }
 
 #[test]
-fn item4_curvature_demo_length_and_maxima() {
+fn curvature_demo_3_39_length_and_maxima() {
     let c = curve_248(&[1.0; 7], 0.25);
     assert_digits(length(&c), 61.2445, 4);
     let maxima = curvature_maxima(&c);
@@ -133,7 +133,7 @@ fn item4_curvature_demo_length_and_maxima() {
 }
 
 #[test]
-fn item4_inflections() {
+fn curvature_demo_3_39_inflections() {
     let c = curve_248(&[1.0; 7], 0.25);
     // Signed planar curvature changes sign at the inflections.
     let signed = |u: f64| {

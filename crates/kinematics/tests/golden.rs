@@ -26,7 +26,7 @@ fn ik(m: &Machine, x: f64, y: f64, z: f64) -> Vec<f64> {
 // ---- Kelekçi (2021), eqs 5.2/5.7: Y-Z-C-A round trip, and the C sign -------------------
 
 #[test]
-fn yzca_round_trip_000_item_16() {
+fn yzca_round_trip_eq_5_2() {
     let m = Machine::builtin("yzca").unwrap();
     let tool = Tool::with_length(100.0);
     // joints y z c a in file units (mm, deg)
@@ -78,7 +78,7 @@ fn yzca_c_sign_convention() {
 
 /// Kelekçi (2021, §5.3.1): C runs 0 … 355° and the next target at 5° is commanded 365°.
 #[test]
-fn yzca_endless_c_unwrap_000_item_17() {
+fn yzca_endless_c_unwrap_eq_5_5() {
     let m = Machine::builtin("yzca").unwrap();
     let tool = Tool::default();
     let mut q = m.home();
@@ -120,7 +120,7 @@ fn yzca_tilt_chosen_by_programmed_a() {
 // ---- Ayyıldız (2017), eq. 3.5: inverse kinematics, absolute and relative ---------------
 
 #[test]
-fn delta_ik_table_002_5_1() {
+fn delta_inverse_eq_3_5() {
     let m = delta();
     let rows: [([f64; 3], [f64; 3]); 9] = [
         ([0.0, 0.0, 0.0], [311.28765, 311.28765, 311.28765]),
@@ -158,7 +158,7 @@ fn delta_ik_table_002_5_1() {
 // ---- Ayyıldız (2017), Figs 5.3–5.15: the thesis's printed conversions ------------------
 
 #[test]
-fn delta_printed_conversions_002_5_2() {
+fn delta_printed_conversions() {
     let m = delta();
     let printed: [([f64; 3], [f64; 3]); 16] = [
         ([-27.426, -27.714, 0.0], [-17.0, -7.83, 16.51]),
@@ -211,7 +211,7 @@ fn delta_printed_conversions_002_5_2() {
 
 /// Ayyıldız (2017), Fig. 5.15: the 16 chord points of `G3 X7.015 Y17.204 I-12.5 J0.` at Z −0.2.
 #[test]
-fn delta_arc_chords_002_5_3() {
+fn delta_arc_chords_fig_5_15() {
     let m = delta();
     let printed: [[f64; 3]; 17] = [
         [9.0, -3.27, -8.59],
@@ -248,7 +248,7 @@ fn delta_arc_chords_002_5_3() {
 /// points of the 100 mm XY diagonal sags 4.646 mm (Z −4.577, in plane 0.799), against the −4.599 mm
 /// measured in its Table 5.2.
 #[test]
-fn delta_joint_space_sag_002_5_4() {
+fn delta_joint_space_sag_table_5_2() {
     let m = delta();
     let tool = Tool::default();
     let a = Vector3::new(-31.654, -28.911, -0.2);
@@ -309,7 +309,7 @@ fn delta_joint_space_sag_002_5_4() {
 // ---- Kahraman et al., eqs 1–3: Rodrigues tool-axis interpolation -----------------------
 
 #[test]
-fn rodrigues_004_5_1() {
+fn rodrigues_eqs_1_to_3() {
     let v = Vector3::z_axis();
     let u = Unit::new_normalize(Vector3::new(0.5, 0.0, 3f64.sqrt() / 2.0));
     let mid = slerp_axis(&v, &u, 0.5).unwrap();
@@ -329,7 +329,7 @@ fn rodrigues_004_5_1() {
 // ---- ISO 9283 (Ayyıldız, 2017, eqs 3.16–3.19), synthetic measurements -----------------
 
 #[test]
-fn iso9283_002_5_5() {
+fn iso9283_eqs_3_16_to_3_19() {
     use tezgah_kinematics::iso9283::{evaluate, parse_csv};
     let csv = "\
 pose,cycle,cmd_x,cmd_y,cmd_z,x,y,z
@@ -391,7 +391,7 @@ fn iso9283_errors() {
 /// direction ≈ 16 600 cm³. (The thesis's own 18 786 cm³ has no stated method.) Such a cone excludes
 /// the thesis's ISO pose P3, which is why the built-in file leaves it off.
 #[test]
-fn delta_workspace_volume_002_2_4() {
+fn delta_workspace_volume() {
     let m = delta();
     let tezgah_kinematics::Model::LinearDelta(d) = &m.kinematics else {
         unreachable!()

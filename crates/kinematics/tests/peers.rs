@@ -163,7 +163,7 @@ proptest! {
     }
 
     #[test]
-    fn reference_002_closed_form(x in -120.0..120.0f64, y in -120.0..120.0f64, z in -100.0..100.0f64) {
+    fn ayyildiz_corrected_closed_form(x in -120.0..120.0f64, y in -120.0..120.0f64, z in -100.0..100.0f64) {
         let ours = delta(160.0, 350.0, [0.0, 120.0, 240.0], [0.0; 3]);
         let p = Vector3::new(x, y, z);
         let q = ours.inverse(&ToolPose::vertical(p), &Tool::default(), &Joints::zeros(3)).unwrap();

@@ -31,7 +31,7 @@ fn peak(p: &Profile) -> (f64, f64) {
 /// Source: t_a = t_d = 0.0387298 s, peak 774.60 mm/s², accel distance 1.161895 mm,
 /// cruise 0.223614 s, T = 0.378534 s. Ours (= Ruckig): T = 0.37853366692.
 #[test]
-fn item_8_arc_rest_to_rest() {
+fn arc_3_25_rest_to_rest() {
     let l = Limits::new(30.0, 1000.0, 20000.0).unwrap();
     let p = solve(9.03222, 0.0, 0.0, &l).unwrap();
     let d = p.durations();
@@ -57,7 +57,7 @@ fn item_8_arc_rest_to_rest() {
 /// Ours (= Ruckig): T = 0.63851648071; the speed change 50 = A²/J sits exactly on the boundary
 /// where the plateau appears, so the plateau has length 0.
 #[test]
-fn item_10_line_rest_to_rest() {
+fn line_3_17_rest_to_rest() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let len = 725f64.sqrt();
     let p = solve(len, 0.0, 0.0, &l).unwrap();
@@ -86,7 +86,7 @@ fn item_10_line_rest_to_rest() {
 /// 1 mm → 47.9139 (lowest reachable). Ours: 27.144176166, 25.696036532, 47.913869023. Where
 /// the source then *raises* the requested end speed (3.14), ours reports it instead.
 #[test]
-fn item_13_reachable_end_speeds() {
+fn reachable_end_speeds_3_10_3_14() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let up0 = max_reachable_speed(0.0, 1.0, &l).unwrap();
     assert!(
@@ -122,7 +122,7 @@ fn item_13_reachable_end_speeds() {
 /// Source: rest to rest over 2 mm → Vp = 27.1442; 0 → 10 over 3 mm → Vp = 34.5744.
 /// Ours (= Ruckig): Vp = 27.144176166 (T = 0.14736125995 s), 34.574390513 (T = 0.15326193767 s).
 #[test]
-fn item_14_short_move_peaks() {
+fn short_move_peaks() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let p = solve(2.0, 0.0, 0.0, &l).unwrap();
     let vp = p.knots()[3].1.v;

@@ -128,7 +128,7 @@ fn the_machine_gives_the_closed_form_axis() {
 /// quintic of Step 6 through Step 5's rigid-body end data for a point h along the axis; Eq 7
 /// gives the axis. The library's blend must give the same axis for every h.
 #[test]
-fn two_curve_blend_matches_reference_004_steps_5_to_7() {
+fn two_curve_blend_matches_closed_form() {
     let (v, t_blend) = (10.0, 0.2);
     // Legs: the tool tilts about the path normal on each (θ̇ = 0.2 rad/s and −0.3 rad/s).
     let o0 = table_ac_axis(20.0, 0.0);

@@ -29,7 +29,7 @@ fn square(tol: Option<f64>) -> Vec<Move> {
 }
 
 #[test]
-fn reference_004_corner_at_tolerance_exact_leg() {
+fn corner_at_tolerance_exact_leg() {
     // Tolerance-driven case: ε = 0.05 mm for the blend at 90° gives ℓ = 0.188562 mm and
     // a corner deviation of exactly 0.05 mm. With the 40 % blend share, the program's tolerance
     // is 0.125 mm.
@@ -63,7 +63,7 @@ fn reference_004_corner_at_tolerance_exact_leg() {
 }
 
 #[test]
-fn reference_004_45_degree_corner() {
+fn blend_45_degree_corner() {
     // Another case: 45° turn with ℓ = 0.5 gives δ = 0.071753. ℓ = 8ε/(3 sin 22.5°) = 0.5
     // for ε = 0.0717530…; tolerance = ε / 0.4.
     let eps = 0.5 * 3.0 * (22.5f64.to_radians()).sin() / 8.0;

@@ -293,7 +293,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reference_004_rodrigues_5_1() {
+    fn rodrigues_30_degrees() {
         // Eqs 1–3 by hand: V = (0,0,1), U = (0.5, 0, √3/2): k = (0,1,0), θmax = 30°.
         let v = Vec3::z();
         let u = Vec3::new(0.5, 0.0, 0.75f64.sqrt());

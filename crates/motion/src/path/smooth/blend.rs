@@ -390,7 +390,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reference_004_line_line_90() {
+    fn quintic_line_line_90() {
         // Kahraman et al.'s quintic at a 90° corner, ℓ = 1, v = 10 mm/s:
         // x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
         let z = Vec3::zeros();
