@@ -93,7 +93,7 @@ fn helix_2_24_g03_and_curvature() {
     assert_close(a.sweep().to_degrees(), 15.194, 3, "sweep");
     let planar = a.radius() * a.sweep();
     assert_close(planar, 3.9715, 4, "planar length");
-    // The helix's own length includes the lead (DESIGN: F includes helix pitch).
+    // The helix's own length includes the lead (F is along the helix, pitch included).
     assert!((a.length() - planar.hypot(2.0)).abs() < 1e-12);
     let numeric = ArcLengthMap::new(&a, 1e-12).unwrap().length();
     assert!((numeric - a.length()).abs() < 1e-11);
