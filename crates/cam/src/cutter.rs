@@ -1,6 +1,7 @@
 //! Cutters: ball, flat and bull-nose (torus) end mills with their shank and holder, the
 //! geometry every CAM stage shares — strategies place them, gouge checks test them, the
-//! verifying simulation sweeps them. Dimensions in mm; DESIGN.md's `SPEC` strings parse here.
+//! verifying simulation sweeps them. Dimensions in mm; the command line's `SPEC` strings parse
+//! here.
 
 use std::fmt;
 use std::str::FromStr;
@@ -89,7 +90,7 @@ pub enum CutterSpecError {
 impl FromStr for CutterShape {
     type Err = CutterSpecError;
 
-    /// DESIGN.md's `SPEC`: `ball:D`, `flat:D`, `bull:D:r`.
+    /// The command line's `SPEC`: `ball:D`, `flat:D`, `bull:D:r`.
     fn from_str(spec: &str) -> Result<Self, Self::Err> {
         let number = |text: &str, what| {
             text.trim()

@@ -3,7 +3,7 @@
 //! Angles in radians, lengths in mm.
 //!
 //! At a contact whose surface normal makes the angle `α` with the tool axis, the cutter surface
-//! has two principal curvatures (Rao, Ismail & Bedi 1997; reference 001 §2.4/§2.6): along the
+//! has two principal curvatures (Rao, Ismail & Bedi 1997; Can, 2010, §3.3.7): along the
 //! meridian (the plane of axis and normal) `κ_m = 1/r` (corner radius `r`; infinite for a flat
 //! end, whose rim is a sharp edge), and along the parallel circle, by Meusnier,
 //! `κ_p = sin α / (R₀ + r sin α)` with `R₀ = R − r`. The scallop left across the feed is the
@@ -11,7 +11,7 @@
 //! the (feed, cross-feed) frame that silhouette has curvature `det K / K_ff`. With `β` the angle
 //! between the feed and the meridian direction, `K_ff = κ_m cos²β + κ_p sin²β`, so the effective
 //! radius is `r_e = (κ_m cos²β + κ_p sin²β) / (κ_m κ_p)`. For a pure lead (`β = 0`) this is
-//! `1/κ_p = R₀/sin α + r` (001 Table §2.6: ball `R`, flat `R/sin S`, torus `R₀/sin α + r`).
+//! `1/κ_p = R₀/sin α + r` (Can, 2010, §3.3.7: ball `R`, flat `R/sin S`, torus `R₀/sin α + r`).
 
 use crate::cutter::CutterShape;
 
@@ -28,8 +28,8 @@ pub struct ContactCurvatures {
 /// The tool axis relative to the surface at the contact: lead (rotation toward the feed) and
 /// tilt (rotation toward the cross-feed side), radians. The axis is
 /// `a ∝ n + tan(lead)·f + tan(tilt)·t` in the contact frame (feed `f`, cross-feed `t = n × f`,
-/// normal `n`), i.e. 001 Eq. 3.36 with inclination `α = atan √(tan² lead + tan² tilt)` and yaw
-/// `β = atan2(tan tilt, tan lead)`.
+/// normal `n`), i.e. Can's (2010) Eq. 3.36 with inclination `α = atan √(tan² lead + tan² tilt)` and
+/// yaw `β = atan2(tan tilt, tan lead)`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LeadTilt {
     pub lead: f64,
@@ -111,10 +111,10 @@ impl CutterShape {
     }
 
     /// The smallest inclination (pure lead, radians) at which the effective radius is at most
-    /// `radius` — curvature matching for flat and bull-nose cutters (001 §2.6, `S = asin(r/ρ)`
-    /// for a flat end; `sin α = R₀/(ρ − r)` for a torus). `Some(0)` when even the untilted
-    /// cutter fits; `None` when no inclination below 90° does (a ball or a torus corner wider
-    /// than `radius`).
+    /// `radius` — curvature matching for flat and bull-nose cutters (Can, 2010, §3.4.7.2.2, `S =
+    /// asin(r/ρ)` for a flat end; `sin α = R₀/(ρ − r)` for a torus). `Some(0)` when even the
+    /// untilted cutter fits; `None` when no inclination below 90° does (a ball or a torus corner
+    /// wider than `radius`).
     pub fn matching_lead(&self, radius: f64) -> Option<f64> {
         let (big_r, r) = (self.radius(), self.corner_radius());
         let r0 = big_r - r;
@@ -154,7 +154,7 @@ mod tests {
             assert!((flat.effective_radius(lt) - 5.0 / s).abs() < 1e-9 * (5.0 / s));
             assert!((bull.effective_radius(lt) - (4.0 / s + 2.0)).abs() < 1e-9 * (4.0 / s));
         }
-        // 001 §5.3 T9: flat D = 40 at S = 25° → r_e = 47.32 mm.
+        // Can (2010, §3.3): flat D = 40 at S = 25° → r_e = 47.32 mm.
         let flat40 = CutterShape::Flat { radius: 20.0 };
         let re = flat40.effective_radius(LeadTilt::new(deg(25.0), 0.0));
         assert!((re - 47.324).abs() < 1e-3, "{re}");
@@ -183,7 +183,7 @@ mod tests {
 
     #[test]
     fn matching_lead_reproduces_the_thesis_sturz_angles() {
-        // 001 §5.3 T1: D = 10 on ρ = 20 → S = asin(5/20) = 14.4775°.
+        // Can (2010, §3.4.7.2): D = 10 on ρ = 20 → S = asin(5/20) = 14.4775°.
         let flat = CutterShape::Flat { radius: 5.0 };
         let s = flat.matching_lead(20.0).unwrap();
         assert!((s.to_degrees() - 14.477_512_185_929_92).abs() < 1e-9);

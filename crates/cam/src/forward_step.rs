@@ -2,9 +2,9 @@
 //! curve on the surface so that the straight move between two contact points stays within
 //! the tolerance of the curve everywhere between them. Every strategy steps its passes here.
 //!
-//! 001 §2.8 tests one mid-point per chord, which cannot see an inflection: on the reference's
-//! own boundary curve it lets 0.424 mm through at ε = 0.05 mm (001 §5.2). Here the deviation
-//! of a chord is measured as the maximum distance from the curve to the segment over
+//! Can (2010, §3.4.3.1) tests one mid-point per chord, which cannot see an inflection: on the
+//! boundary curve of the thesis's own STEP surface it lets 0.424 mm through at ε = 0.05 mm. Here
+//! the deviation of a chord is measured as the maximum distance from the curve to the segment over
 //! [`CHORD_SAMPLES`] interior samples, refined by golden-section search around every local
 //! maximum among them (`tezgah_geom::deviation::maximise`), so both humps of an S-shaped span
 //! are seen; the step is then grown or shrunk by the
@@ -93,8 +93,8 @@ pub fn chord_error(surface: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb:
     maximise(dist, ta, tb, CHORD_SAMPLES + 1).distance
 }
 
-/// The chord of a circle of radius `rho` whose sagitta is `eps`: `λ = 2√(2ρε − ε²)` (001
-/// Eq. 3.22, Choi 1991) — the forward step on a path of constant curvature.
+/// The chord of a circle of radius `rho` whose sagitta is `eps`: `λ = 2√(2ρε − ε²)` (Can,
+/// 2010, Eq. 3.22; Choi 1991) — the forward step on a path of constant curvature.
 pub fn chord_for_sagitta(rho: f64, eps: f64) -> f64 {
     2.0 * (2.0 * rho * eps - eps * eps).max(0.0).sqrt()
 }
@@ -188,7 +188,7 @@ mod tests {
     use super::*;
     use crate::testing;
 
-    /// The thesis's midpoint test (001 §2.8), for the regression that shows its defect.
+    /// The thesis's midpoint test (Can, 2010, §3.4.3.1), for the regression that shows its defect.
     fn midpoint_error(s: &NurbsSurface, path: &impl SurfacePath, ta: f64, tb: f64) -> f64 {
         let (a, b) = (at(s, path, ta), at(s, path, tb));
         point_segment_distance(&at(s, path, 0.5 * (ta + tb)), &a, &b)
@@ -217,7 +217,7 @@ mod tests {
             start: 0.0,
             end: 1.0,
         };
-        // 001 §5.2 golden values of S(0, v).
+        // Golden values of S(0, v), by Cox–de Boor on the thesis's STEP data (Appendix A).
         let golden = [
             (0.1, [12.973_465_610, 160.0, 0.257_625_035]),
             (0.25, [32.400_423_760, 160.0, -0.194_959_050]),
@@ -230,8 +230,8 @@ mod tests {
             let q = s.point(0.0, v);
             assert!((q - Vec3::from(p)).norm() < 2e-8, "v = {v}: {q:?}");
         }
-        // The thesis's CC points at ε = 0.05 (001 §5.2) pass its midpoint test within ±5 %
-        // but deviate by up to 0.424 mm; ours stay within ε.
+        // The thesis's CC points at ε = 0.05 (Can, 2010, §3.4.3.1) pass its midpoint test within ±5
+        // % but deviate by up to 0.424 mm; ours stay within ε.
         let thesis = [0.0, 0.1289, 0.5751, 0.6680, 0.8236, 1.0];
         let worst_mid = thesis
             .windows(2)
@@ -255,7 +255,7 @@ mod tests {
 
     #[test]
     fn chord_error_on_a_circle_is_the_sagitta() {
-        // 001 §5.3 T8: ρ = 100, ε = 0.05 → λ = 6.3238 mm.
+        // Can (2010), Eq. 3.22: ρ = 100, ε = 0.05 → λ = 6.3238 mm.
         assert!((chord_for_sagitta(100.0, 0.05) - 6.3238).abs() < 5e-5);
         // On a roller of radius 100 (an exact rational arc across u), two points a chord λ
         // apart deviate from the arc by exactly ε in the middle.

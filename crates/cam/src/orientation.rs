@@ -36,7 +36,7 @@ impl ContactFrame {
         })
     }
 
-    /// The tool axis `a ∝ n + tan(lead)·f + tan(tilt)·t` (001 Eq. 3.36 with `β` the yaw
+    /// The tool axis `a ∝ n + tan(lead)·f + tan(tilt)·t` (Can, 2010, Eq. 3.36, with `β` the yaw
     /// toward the cross-feed side; lead tilts the tool's top toward the feed, so the tool
     /// centre trails the contact and the heel clears the cut surface).
     pub fn axis(&self, angles: LeadTilt) -> Unit<Vec3> {
@@ -61,10 +61,10 @@ impl ContactFrame {
 impl CutterShape {
     /// CC → CL: the tool tip for a contact at `contact` with surface normal `n` and tool axis
     /// `a`. The corner-circle centre is `c = CC + r·n + (R − r)·m` with `m` the unit of
-    /// `n − (a·n)a` (Choi 1998, 001 Eq. 3.11, sign fixed so the corner touches at CC: the
+    /// `n − (a·n)a` (Choi 1998; Can, 2010, Eq. 3.11, sign fixed so the corner touches at CC: the
     /// cutter's outward normal there is `−n`); the tip is `c − r·a`. When `a ∥ n` the flat part
     /// lies on the tangent plane and the contact is taken on the front of the rim: `m = −f`
-    /// (001 §3.4.5, "TK = TT − r·f"). Ball: `tip = CC + R n − R a`.
+    /// (Can, 2010, §3.4.5, "TK = TT − r·f"). Ball: `tip = CC + R n − R a`.
     pub fn tip_for_contact(&self, contact: &Vec3, frame: &ContactFrame, axis: &Unit<Vec3>) -> Vec3 {
         let (big_r, r) = (self.radius(), self.corner_radius());
         let n = frame.normal.into_inner();
@@ -110,8 +110,8 @@ mod tests {
         let flat = CutterShape::Flat { radius: 5.0 };
         let tip = flat.tip_for_contact(&cc, &f, &a);
         assert!((tip - (cc - Vec3::x() * 5.0)).norm() < 1e-12);
-        // Flat with lead λ (001 §2.13 digest: p_CL = CC + R(sin λ n − cos λ f)): the tip is the
-        // bottom centre, and the contact lies on the rim, R from the tip in the bottom plane.
+        // Flat with lead λ (from Can, 2010, §3.4.5: p_CL = CC + R(sin λ n − cos λ f)): the tip is
+        // the bottom centre, and the contact lies on the rim, R from the tip in the bottom plane.
         let lead = 0.25f64;
         let a = f.axis(LeadTilt::new(lead, 0.0));
         let tip = flat.tip_for_contact(&cc, &f, &a);

@@ -3,17 +3,17 @@
 //! normal curvature `κ` there (1/mm, positive where the surface bends toward its normal, i.e.
 //! concave seen from the tool). The strategies size every side step here.
 //!
-//! Two models: 001's Eq. 3.69/3.70 (Lo 1999, second order), kept for the reference's worked
-//! examples; and the exact circle–circle cusp used for planning. In the plane normal to the
+//! Two models: Can's (2010) Eq. 3.69/3.70 (Lo 1999, second order), kept for the thesis's
+//! worked examples; and the exact circle–circle cusp used for planning. In the plane normal to the
 //! feed the surface is a circle of radius `ρ = 1/|κ|` about `O` and each pass's cutter profile
 //! a circle of radius `r_e` about `C`, tangent to it; the cusp `P` between two passes lies on
 //! the bisector at `|OP| = ρ ± h`. The triangle `O, C, P` (sides `|OC| = ρ ± r_e`, `|OP|`,
 //! `|CP| = r_e`) gives the half angle between the contact points by the half-angle law of
 //! cosines, `sin²(θ/2) = h (2 r_e − h) / (4 |OC| |OP|)` (convex and concave alike; the plane is
-//! its limit `ω = 2√(2 r_e h − h²)`, 001 Eq. 3.61), free of the cancellation of `cos θ` for
+//! its limit `ω = 2√(2 r_e h − h²)`, Can, 2010, Eq. 3.61), free of the cancellation of `cos θ` for
 //! large `ρ`. The side step `ω` is the chord `2ρ sin θ` between the contact points.
 
-/// 001 Eq. 3.69/3.70 (Lo 1999): `ω = √(8 |ρ| r h / (|ρ| + r·sign))`, `sign = +1` convex, −1
+/// Can (2010), Eq. 3.69/3.70 (Lo 1999): `ω = √(8 |ρ| r h / (|ρ| + r·sign))`, `sign = +1` convex, −1
 /// concave, `ρ = None` for a plane (`ω = √(8 r h)`). `None` where the denominator is not
 /// positive (a concave radius at or below the cutter's: local gouge).
 pub fn stepover_lo(r: f64, radius: Option<Convexity>, h: f64) -> Option<f64> {
@@ -30,7 +30,7 @@ pub fn stepover_lo(r: f64, radius: Option<Convexity>, h: f64) -> Option<f64> {
     }
 }
 
-/// 001's inverse of Eq. 3.69: the scallop `h = ω² (|ρ| + r·sign) / (8 |ρ| r)`.
+/// The inverse of Can's Eq. 3.69: the scallop `h = ω² (|ρ| + r·sign) / (8 |ρ| r)`.
 pub fn scallop_lo(r: f64, radius: Option<Convexity>, omega: f64) -> f64 {
     match radius {
         None => omega * omega / (8.0 * r),
@@ -94,9 +94,9 @@ pub fn stepover_exact(r_e: f64, kappa: f64, h: f64) -> Option<f64> {
 }
 
 /// The exact cusp height left between contact points a chord `omega` apart (inverse of
-/// [`stepover_exact`]): 001 §2.7's closed forms, convex `h = (ρ+r)cos θ − √(r² − (ρ+r)² sin²θ) − ρ`,
-/// concave `h = ρ − (ρ−r)cos θ − √(r² − (ρ−r)² sin²θ)`, `sin θ = ω/(2ρ)`. `None` where the
-/// geometry has no cusp (`ω ≥ 2r` on a plane, a gouging concave section).
+/// [`stepover_exact`]): Can's (2010, §3.3.14) closed forms, convex `h = (ρ+r)cos θ − √(r² − (ρ+r)²
+/// sin²θ) − ρ`, concave `h = ρ − (ρ−r)cos θ − √(r² − (ρ−r)² sin²θ)`, `sin θ = ω/(2ρ)`. `None` where
+/// the geometry has no cusp (`ω ≥ 2r` on a plane, a gouging concave section).
 pub fn scallop_exact(r: f64, kappa: f64, omega: f64) -> Option<f64> {
     if kappa.abs() < PLANE {
         let half = omega / 2.0;
@@ -143,7 +143,7 @@ mod tests {
         assert!((scallop_lo(20.0, None, 4.0) - 0.1).abs() < 1e-12);
         let re = 20.0 / 25f64.to_radians().sin();
         assert!((scallop_lo(re, None, 4.0) - 0.0423).abs() < 5e-5);
-        // 001 §2.7 caveat: the exact cusp at T4's step is 0.206, not 0.200.
+        // Caveat: the exact cusp at the step of Can's Table 4.3 (h = 0.2) is 0.206, not 0.200.
         let h = scallop_exact(5.0, -1.0 / 26.054_498_581_438_6, 2.5907).unwrap();
         assert!((h - 0.206).abs() < 5e-4, "{h}");
         // …and for T7 0.223 (+12 %).

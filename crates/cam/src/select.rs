@@ -1,9 +1,9 @@
-//! Tool selection (001 §2.10): the largest cutter of a standard set that fits the surface's
-//! tightest concave curvature. A ball fits if its radius is below the smallest concave radius;
-//! a flat end mill needs a lead ("Sturz") angle with `r / sin S ≤ ρ`, capped at `S_max`
+//! Tool selection (Can, 2010, §3.4.7.2): the largest cutter of a standard set that fits the
+//! surface's tightest concave curvature. A ball fits if its radius is below the smallest concave
+//! radius; a flat end mill needs a lead ("Sturz") angle with `r / sin S ≤ ρ`, capped at `S_max`
 //! (20° in 001), so its radius is at most `ρ sin S_max`, snapped down to a standard size, and
 //! the lead recomputed as `asin(r/ρ)`. The tightest radius is read from the principal
-//! curvatures over the whole surface (001 scans only the two iso-parametric directions).
+//! curvatures over the whole surface (Can scans only the two iso-parametric directions).
 
 use tezgah_geom::NurbsSurface;
 
@@ -63,7 +63,7 @@ pub fn tightest_concave_radius(
 }
 
 /// The largest flat-end radius that curvature matching allows on `radius` at `max_lead_deg`:
-/// `ρ sin S_max` (001 L1894).
+/// `ρ sin S_max` (Can, 2010, §3.4.7.2).
 pub fn max_flat_radius(radius: f64, max_lead_deg: f64) -> f64 {
     radius * max_lead_deg.to_radians().sin()
 }
@@ -130,8 +130,9 @@ mod tests {
     use super::*;
     use crate::testing;
 
-    /// The sizes 001's tables use (its standard table is not given): with 12 mm in the set
-    /// T1 would pick 12, so the thesis's own set evidently lacked it.
+    /// The sizes Can's (2010) tables use (its standard table is not given): with 12 mm in the
+    /// set its §3.4.7.2 example (ρ = 20, S ≤ 20°) would pick 12, so the thesis's own set evidently
+    /// lacked it.
     const THESIS_SET: [f64; 4] = [6.0, 10.0, 16.0, 20.0];
 
     #[test]

@@ -1,7 +1,7 @@
 //! Test surfaces built in code, shared by the unit tests, the integration tests and the
-//! benchmark: a plane, the complete boundary curve of reference 001's STEP excerpt, a
-//! free-form bicubic patch, cylinder and sphere patches as rational NURBS, a saddle, and random
-//! bicubic patches for property tests. Not part of the planning API.
+//! benchmark: a plane, the complete boundary curve of the STEP excerpt in Can (2010,
+//! Appendix A), a free-form bicubic patch, cylinder and sphere patches as rational NURBS, a
+//! saddle, and random bicubic patches for property tests. Not part of the planning API.
 
 use tezgah_geom::{NurbsSurface, Vec3};
 
@@ -23,10 +23,10 @@ pub fn plane(size: f64) -> NurbsSurface {
     NurbsSurface::bspline(1, 1, &p, clamped(1, &[]), clamped(1, &[])).expect("valid plane")
 }
 
-/// Row 1 of reference 001's STEP excerpt (entities #3, #2, #4, #10, #5, #12, #11, #9, #8, #7,
-/// #6 with the corrected 15-knot v vector, 001 §5.1) as the `u = 0` edge of a ruled strip
+/// Row 1 of Can's (2010, Appendix A) STEP excerpt (entities #3, #2, #4, #10, #5, #12, #11, #9, #8,
+/// #7, #6 with the v knot vector corrected to 15 knots) as the `u = 0` edge of a ruled strip
 /// (the second row is the first moved 10 mm along −y), so `S(0, v)` is the boundary curve
-/// whose golden values 001 §5.2 lists.
+/// whose golden values `forward_step`'s tests list.
 // The coordinates and knots keep every digit the STEP file prints.
 #[allow(clippy::excessive_precision)]
 pub fn boundary_curve_001() -> NurbsSurface {

@@ -48,7 +48,7 @@ fn bull(d: f64, r: f64) -> Cutter {
 }
 
 /// Settings as `tezgah cam` makes them for tolerance [`TOLERANCE`]; flat and bull-nose
-/// cutters stand at `lead_deg` (001: 5–20°).
+/// cutters stand at `lead_deg` (Can, 2010: 5–20°).
 fn banded(kind: StrategyKind, h: f64, lead_deg: f64) -> Settings {
     let shares = ToleranceShares::of(TOLERANCE);
     let mut s = Settings::new(kind, h, shares.chord);

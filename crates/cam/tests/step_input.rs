@@ -1,4 +1,4 @@
-//! STEP input: the thesis's STEP excerpt (reference 001, EK-A) with its golden boundary curve,
+//! STEP input: the STEP excerpt of Can (2010, Appendix A) with its golden boundary curve,
 //! hand-written files with closed-form answers (a plane face, units), and the exact error
 //! texts for unknown entities, dangling references, bad knot counts and units.
 
@@ -111,8 +111,9 @@ fn excerpt_surface_reports_the_corrupted_multiplicities_then_the_elided_points()
         f.surface(1).unwrap_err().to_string(),
         "#1 B_SPLINE_SURFACE_WITH_KNOTS (line 15): v multiplicities list has 8 entries but v knots has 9"
     );
-    // Reference 001 §5.1: the v list must be (4,1,1,1,1,1,1,1,4); with it repaired, the first
-    // control point the excerpt elided (row 2, column 8) is the error.
+    // The excerpt's v multiplicities do not add up (Σ ≠ n + p + 1): the v list must be
+    // (4,1,1,1,1,1,1,1,4); with it repaired, the first control point the excerpt elided (row 2,
+    // column 8) is the error.
     let repaired = text.replacen(
         "( 4, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 0.0",
         "( 4, 1, 1, 1, 1, 1, 1, 1, 4 ),\n  ( 0.0",
@@ -132,9 +133,9 @@ fn excerpt_surface_reports_the_corrupted_multiplicities_then_the_elided_points()
 
 #[test]
 fn excerpt_boundary_curve_matches_the_golden_values() {
-    // #114 is the u = 0 boundary reversed: C(t) = S(0, 1 − t); reference 001 §5.2 gives
-    // S(0, v) to 9 decimals. #121 (the curve's first point) lost digits in transcription
-    // (≈ 2e-9 mm), hence 1e-8.
+    // #114 is the u = 0 boundary reversed: C(t) = S(0, 1 − t); Cox–de Boor on the
+    // repaired data gives S(0, v) to 9 decimals. #121 (the curve's first point) lost digits in
+    // transcription (≈ 2e-9 mm), hence 1e-8.
     let f = StepFile::parse(excerpt_without_elisions().as_bytes()).unwrap();
     let c = f.curve(114).unwrap();
     assert_eq!(c.degree(), 3);

@@ -494,10 +494,10 @@ fn one_way_and_two_way_zigzag_differ_only_in_direction() {
 
 #[test]
 fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
-    // 001 §4.1: a flat end mill with curvature-matched lead cuts 30–40 % less path than a ball
-    // of the same diameter. Free-form patch, D6, iso-scallop, h = 0.04, lead 5° (raised where
-    // the cross-feed section is concave, and where the heel would gouge). A tight chord
-    // tolerance (a tenth of h), so the material left below is the scallop, not the chords.
+    // Can (2010, Tables 4.1–4.5): a flat end mill with curvature-matched lead cuts 30–40 % less
+    // path than a ball of the same diameter. Free-form patch, D6, iso-scallop, h = 0.04, lead 5°
+    // (raised where the cross-feed section is concave, and where the heel would gouge). A tight
+    // chord tolerance (a tenth of h), so the material left below is the scallop, not the chords.
     // (It ran at h = 0.01, with four times the locations: both steps grow as √h while h is
     // small against the radii.)
     let s = testing::freeform(0.0);

@@ -1,5 +1,5 @@
 // The 3-D path preview: plain WebGL lines, an orbit camera (rotate, pan, zoom; mouse, wheel
-// and touch), the path coloured by kind as reference 000 does, the travel box and the tool.
+// and touch), the path coloured by kind as Kelekçi (2021) does, the travel box and the tool.
 
 const COLOURS = {
   line: [0.25, 0.88, 0.82],   // turquoise

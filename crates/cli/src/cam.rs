@@ -19,7 +19,7 @@ use tezgah_kinematics::{Kinematics, Machine};
 
 use crate::cam_tool::{self, ToolSpec};
 
-/// The command line of `tezgah cam` (DESIGN.md "Command-line contract").
+/// The command line of `tezgah cam` (README.md and docs/cam.md describe it).
 #[derive(clap::Args)]
 pub struct CamArgs {
     /// The surface (STEP file).
@@ -452,8 +452,8 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     if let Some(c) = args.verify_cell_mm {
         positive("--verify-cell", c)?;
     }
-    // One guarantee (DESIGN.md "Tolerance"), one-sided: the machine's motion runs between
-    // the exact cutter-location surface and the tolerance outside it. Chords get half,
+    // One guarantee (ARCHITECTURE.md, "One tolerance budget"), one-sided: the machine's motion runs
+    // between the exact cutter-location surface and the tolerance outside it. Chords get half,
     // linearisation and blending an eighth each (`ToleranceShares`).
     let shares = ToleranceShares::of(tolerance);
     // Trims are followed to a quarter of the chord tolerance.

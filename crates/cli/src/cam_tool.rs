@@ -1,5 +1,5 @@
 //! `tezgah cam --tool auto`: the cutter chosen for the face before planning — the largest ball
-//! end mill that fits the face's tightest concave curvature (reference 001 §2.10, via
+//! end mill that fits the face's tightest concave curvature (Can, 2010, §3.4.7.2, via
 //! `tezgah_cam::select`), from the tool table's ball end mills or else the standard set.
 
 use std::path::Path;
@@ -17,7 +17,8 @@ const CURVATURE_LATTICE: usize = 64;
 /// sees the curvature only at its nodes, and the strategy refuses any point where the ball's
 /// radius exceeds the local one (a local gouge), splitting the pass there.
 const FIT_MARGIN: f64 = 0.05;
-/// Most lead a flat end mill may need to fit (001 §2.10's `S_max`), for the alternative noted.
+/// Most lead a flat end mill may need to fit (Can's `S_max`, 2010, §3.4.7.2), for the alternative
+/// noted.
 const MAX_FLAT_LEAD_DEG: f64 = 20.0;
 
 /// What `--tool` asks for: a cutter given by its SPEC, or `auto`.

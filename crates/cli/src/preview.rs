@@ -1,6 +1,6 @@
 //! The panel's 3-D preview of a loaded program: its moves as polylines of tool-tip points
 //! (mm, the frame of the status' `tip`), each with its kind, so the panel colours them as
-//! reference 000 does: lines, arcs and helices, G05.1-fitted runs, NURBS, rapids.
+//! Kelekçi (2021, ch. 4) does: lines, arcs and helices, G05.1-fitted runs, NURBS, rapids.
 
 use serde::Serialize;
 use tezgah_geom::{Arc, Curve, Move, MoveKind, Pose};

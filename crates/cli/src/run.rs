@@ -103,7 +103,7 @@ enum SinkError {
     Forward(u32, tezgah_kinematics::KinematicsError),
 }
 
-/// The command line of `tezgah run` (DESIGN.md "Command-line contract").
+/// The command line of `tezgah run` (README.md describes it).
 #[derive(clap::Args)]
 pub struct RunArgs {
     /// The G-code program (default: the built-in demo).
@@ -234,7 +234,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         ..PlanOptions::default()
     };
 
-    // DESIGN.md: the tool axis columns for machines with rotary joints.
+    // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
         .joints
         .iter()

@@ -1,7 +1,7 @@
 //! `tezgah run --drive servo`: every planned sample goes, as the executor would send it
 //! (position, and velocity and acceleration by backward differences), through the simulated
 //! servo drive of the machine file (`tezgah_executor::drive::servo`); the report gives the
-//! tracking errors as reference 000 §4 does (eq. 5.1): per joint RMSE and largest following
+//! tracking errors as Kelekçi (2021, eq. 5.1) does: per joint RMSE and largest following
 //! error, and the contour error (distance of the actual tip from the commanded path).
 
 use tezgah_executor::drive::{ContourError, ContourStats, Drive, JointTracking, ServoDrive};

@@ -1,5 +1,5 @@
 //! `tezgah cam --tool auto` end to end: the cutter is chosen for the face (the largest ball
-//! that fits its tightest concave curvature, reference 001 §2.10) from the tool table's ball
+//! that fits its tightest concave curvature, Can, 2010, §3.4.7.2) from the tool table's ball
 //! end mills, or from the standard set without a table; the choice and its reason are
 //! printed, and the report and program name the chosen tool.
 

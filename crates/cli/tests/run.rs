@@ -1,5 +1,5 @@
 //! `tezgah run` and `tezgah machines` end to end through the binary: the demo on the default
-//! machine, the samples CSV and report JSON per DESIGN.md's contract, plots, and errors.
+//! machine, the samples CSV and report JSON as the README documents them, plots, and errors.
 
 mod common;
 
@@ -353,9 +353,9 @@ fn close(got: [f64; 3], want: [f64; 3], tol: f64, what: &str) {
 }
 
 /// table-ac with TCP off: the joints are the program axes, and the tip columns are the tool
-/// tip by DESIGN.md's convention — p = Rz(−C)·(Rx(−A)·(q − L·ẑ − pivot) − c_offset) with
-/// G43's L = 28.5 (T2) — and the tool axis (sin A sin C, sin A cos C, cos A). Columns print 12
-/// decimals, hence the 1e-9.
+/// tip by the table-ac convention (docs/machine-files.md) — p = Rz(−C)·(Rx(−A)·(q − L·ẑ − pivot) −
+/// c_offset) with G43's L = 28.5 (T2) — and the tool axis (sin A sin C, sin A cos C, cos A).
+/// Columns print 12 decimals, hence the 1e-9.
 #[test]
 fn samples_tip_and_tool_axis_are_the_forward_kinematics_on_table_ac() {
     let program = "G21 G90 G94 G61\nG43 H2\nG0 X10 Y20 Z30 A0 C0\n\

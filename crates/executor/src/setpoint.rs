@@ -1,7 +1,7 @@
-//! The set-point: what the executor hands the drives once per period (reference 000 §1.4's
-//! 1 ms stream). Position, velocity and acceleration per joint, so a drive can feed forward;
-//! internal units (mm, rad), machine-file joint order. Fixed size: it crosses the lock-free
-//! ring into the real-time thread, which never allocates.
+//! The set-point: what the executor hands the drives once per period (the 1 ms stream of
+//! Kelekçi, 2021, §4.2). Position, velocity and acceleration per joint, so a drive can feed
+//! forward; internal units (mm, rad), machine-file joint order. Fixed size: it crosses the
+//! lock-free ring into the real-time thread, which never allocates.
 //!
 //! The velocity and acceleration a set-point carries are the state at its own instant of the
 //! cubic through it and the three positions before it ([`History`]): the real-time side

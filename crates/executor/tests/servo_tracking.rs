@@ -1,7 +1,7 @@
 //! The simulated servo drive under manual motion and under a circle, against closed forms:
 //! a single-joint jog lags along its own line (following error, no contour error); a circle
 //! through two identical loops shrinks by the loop's gain at ω = v/R (contour error) and each
-//! joint's error is the sinusoid R·|1 − H(jω)| (RMSE = that / √2, reference 000 eq. 5.1).
+//! joint's error is the sinusoid R·|1 − H(jω)| (RMSE = that / √2, Kelekçi, 2021, eq. 5.1).
 
 use std::f64::consts::PI;
 

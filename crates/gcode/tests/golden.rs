@@ -1,4 +1,4 @@
-//! Golden cases from reference 000 (Kelekçi 2021): the controller listing of its §1.2 must
+//! Golden cases from Kelekçi (2021): the controller's listing (Fig. 4.36) must
 //! read into alternating lines and R-format fillet arcs with exact trailing-dot numbers.
 
 use tezgah_gcode::{Canon, Config, Interpreter, Origin};
@@ -27,7 +27,7 @@ M2
 ";
 
 #[test]
-fn listing_of_reference_000_section_1_2() {
+fn kelekci_fig_4_36_listing() {
     let mut calls: Vec<(Origin, Canon)> = Vec::new();
     Interpreter::new(Config::default())
         .run(LISTING, &mut calls)

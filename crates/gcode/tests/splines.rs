@@ -1,6 +1,7 @@
 //! Spline blocks end to end, program text to moves: Fanuc's G06.2 on the golden NURBS of
-//! reference 000 §5 items 1–2 (the move's curve length), the frames applied to control points,
-//! LinuxCNC's G5/G5.1/G5.2 as Bézier and NURBS moves, and G06.2's errors with line and column.
+//! Kelekçi (2021, data (2.39) and (2.48), Table 2.4: the move's curve length), the frames applied
+//! to control points, LinuxCNC's G5/G5.1/G5.2 as Bézier and NURBS moves, and G06.2's errors with
+//! line and column.
 
 use tezgah_gcode::{program_moves, Config, ErrorKind, GcodeError};
 use tezgah_geom::{Curve, Move, MoveKind, Nurbs};
@@ -56,7 +57,7 @@ const K_248: [f64; 11] = [0.0, 0.0, 0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0, 1.0, 1.
 
 #[test]
 fn g06_2_thesis_curve_has_the_golden_length() {
-    // Reference 000 §5 item 1: data (2.39), weights 1, clamped cubic: L = 19.0203 mm.
+    // Kelekçi (2021), data (2.39), weights 1, clamped cubic: L = 19.0203 mm.
     let c = the_nurbs(&g06_2(4, &X_239, &Y_239, &[1.0; 10], &K_239, ""));
     assert_eq!(c.degree(), 3);
     assert!((c.length() - 19.0203).abs() < 5e-5, "{}", c.length());
@@ -64,7 +65,7 @@ fn g06_2_thesis_curve_has_the_golden_length() {
 
 #[test]
 fn g06_2_weighted_curves_have_the_golden_lengths() {
-    // Reference 000 §5 item 2: data (2.48), Table 2.4 lengths for W1, W2, W3.
+    // Kelekçi (2021), data (2.48), Table 2.4 lengths for W1, W2, W3.
     let cases = [
         ([1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0], 244.9780),
         ([1.0, 1.0, 5.0, 5.0, 5.0, 1.0, 1.0], 200.6809),

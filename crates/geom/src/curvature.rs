@@ -1,6 +1,6 @@
-//! Local curvature maxima of a curve: where the feed planner must slow down (reference 000
-//! §2.6 splits a NURBS at the maxima above a threshold and limits the feed there by
-//! `√(A/κ)` and `(J/κ²)^(1/3)`). Dense sampling per knot span plus golden-section refinement.
+//! Local curvature maxima of a curve: where the feed planner must slow down (Kelekçi,
+//! 2021, §3.3.1, eq. 3.33, splits a NURBS at the maxima above a threshold and limits the feed there
+//! by `√(A/κ)` and `(J/κ²)^(1/3)`). Dense sampling per knot span plus golden-section refinement.
 
 use crate::curve::Curve;
 use crate::deviation::maximise;

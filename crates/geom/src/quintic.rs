@@ -1,4 +1,4 @@
-//! The quintic corner blend of reference 004 (§2.4, Eqs 4–6): a degree-5 polynomial in local
+//! The quintic corner blend of Kahraman et al. (§3, eqs 4–6): a degree-5 polynomial in local
 //! time `τ` in `[0, T]` that matches position, velocity and acceleration at both ends, so a
 //! blended junction is C² in time. The path builder places one at every blended corner.
 
@@ -24,8 +24,8 @@ pub struct Quintic {
 }
 
 impl Quintic {
-    /// The unique quintic with the given end states over `duration` seconds (reference 004,
-    /// Step 6, checked against its worked example).
+    /// The unique quintic with the given end states over `duration` seconds (Kahraman et
+    /// al., §3; checked against coefficients worked out by hand in `tests/closed_forms.rs`).
     pub fn hermite(start: State, end: State, duration: f64) -> Result<Self, CurveError> {
         let t = duration;
         if !(t.is_finite() && t > 0.0) {

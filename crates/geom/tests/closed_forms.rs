@@ -1,6 +1,7 @@
 //! Closed forms: line, arc and helix lengths and curvature (1/r, r/(r²+c²)), arcs in every plane
-//! with the right sense of rotation (reference 000 §5 items 7–9), the exact NURBS quarter
-//! circle, Bézier = clamped B-spline, and the quintic blend values of reference 004 §5.3–5.4.
+//! with the right sense of rotation (Kelekçi, 2021, examples (2.21), (3.25), (2.24)), the exact
+//! NURBS quarter circle, Bézier = clamped B-spline, and the values of Kahraman et al.'s quintic
+//! blend (§3), worked out by hand.
 
 use std::f64::consts::{FRAC_PI_2, PI, SQRT_2};
 
@@ -27,12 +28,12 @@ fn line_is_arc_length_parameterised() {
     let m = ArcLengthMap::new(&l, 1e-12).unwrap();
     assert!((m.length() - 13.0).abs() < 1e-12);
     assert!((m.u_at(&l, 6.5) - 6.5).abs() < 1e-12);
-    // Reference 000 §2.1 examples.
+    // Kelekçi (2021), §2.1 examples.
     let l = Line::new(Vec3::new(2.0, -1.0, 3.0), Vec3::new(12.0, 7.0, -2.0)).unwrap();
     assert_close(l.length(), 13.7477, 4, "G01 X12 Y7 Z-2");
 }
 
-/// Centre of an R-form arc (reference 000 §2.2, vector form): right of the chord for CW with
+/// Centre of an R-form arc (Kelekçi, 2021, §2.2, vector form): right of the chord for CW with
 /// R > 0, left for CCW; R < 0 flips the side.
 fn r_centre(p0: (f64, f64), p1: (f64, f64), r: f64, cw: bool) -> [f64; 2] {
     let (dx, dy) = (p1.0 - p0.0, p1.1 - p0.1);
@@ -58,7 +59,7 @@ fn xy_arc(start: Pose, end: (f64, f64, f64), r: f64, cw: bool) -> Arc {
 }
 
 #[test]
-fn item7_g02_r5_and_major_arc() {
+fn arc_2_21_g02_r5_and_major_arc() {
     let s = Pose::new(0.24, 1.53, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (9.019, 2.975, 0.0), 5.0, true);
     assert_close(a.center().x, 5.0, 3, "cx");
@@ -74,7 +75,7 @@ fn item7_g02_r5_and_major_arc() {
 }
 
 #[test]
-fn item8_g02_r14_976() {
+fn arc_3_25_g02_r14_976() {
     let s = Pose::new(0.2407, 1.533, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (9.019, 2.975, 0.0), 14.976, true);
     assert_close(a.center().x, 6.9479, 4, "cx");
@@ -84,7 +85,7 @@ fn item8_g02_r14_976() {
 }
 
 #[test]
-fn item9_g03_helix_and_curvature() {
+fn helix_2_24_g03_and_curvature() {
     let s = Pose::new(14.32, 5.66, 0.0, 0.0, 0.0, 0.0);
     let a = xy_arc(s, (14.94, 1.749, 2.0), 14.976, false);
     assert_close(a.center().x, 29.2915, 4, "cx");
@@ -92,7 +93,7 @@ fn item9_g03_helix_and_curvature() {
     assert_close(a.sweep().to_degrees(), 15.194, 3, "sweep");
     let planar = a.radius() * a.sweep();
     assert_close(planar, 3.9715, 4, "planar length");
-    // The helix's own length includes the lead (DESIGN: F includes helix pitch).
+    // The helix's own length includes the lead (F is along the helix, pitch included).
     assert!((a.length() - planar.hypot(2.0)).abs() < 1e-12);
     let numeric = ArcLengthMap::new(&a, 1e-12).unwrap().length();
     assert!((numeric - a.length()).abs() < 1e-11);
@@ -229,7 +230,7 @@ fn st(p: [f64; 3], v: [f64; 3], a: [f64; 3]) -> State {
 }
 
 #[test]
-fn quintic_coefficients_of_reference_004() {
+fn quintic_coefficients() {
     let q = Quintic::hermite(
         st([1., 0., 0.], [2., 0., 0.], [3., 0., 0.]),
         st([5., 0., 0.], [-1., 0., 0.], [0.5, 0., 0.]),
@@ -260,7 +261,7 @@ fn quintic_coefficients_of_reference_004() {
     .is_err());
 }
 
-/// Line–line corner blend of reference 004 §2.5: legs `ell`, speed `v`, turn `phi`.
+/// Line–line corner blend of Kahraman et al. (§3): legs `ell`, speed `v`, turn `phi`.
 fn corner(ell: f64, v: f64, phi: f64) -> (Quintic, Vec3) {
     let t0 = Vec3::new(1.0, 0.0, 0.0);
     let t1 = Vec3::new(phi.cos(), phi.sin(), 0.0);
@@ -295,7 +296,7 @@ fn peaks(q: &Quintic) -> (f64, f64, f64) {
 }
 
 #[test]
-fn quintic_corner_blends_of_reference_004() {
+fn quintic_corner_blends() {
     let (q, c) = corner(1.0, 10.0, FRAC_PI_2);
     let k = q.coefficients();
     // x(τ) = −1 + 10τ − 250τ³ + 625τ⁴, y(τ) = 250τ³ − 625τ⁴.

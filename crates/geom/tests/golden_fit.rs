@@ -1,6 +1,7 @@
-//! Golden fitting numbers of reference 000 §5: centripetal interpolation (item 5: parameters,
-//! averaged knots, control points), the other parameterisations' parameters and knots, the
-//! polyline totals of Table 2.6 (item 6) and the reference's reproduction of the fitted lengths.
+//! Golden fitting numbers of Kelekçi (2021, §2.4): centripetal interpolation (eqs 2.66–2.70:
+//! parameters, averaged knots, control points), the other parameterisations' parameters and
+//! knots, the polyline totals of Table 2.6 and its fitted lengths recomputed by the standard
+//! algorithm.
 
 use tezgah_geom::fit::{averaged_knots, interpolate, parameters, Parameterisation};
 use tezgah_geom::{Curve, Vec3};
@@ -42,7 +43,7 @@ fn set(i: usize) -> Vec<Vec3> {
 }
 
 #[test]
-fn item5_centripetal_interpolation() {
+fn centripetal_interpolation_2_66() {
     let q = set(0);
     let t = parameters(&q, Parameterisation::Centripetal, 3).unwrap();
     assert_all(&t, &[0., 0.19921, 0.37603, 0.59325, 0.83700, 1.], 5, "t");
@@ -71,7 +72,7 @@ fn item5_centripetal_interpolation() {
 }
 
 #[test]
-fn item5_chord_and_uniform_parameters_and_knots() {
+fn chord_and_uniform_parameters_and_knots() {
     let q = set(0);
     let t = parameters(&q, Parameterisation::ChordLength, 3).unwrap();
     assert_all(
@@ -101,11 +102,11 @@ fn polyline_length(q: &[Vec3]) -> f64 {
 }
 
 #[test]
-fn item6_polyline_totals() {
+fn table_2_6_polyline_totals() {
     let want = [27.698, 23.282, 12.898, 28.217];
     let got: Vec<f64> = (0..4).map(|i| polyline_length(&set(i))).collect();
     // True totals 27.69874 and 12.89726: Table 2.6 prints 27.698 (truncated) and 12.898 (one
-    // unit high); the reference's recomputation prints 27.699 and 12.897. One unit of slack.
+    // unit high); rounded they are 27.699 and 12.897. One unit of slack.
     for (g, w) in got.iter().zip(want) {
         assert!((g - w).abs() <= 1e-3, "{got:?}");
     }
@@ -114,8 +115,9 @@ fn item6_polyline_totals() {
 
 #[test]
 fn table_2_6_fitted_lengths_as_reproduced() {
-    // Reference 000 §4, "my reproduction" (degree 3, averaged knots, universal = uniform
-    // knots + basis peaks): columns centripetal, chord, uniform, universal.
+    // Table 2.6 recomputed by Piegl & Tiller's A9.1 (degree 3, averaged knots, universal =
+    // uniform knots + basis peaks; the thesis's 31.329 and 26.855 differ, docs/errata.md): columns
+    // centripetal, chord, uniform, universal.
     let want = [
         [32.332, 31.692, 34.774, 31.465],
         [25.107, 26.310, 29.393, 25.638],

@@ -1,5 +1,6 @@
-//! Golden NURBS numbers of reference 000 §5 (items 1–4): lengths, weighted lengths and the
-//! curvature maxima of the (3.39) demo curve. Each value is checked to every digit given.
+//! Golden NURBS numbers of Kelekçi (2021, §2.3): lengths of (2.39), weighted lengths of Table
+//! 2.4 and the curvature maxima of the (3.39) demo curve. Each value is checked to every digit
+//! given.
 
 use tezgah_geom::curvature::curvature_peaks;
 use tezgah_geom::{ArcLengthMap, Curve, Nurbs, Vec3};
@@ -34,16 +35,16 @@ fn length(c: &Nurbs) -> f64 {
 }
 
 #[test]
-fn item1_clamped_cubic_length_19_02() {
+fn clamped_cubic_2_39_length_19_02() {
     let knots = vec![0., 0., 0., 0., 1., 2., 3., 4., 5., 6., 7., 7., 7., 7.];
     let c = Nurbs::bspline(3, &data_239(), knots).unwrap();
     assert_digits(length(&c), 19.02, 2);
-    // The reference's own recomputation carries two more digits.
+    // A recomputation carries two more digits.
     assert_digits(length(&c), 19.0203, 4);
 }
 
 #[test]
-fn item1_uniform_knots_length_14_1316() {
+fn uniform_knots_2_39_length_14_1316() {
     let knots = (0..14).map(f64::from).collect();
     let c = Nurbs::bspline(3, &data_239(), knots).unwrap();
     assert_eq!(c.domain(), (3.0, 10.0));
@@ -59,7 +60,7 @@ fn curve_248(w: &[f64], scale: f64) -> Nurbs {
 }
 
 #[test]
-fn item2_weighted_lengths_table_2_4a() {
+fn weighted_lengths_table_2_4a() {
     let w1 = [1.0; 7];
     let w2 = [1., 1., 5., 5., 5., 1., 1.];
     let w3 = [1., 1., 10., 10., 10., 1., 1.];
@@ -76,18 +77,18 @@ fn curve_249(w: &[f64], planar: bool) -> Nurbs {
     let knots = vec![
         0., 0., 0., 0., 0.125, 0.25, 0.375, 0.5, 0.625, 0.75, 0.875, 1., 1., 1., 1.,
     ];
-    // Erratum: the reference prints 12 weights for 11 points; the first 11 reproduce it.
+    // Erratum: the thesis prints 12 weights for 11 points; the first 11 reproduce it.
     Nurbs::new(3, &pts(&x, &y, &z), &w[..11], knots).unwrap()
 }
 
 #[test]
-fn item3_table_2_4b_planar_first_eleven_weights() {
+fn table_2_4b_planar_first_eleven_weights() {
     let w1 = [1.0; 12];
     let w2 = [1., 2., 2., 1., 1., 1., 1., 1., 1., 2., 2., 1.];
     let w3 = [1., 5., 5., 1., 1., 1., 1., 1., 1., 5., 5., 1.];
     assert_digits(length(&curve_249(&w1, true)), 47.8306, 4);
     assert_digits(length(&curve_249(&w2, true)), 48.8923, 4);
-    // The thesis prints 50.1599; the true value is 50.16002 (the reference's 50.1600).
+    // The thesis prints 50.1599; the true value is 50.16002.
     assert_digits(length(&curve_249(&w3, true)), 50.1600, 4);
     assert_digits(length(&curve_249(&w1, false)), 49.3914, 4);
 }
@@ -101,7 +102,7 @@ fn curvature_maxima(c: &Nurbs) -> Vec<(f64, f64)> {
 }
 
 #[test]
-fn item4_curvature_demo_length_and_maxima() {
+fn curvature_demo_3_39_length_and_maxima() {
     let c = curve_248(&[1.0; 7], 0.25);
     assert_digits(length(&c), 61.2445, 4);
     let maxima = curvature_maxima(&c);
@@ -132,7 +133,7 @@ fn item4_curvature_demo_length_and_maxima() {
 }
 
 #[test]
-fn item4_inflections() {
+fn curvature_demo_3_39_inflections() {
     let c = curve_248(&[1.0; 7], 0.25);
     // Signed planar curvature changes sign at the inflections.
     let signed = |u: f64| {
@@ -151,7 +152,7 @@ fn item4_inflections() {
             }
         }
         // Exact zeros are 0.201444, 0.418448, 0.581552, 0.798556 (symmetric about 0.5): the
-        // reference's 0.2015 and 0.4185 are one unit high in the last digit.
+        // often quoted 0.2015 and 0.4185 are one unit high in the last digit.
         let u = 0.5 * (a + b);
         assert!((u - want).abs() <= 1e-4, "inflection {u} vs {want}");
     }

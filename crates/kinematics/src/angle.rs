@@ -1,6 +1,6 @@
 //! Angle helpers shared by the rotary models: wrapping, shortest unwrap next to the previous
 //! joint value, and choosing a turn that respects limits. Used by `yzca` and the trunnions
-//! when the inverse picks among solutions by continuity (reference 000 §2.9, eq. 5.5).
+//! when the inverse picks among solutions by continuity (Kelekçi, 2021, §5.3.1, eq. 5.5).
 
 use std::f64::consts::{PI, TAU};
 
@@ -17,7 +17,7 @@ pub fn wrap_pi(a: f64) -> f64 {
 }
 
 /// The value congruent to `a` (mod 2π) nearest to `previous`: the endless-table unwrap of
-/// reference 000 eq. 5.5 in its general form, θᵢ = θᵢ₋₁ + wrap(θ_new − θᵢ₋₁).
+/// Kelekçi (2021), eq. 5.5, in its general form, θᵢ = θᵢ₋₁ + wrap(θ_new − θᵢ₋₁).
 /// 355° followed by 5° gives 365°.
 #[inline]
 pub fn unwrap_near(a: f64, previous: f64) -> f64 {
@@ -225,7 +225,7 @@ mod tests {
         assert!((wrap_pi(-0.5 - TAU) + 0.5).abs() < 1e-12);
     }
 
-    /// Reference 000 §5 item 17: 0 … 355° then 5° is commanded as 365°.
+    /// Kelekçi (2021, §5.3.1): 0 … 355° then 5° is commanded as 365°.
     #[test]
     fn c_unwrap_355_to_5_is_365() {
         let c = unwrap_near(deg(5.0), deg(355.0));

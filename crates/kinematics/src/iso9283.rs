@@ -1,5 +1,5 @@
 //! ISO 9283 pose accuracy (AP) and pose repeatability (RP) from repeated measurements of
-//! commanded poses, as reference 002 §2.10 (eqs 3.16–3.19) reports them. A report-side tool:
+//! commanded poses, as Ayyıldız (2017, eqs 3.16–3.19) reports them. A report-side tool:
 //! it reads a CSV of commanded and attained positions and knows nothing of machines.
 
 use std::collections::BTreeMap;
@@ -123,7 +123,7 @@ pub fn parse_csv(text: &str) -> Result<Vec<Measurement>, Iso9283Error> {
     Ok(out)
 }
 
-/// Evaluates AP and RP per pose (reference 002 eqs 3.16–3.19).
+/// Evaluates AP and RP per pose (Ayyıldız, 2017, eqs 3.16–3.19).
 pub fn evaluate(measurements: &[Measurement]) -> Result<Report, Iso9283Error> {
     if measurements.is_empty() {
         return Err(Iso9283Error::Empty);

@@ -1,6 +1,6 @@
 //! The `Kinematics` trait every machine model implements: forward, inverse with continuity,
 //! the Jacobian, limits and the tool-centre-point (TCP) mapping. The planner calls it through
-//! [`crate::machine::Machine`]; the interpolator calls `inverse` once per sample (DESIGN.md flow).
+//! [`crate::machine::Machine`]; the interpolator calls `inverse` once per sample.
 
 use nalgebra::{Matrix6xX, Vector3, Vector6};
 
@@ -17,7 +17,8 @@ pub struct Tolerances {
     /// produce before the pose is refused (e.g. a tilted axis on a 3-axis mill).
     pub axis_rad: f64,
     /// Half-angle (rad) of the cone around a table's C axis inside which C is undefined and
-    /// the previous C is kept (the pole, reference peers_cam §7.3 item 2).
+    /// the previous C is kept (the pole: near it dC ≈ |d(i, j)|/sin A, so a path passing close
+    /// would swing C half a turn in one block; posts hold C inside a small cone).
     pub pole_cone_rad: f64,
     /// Distance (mm) from the C axis under which a tip is treated as on the axis (Y-Z-C-A).
     pub centre_mm: f64,

@@ -1,8 +1,8 @@
 //! tezgah-kinematics: machine models that map tool poses (tip + tool axis in the workpiece
 //! frame) to joint positions and back, and the machine definitions they are built from.
 //!
-//! Sits between the planner's interpolator and the joint set-points (DESIGN.md "The data
-//! flow": `poses ──kinematics: inverse──► joint set-points`). Layout, one idea per module:
+//! Sits between the planner's interpolator and the joint set-points (ARCHITECTURE.md,
+//! "Data flow": `poses ──kinematics: inverse──► joint set-points`). Layout, one idea per module:
 //!
 //! * [`pose`], [`error`], [`angle`]: typed values, errors, angle unwrapping;
 //! * [`kinematics`]: the [`Kinematics`] trait;

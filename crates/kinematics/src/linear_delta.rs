@@ -1,9 +1,9 @@
-//! Linear delta (3-PSS, reference 002): three vertical towers whose carriages carry rods of
+//! Linear delta (3-PSS, as Ayyıldız, 2017): three vertical towers whose carriages carry rods of
 //! length L to a platform that only translates. Joints are carriage heights, as LinuxCNC's
-//! lineardeltakins: `q_i = z + √(L² − (x − x_i)² − (y − y_i)²) − offset_i` (DESIGN.md).
+//! lineardeltakins: `q_i = z + √(L² − (x − x_i)² − (y − y_i)²) − offset_i`.
 //!
-//! The forward map is the closed-form trilateration of reference 002 §2.3 *as corrected
-//! there* (the thesis's printed eqs 3.6–3.15 do not invert eq. 3.5), written for any tower
+//! The forward map is Ayyıldız's closed-form trilateration (2017, eqs 3.6–3.15) *corrected*:
+//! as printed it does not invert eq. 3.5 (docs/errata.md), written for any tower
 //! angles: subtracting closure equations gives x, y linear in z; the smaller root of the
 //! remaining quadratic is the platform below the carriages.
 
@@ -22,16 +22,16 @@ pub struct DeltaGeometry {
     pub radius: f64,
     /// Rod length L, mm.
     pub rod_length: f64,
-    /// Tower angles from +X, rad (DESIGN.md default 90°, 210°, 330°).
+    /// Tower angles from +X, rad (LinuxCNC's and Klipper's default 90°, 210°, 330°).
     pub tower_angles: [f64; 3],
-    /// Subtracted from each carriage height, mm: joint = height − offset. Reference 002 uses
+    /// Subtracted from each carriage height, mm: joint = height − offset. Ayyıldız (2017) uses
     /// √(L² − r²) = 311.28765 so the platform at the origin reads joints (0, 0, 0).
     pub carriage_offsets: [f64; 3],
-    /// Smallest angle between a rod and the platform plane, rad (reference 002 uses 5°):
+    /// Smallest angle between a rod and the platform plane, rad (Ayyıldız, 2017, uses 5°):
     /// the rate q̇ = J·ṗ blows up as a rod becomes horizontal.
     pub min_rod_angle: f64,
     /// Largest angle, rad, between a rod and its direction with the platform at the centre:
-    /// the spherical joints' cone (reference 002's joints turn 22°). `None`: unchecked.
+    /// the spherical joints' cone (Ayyıldız's joints turn 22°). `None`: unchecked.
     pub max_joint_angle: Option<f64>,
 }
 
@@ -174,7 +174,7 @@ impl LinearDelta {
 
     /// Workspace volume, mm³: grid points (spacing `step_mm`) where the inverse succeeds
     /// within the rod angle, the joint cone and the carriage strokes, times the cell volume.
-    /// Reference 002 §2.4 reports 18 786 cm³ without a method; its digest derives ≈ 46 900 cm³
+    /// Ayyıldız (2017, §3) reports 18 786 cm³ without a method; a grid count gives ≈ 46 900 cm³
     /// (500 mm stroke, 5° rod angle) and ≈ 16 600 cm³ (plus a 22° joint cone), which this
     /// reproduces. Needs finite joint limits; refuses grids over `max_points` points.
     pub fn workspace_volume(&self, step_mm: f64, max_points: u64) -> Result<f64, KinematicsError> {
@@ -244,7 +244,8 @@ impl LinearDelta {
         }
     }
 
-    /// Platform point for joints: corrected closed form (reference 002 §2.3), any tower angles.
+    /// Platform point for joints: corrected closed form (Ayyıldız, 2017, eqs 3.6–3.15), any tower
+    /// angles.
     pub fn forward_platform(&self, q: &[f64; 3]) -> Result<Vector3<f64>, KinematicsError> {
         let o = &self.geometry.carriage_offsets;
         // Work relative to carriage 1's height to keep the numbers small.
@@ -281,7 +282,7 @@ impl LinearDelta {
         Ok(Vector3::new(ex + fx * z, ey + fy * z, z + h1))
     }
 
-    /// ∂q/∂p at a platform point (reference 002 §6.2 item 2): rows (−Δx/hᵢ, −Δy/hᵢ, 1).
+    /// ∂q/∂p at a platform point, differentiating eq. 3.5: rows (−Δx/hᵢ, −Δy/hᵢ, 1).
     pub fn inverse_jacobian(&self, p: &Vector3<f64>) -> Result<Matrix3<f64>, KinematicsError> {
         let mut m = Matrix3::zeros();
         for i in 0..3 {

@@ -1,4 +1,4 @@
-//! Machine definitions: the TOML file of DESIGN.md ("Machine definition (TOML)") read,
+//! Machine definitions: the TOML machine file (docs/machine-files.md) read,
 //! validated field by field, and turned into a kinematic [`Model`]. The CLI's `--machine`
 //! and `tezgah machines` and the planner's joint limits all start here.
 //!
@@ -776,7 +776,7 @@ fn build_home(
     })
 }
 
-/// Fills in the homing order. By default Z goes first (reference 000 §1.3: away from the work
+/// Fills in the homing order. By default Z goes first (as Kelekçi, 2021, §4.1: away from the work
 /// before anything moves sideways), then the others one after another in file order; joints
 /// without a `sequence` when others have one follow them one after another in file order.
 fn home_order(joints: &mut [Joint], given: &[Option<u32>]) -> Result<(), MachineError> {

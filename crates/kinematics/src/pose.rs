@@ -1,6 +1,6 @@
 //! Typed values that flow through kinematics: joint sets, tool poses, tools and joint limits.
 //! Joint sets go in and out of every model; poses are what the interpolator produces in
-//! workpiece coordinates (DESIGN.md "The data flow"). Internal units are mm and rad.
+//! workpiece coordinates (ARCHITECTURE.md, "Data flow"). Internal units are mm and rad.
 
 use nalgebra::{Unit, Vector3};
 
@@ -115,7 +115,7 @@ impl std::ops::IndexMut<usize> for Joints {
 }
 
 /// Tool tip and tool axis in the workpiece frame (mm; the axis is a unit vector from the
-/// tip toward the spindle, DESIGN.md "Conventions").
+/// tip toward the spindle; docs/machine-files.md, "Kinematic conventions").
 #[derive(Clone, Copy, PartialEq, Debug)]
 pub struct ToolPose {
     /// Tool tip, mm, workpiece frame.
@@ -145,7 +145,7 @@ impl ToolPose {
 /// The tool as kinematics sees it: its length from the spindle gauge point to the tip.
 ///
 /// Linear joints position the gauge point (tool length 0); the tip is `length` further
-/// along −axis. The tool table supplies the value (DESIGN.md, tool-centre-point control).
+/// along −axis. The tool table supplies the value (G43/G43.4 H).
 #[derive(Clone, Copy, PartialEq, Debug, Default)]
 pub struct Tool {
     /// Gauge point to tool tip, mm (≥ 0 in practice; not enforced so probes can be modelled).

@@ -1,11 +1,12 @@
 //! Segmentation by deviation, not time: a move that is straight in program space is split so
 //! that interpolating the JOINTS linearly inside each piece keeps the tool tip within the
 //! tolerance of the programmed line. Used between the planner and joint-space sinks for
-//! non-linear machines (reference 002 §2.8: end-point-only conversion sags 4.6 mm).
+//! non-linear machines (Ayyıldız, 2017, converts end points only: its 100 mm XY
+//! diagonal sags 4.6 mm in Z, Table 5.2).
 //!
 //! Program space: tip on the straight line; tool axis on the great circle between the end
-//! axes (Rodrigues with the normalised rotation axis, reference 004 §2.3 corrected), or, under
-//! TCP, the rotary angles interpolated linearly.
+//! axes (Rodrigues with the normalised rotation axis; Kahraman et al.'s eq. 1 omits the
+//! normalisation), or, under TCP, the rotary angles interpolated linearly.
 
 use nalgebra::{Unit, Vector3};
 
@@ -53,8 +54,8 @@ pub struct Segmented {
 }
 
 /// The tool axis a fraction `t` of the way from `v` to `u` along the great circle:
-/// O(θ) = V·cos θ + (k̂ × V)·sin θ with k̂ = V×U/|V×U| (reference 004 eqs 1–3, with the
-/// normalisation the paper omits). Fails for opposite axes, where the circle is undefined.
+/// O(θ) = V·cos θ + (k̂ × V)·sin θ with k̂ = V×U/|V×U| (Kahraman et al., eqs 1–3, with
+/// the normalisation the paper omits). Fails for opposite axes, where the circle is undefined.
 pub fn slerp_axis(
     v: &Unit<Vector3<f64>>,
     u: &Unit<Vector3<f64>>,

@@ -1,11 +1,11 @@
-//! Table-tilting A/C orientation (DESIGN.md "Kinematic conventions"): A tilts the table
-//! about machine X, C turns the table about its own Z. This file holds only the tool-axis ↔
+//! Table-tilting A/C orientation (docs/machine-files.md, "Kinematic conventions"): A tilts the
+//! table about machine X, C turns the table about its own Z. This file holds only the tool-axis ↔
 //! (A, C) map; the chain with `pivot` and `c_offset` is shared in [`crate::trunnion`].
 
 use nalgebra::Vector3;
 
 /// Tool axis seen from the part for table angles (A, C), rad:
-/// `(sin A·sin C, sin A·cos C, cos A)` = Rz(C)ᵀ·Rx(A)ᵀ·ẑ (DESIGN.md).
+/// `(sin A·sin C, sin A·cos C, cos A)` = Rz(C)ᵀ·Rx(A)ᵀ·ẑ.
 #[inline]
 pub fn axis(a: f64, c: f64) -> Vector3<f64> {
     let (sa, ca) = a.sin_cos();

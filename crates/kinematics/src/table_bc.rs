@@ -1,12 +1,12 @@
-//! Table-tilting B/C orientation: as `table-ac` with B about machine Y (DESIGN.md). This file
+//! Table-tilting B/C orientation: as `table-ac` with B about machine Y. This file
 //! holds only the tool-axis ↔ (B, C) map; the chain with `pivot` and `c_offset` is shared in
 //! [`crate::trunnion`].
 
 use nalgebra::Vector3;
 
 /// Tool axis seen from the part for table angles (B, C), rad: Rz(C)ᵀ·Ry(B)ᵀ·ẑ =
-/// `(−sin B·cos C, sin B·sin C, cos B)`. (DESIGN.md gives only the A/C form; this is the
-/// same derivation with Ry, right-handed.)
+/// `(−sin B·cos C, sin B·sin C, cos B)`. (The A/C form's derivation with Ry,
+/// right-handed.)
 #[inline]
 pub fn axis(b: f64, c: f64) -> Vector3<f64> {
     let (sb, cb) = b.sin_cos();

@@ -1,6 +1,7 @@
 //! Five-axis table-tilting (trunnion) chain shared by `table-ac` and `table-bc`: a part point
-//! `p` sits at `pivot + R_tilt(θ)·(c_offset + Rz(C)·p)` in machine coordinates (DESIGN.md
-//! "Kinematic conventions"). Joints: X Y Z (spindle gauge point), tilt (A or B), C.
+//! `p` sits at `pivot + R_tilt(θ)·(c_offset + Rz(C)·p)` in machine coordinates
+//! (docs/machine-files.md, "Kinematic conventions"). Joints: X Y Z (spindle gauge point), tilt (A
+//! or B), C.
 
 use nalgebra::{Matrix3, Vector3};
 

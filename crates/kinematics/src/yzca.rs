@@ -1,8 +1,8 @@
-//! Four-axis Y-Z-C-A machine of reference 000 §2.9 (thesis §5.3.1): Y and Z move the tool,
+//! Four-axis Y-Z-C-A machine of Kelekçi (2021, §5.3.1): Y and Z move the tool,
 //! A tilts the tool about X, C is an endless rotary table under the part. Joints
 //! `[y, z, c, a]` (mm, rad); planning happens in the part frame and this maps it to joints.
 //!
-//! Conventions (fixing the thesis's C-sign erratum, reference 000 §5 item 16):
+//! Conventions (fixing the sign of C in the thesis's eq. 5.4; docs/errata.md):
 //! * the Y slide moves the tool along the table's radial line, which is the part's +X
 //!   direction when C = 0;
 //! * C > 0 turns the table counter-clockwise seen from +Z (right-handed about +Z), so a tool
@@ -123,12 +123,12 @@ fn out_of_plane(t: f64) -> KinematicsError {
 }
 
 /// The two tilts that put the tool normal to a path direction (Δy, Δz) in the Y-Z plane,
-/// "inside" and "outside" the curve (reference 000 eq. 5.6). Geometry cannot choose between
+/// "inside" and "outside" the curve (Kelekçi, 2021, eq. 5.6). Geometry cannot choose between
 /// them; [`choose_tilt`] uses the programmed A. Returns `None` for a zero direction.
 ///
 /// With this file's A sign the tool axis (−sin A, cos A) ⟂ (Δy, Δz) gives A = atan2(Δz, Δy)
 /// and A + π. (The printed eq. 5.6 table is not self-consistent: rows 1 and 3 give an axis
-/// that is not normal to the path; see NOTES-kinematics.md.)
+/// that is not normal to the path; see docs/errata.md.)
 pub fn normal_tilts(dy: f64, dz: f64) -> Option<[f64; 2]> {
     if dy == 0.0 && dz == 0.0 {
         return None;
@@ -158,7 +158,7 @@ impl Kinematics for Yzca {
         let l = self.lever(tool);
         let (sa, ca) = q[A].sin_cos();
         let (sc, cc) = q[C].sin_cos();
-        // Reference 000 eq. 5.2, cleaned: r = y + l·sin A, z_w = z − l·cos A.
+        // Kelekçi (2021), eq. 5.2, cleaned: r = y + l·sin A, z_w = z − l·cos A.
         let r = q[Y] + l * sa;
         let tip = Vector3::new(r * cc, -r * sc, q[Z] - l * ca);
         Ok(ToolPose::new(tip, Vector3::new(-sa * cc, sa * sc, ca)))

@@ -1,5 +1,7 @@
-//! Golden values from the references: 000 §5 items 16–17 (Y-Z-C-A), 002 §5 (delta inverse
-//! kinematics, printed conversions, arc chords, joint-space sag), 004 §5.1 (Rodrigues).
+//! Golden values from the literature: Kelekçi (2021, §5.3.1, eqs 5.2–5.7: Y-Z-C-A round trip and
+//! C unwrap), Ayyıldız (2017: delta inverse kinematics eq. 3.5, the conversions printed in
+//! Figs 5.3–5.15, arc chords eqs 4.1–4.3, joint-space sag, ISO 9283 eqs 3.16–3.19), Kahraman
+//! et al. (eqs 1–3: Rodrigues). Values not printed in a work are computed from its equations.
 
 use nalgebra::{Unit, Vector3};
 use tezgah_kinematics::segment::{joint_line_deviation, slerp_axis};
@@ -21,10 +23,10 @@ fn ik(m: &Machine, x: f64, y: f64, z: f64) -> Vec<f64> {
     m.to_file_units(&q)
 }
 
-// ---- reference 000 §5 item 16: Y-Z-C-A round trip, and the C sign -----------------------
+// ---- Kelekçi (2021), eqs 5.2/5.7: Y-Z-C-A round trip, and the C sign -------------------
 
 #[test]
-fn yzca_round_trip_000_item_16() {
+fn yzca_round_trip_eq_5_2() {
     let m = Machine::builtin("yzca").unwrap();
     let tool = Tool::with_length(100.0);
     // joints y z c a in file units (mm, deg)
@@ -74,9 +76,9 @@ fn yzca_c_sign_convention() {
     );
 }
 
-/// Reference 000 §5 item 17: C runs 0 … 355° and the next target at 5° is commanded 365°.
+/// Kelekçi (2021, §5.3.1): C runs 0 … 355° and the next target at 5° is commanded 365°.
 #[test]
-fn yzca_endless_c_unwrap_000_item_17() {
+fn yzca_endless_c_unwrap_eq_5_5() {
     let m = Machine::builtin("yzca").unwrap();
     let tool = Tool::default();
     let mut q = m.home();
@@ -115,10 +117,10 @@ fn yzca_tilt_chosen_by_programmed_a() {
     assert!(normal_tilts(0.0, 0.0).is_none());
 }
 
-// ---- reference 002 §5.1: inverse kinematics, absolute and relative ----------------------
+// ---- Ayyıldız (2017), eq. 3.5: inverse kinematics, absolute and relative ---------------
 
 #[test]
-fn delta_ik_table_002_5_1() {
+fn delta_inverse_eq_3_5() {
     let m = delta();
     let rows: [([f64; 3], [f64; 3]); 9] = [
         ([0.0, 0.0, 0.0], [311.28765, 311.28765, 311.28765]),
@@ -153,10 +155,10 @@ fn delta_ik_table_002_5_1() {
     }
 }
 
-// ---- reference 002 §5.2: the thesis's printed conversions ------------------------------
+// ---- Ayyıldız (2017), Figs 5.3–5.15: the thesis's printed conversions ------------------
 
 #[test]
-fn delta_printed_conversions_002_5_2() {
+fn delta_printed_conversions() {
     let m = delta();
     let printed: [([f64; 3], [f64; 3]); 16] = [
         ([-27.426, -27.714, 0.0], [-17.0, -7.83, 16.51]),
@@ -186,7 +188,7 @@ fn delta_printed_conversions_002_5_2() {
             );
         }
     }
-    // Unrounded values the digest gives to 4 decimals.
+    // Unrounded values, computed from eq. 3.5 to 4 decimals.
     let unrounded: [([f64; 3], [f64; 3]); 7] = [
         ([-27.426, -27.714, 0.0], [-17.0030, -7.8283, 16.5053]),
         ([-17.426, -27.714, -0.5], [-11.3680, -10.2315, 14.2442]),
@@ -207,9 +209,9 @@ fn delta_printed_conversions_002_5_2() {
     }
 }
 
-/// Reference 002 §5.3: the 16 chord points of `G3 X7.015 Y17.204 I-12.5 J0.` at Z −0.2.
+/// Ayyıldız (2017), Fig. 5.15: the 16 chord points of `G3 X7.015 Y17.204 I-12.5 J0.` at Z −0.2.
 #[test]
-fn delta_arc_chords_002_5_3() {
+fn delta_arc_chords_fig_5_15() {
     let m = delta();
     let printed: [[f64; 3]; 17] = [
         [9.0, -3.27, -8.59],
@@ -242,10 +244,11 @@ fn delta_arc_chords_002_5_3() {
     }
 }
 
-/// Reference 002 §5.4 / §2.8: interpolating the joints between the converted end points of
-/// the 100 mm XY diagonal sags 4.646 mm (Z −4.577, in plane 0.799), the measured −4.599 mm.
+/// Ayyıldız (2017) converts end points only: interpolating the joints between the converted end
+/// points of the 100 mm XY diagonal sags 4.646 mm (Z −4.577, in plane 0.799), against the −4.599 mm
+/// measured in its Table 5.2.
 #[test]
-fn delta_joint_space_sag_002_5_4() {
+fn delta_joint_space_sag_table_5_2() {
     let m = delta();
     let tool = Tool::default();
     let a = Vector3::new(-31.654, -28.911, -0.2);
@@ -303,10 +306,10 @@ fn delta_joint_space_sag_002_5_4() {
     }
 }
 
-// ---- reference 004 §5.1: Rodrigues tool-axis interpolation ------------------------------
+// ---- Kahraman et al., eqs 1–3: Rodrigues tool-axis interpolation -----------------------
 
 #[test]
-fn rodrigues_004_5_1() {
+fn rodrigues_eqs_1_to_3() {
     let v = Vector3::z_axis();
     let u = Unit::new_normalize(Vector3::new(0.5, 0.0, 3f64.sqrt() / 2.0));
     let mid = slerp_axis(&v, &u, 0.5).unwrap();
@@ -323,10 +326,10 @@ fn rodrigues_004_5_1() {
     assert!(slerp_axis(&v, &-v, 0.5).is_err());
 }
 
-// ---- reference 002 §5.5: ISO 9283 ------------------------------------------------------
+// ---- ISO 9283 (Ayyıldız, 2017, eqs 3.16–3.19), synthetic measurements -----------------
 
 #[test]
-fn iso9283_002_5_5() {
+fn iso9283_eqs_3_16_to_3_19() {
     use tezgah_kinematics::iso9283::{evaluate, parse_csv};
     let csv = "\
 pose,cycle,cmd_x,cmd_y,cmd_z,x,y,z
@@ -383,12 +386,12 @@ fn iso9283_errors() {
     assert_eq!(evaluate(&[]), Err(Iso9283Error::Empty));
 }
 
-/// Reference 002 §2.4 [DERIVED in the digest]: a 500 mm stroke with the 5° rod-angle rule gives
-/// ≈ 46 900 cm³; adding a 22° spherical-joint cone about the central rod direction ≈ 16 600 cm³.
-/// (The thesis's own 18 786 cm³ has no stated method.) Such a cone excludes the thesis's ISO
-/// pose P3, which is why the built-in file leaves it off.
+/// Workspace of Ayyıldız's delta (2017, §3), counted on a grid: a 500 mm stroke with the 5°
+/// rod-angle rule gives ≈ 46 900 cm³; adding a 22° spherical-joint cone about the central rod
+/// direction ≈ 16 600 cm³. (The thesis's own 18 786 cm³ has no stated method.) Such a cone excludes
+/// the thesis's ISO pose P3, which is why the built-in file leaves it off.
 #[test]
-fn delta_workspace_volume_002_2_4() {
+fn delta_workspace_volume() {
     let m = delta();
     let tezgah_kinematics::Model::LinearDelta(d) = &m.kinematics else {
         unreachable!()

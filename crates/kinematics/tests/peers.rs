@@ -1,7 +1,7 @@
-//! Cross-checks against peers' formulas (reference peers_gcode_delta.md, peers_cam.md §7.1),
-//! each re-implemented here from its published equations: LinuxCNC lineardeltakins, Klipper's
-//! delta (inverse per stepper, forward by trilateration), reference 002's corrected closed
-//! form, and LinuxCNC's xyzac/xyzbc-trt kinematics (trtfuncs.c, TCP with tool offset).
+//! Cross-checks against peers' formulas, each re-implemented here from its published
+//! equations: LinuxCNC lineardeltakins, Klipper's delta (inverse per stepper, forward by
+//! trilateration), Ayyıldız's (2017) closed form as corrected in docs/errata.md, and LinuxCNC's
+//! xyzac/xyzbc-trt kinematics (trtfuncs.c, TCP with tool offset).
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
@@ -108,7 +108,7 @@ fn klipper_trilateration(spheres: [Vector3<f64>; 3], arm2: f64) -> Vector3<f64> 
     s1 + ex * x + ey * y + ez * z
 }
 
-// ---- reference 002 §2.3, the corrected closed form (towers at 0°, 120°, 240°, absolute q)
+// ---- Ayyıldız (2017), eqs 3.6–3.15 corrected (towers at 0°, 120°, 240°, absolute q)
 
 fn ref002_forward(r: f64, l: f64, q: [f64; 3]) -> Vector3<f64> {
     let s = 3f64.sqrt();
@@ -163,7 +163,7 @@ proptest! {
     }
 
     #[test]
-    fn reference_002_closed_form(x in -120.0..120.0f64, y in -120.0..120.0f64, z in -100.0..100.0f64) {
+    fn ayyildiz_corrected_closed_form(x in -120.0..120.0f64, y in -120.0..120.0f64, z in -100.0..100.0f64) {
         let ours = delta(160.0, 350.0, [0.0, 120.0, 240.0], [0.0; 3]);
         let p = Vector3::new(x, y, z);
         let q = ours.inverse(&ToolPose::vertical(p), &Tool::default(), &Joints::zeros(3)).unwrap();

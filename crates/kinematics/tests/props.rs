@@ -1,7 +1,7 @@
 //! Property tests on every model: forward(inverse(p)) = p, inverse(forward(q)) = q up to
 //! branch and turns (outside a 1e-6 rad cone around the pole), the analytic Jacobian against
-//! central finite differences, and reference 004's warm-started damped-least-squares inverse
-//! converging to the closed form.
+//! central finite differences, and a warm-started damped-least-squares inverse (the iterative
+//! inverse of Kahraman et al., §4) converging to the closed form.
 
 use nalgebra::{DMatrix, DVector, Vector3};
 use proptest::prelude::*;
@@ -217,9 +217,9 @@ proptest! {
         }
     }
 
-    /// Reference 004 §2.7 [DERIVED]: a damped-least-squares inverse warm-started from the
-    /// previous sample converges to the closed-form joints (checks Jacobian and closed form
-    /// against each other).
+    /// After Kahraman et al. (§4), who invert by Jacobian iteration: a damped-least-squares inverse
+    /// warm-started from the previous sample converges to the closed-form joints (checks Jacobian
+    /// and closed form against each other).
     #[test]
     fn dls_warm_start_converges_004(x in -100.0..100.0f64, y in -100.0..100.0f64, z in -100.0..100.0f64,
                                     a in 10.0..110.0f64, c in -180.0..180.0f64,

@@ -272,7 +272,7 @@ fn tcp_from_interpreter_pose() {
     for i in 0..6 {
         assert!((back.0[i] - prog.0[i]).abs() < 1e-9, "{back:?}");
     }
-    // the tool axis is the DESIGN.md one for (A, C)
+    // the tool axis of docs/machine-files.md's conventions for (A, C)
     let axis = tcp.tool_pose(&pp, &m.home()).unwrap().axis;
     assert!((axis.into_inner() - ac_axis(35.0, 400.0)).norm() < 1e-12);
     assert_eq!(

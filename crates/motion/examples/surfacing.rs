@@ -1,4 +1,4 @@
-//! Dense surfacing programs for the smoothing figures (NOTES-smooth.md, BENCHMARKS.md): raster
+//! Dense surfacing programs for the smoothing figures (BENCHMARKS.md): raster
 //! rows 60 mm long, 2 mm apart, over `z = 2 sin(w·x/7) cos(w·y/5)`, points every 0.2 mm
 //! (`uniform`) or 0.05–0.3 mm apart (`random`), coordinates rounded as a CAM post would.
 //!

@@ -1,8 +1,8 @@
 //! Pre-flight of a built path: before anything moves, every segment is turned into joints at
 //! its ends and at points at most [`PREFLIGHT_STEP_MM`] apart, through the same kinematics the
 //! interpolator uses ([`PlanMachine::segment_joints`]), so a pose out of reach or a joint past
-//! its limit is reported with its source line instead of stopping a run half-way (DESIGN.md:
-//! "a program file is checked whole before motion starts").
+//! its limit is reported with its source line instead of stopping a run half-way: a program
+//! file is checked whole before motion starts.
 //!
 //! Sampling bounds what it can miss: between two checked points a curve of radius ρ bulges at
 //! most h²/(8ρ) beyond their chord (h ≤ the step), so a limit crossed by less than that on a

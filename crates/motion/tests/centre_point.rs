@@ -1,8 +1,8 @@
 //! Tool-centre-point control switched by the program (G43.4 H<n> / G49) on the table-ac
 //! trunnion, end to end: G-code → moves → smoothing path → plan → samples. With TCP on the
 //! joints put the tool tip on the program point with the tool length along the tool axis
-//! (closed form of DESIGN.md's table-ac convention); with TCP off the program axes are the
-//! joints and a move is straight in joint space; every joint stays inside its limits.
+//! (closed form of the table-ac convention, docs/machine-files.md); with TCP off the program axes
+//! are the joints and a move is straight in joint space; every joint stays inside its limits.
 
 use std::sync::Arc;
 
@@ -66,8 +66,8 @@ fn assert_within_limits(r: &Report) {
     assert!(r.max_deviation <= 0.01, "deviation {}", r.max_deviation);
 }
 
-/// DESIGN.md: part point p is at `pivot + Rx(A)·(c_offset + Rz(C)·p)`; the spindle's gauge
-/// point is `length` above the tip along machine +Z, the tool axis.
+/// Table-ac (docs/machine-files.md): part point p is at `pivot + Rx(A)·(c_offset + Rz(C)·p)`; the
+/// spindle's gauge point is `length` above the tip along machine +Z, the tool axis.
 fn closed_form(p: [f64; 3], a_deg: f64, c_deg: f64, length: f64) -> [f64; 5] {
     let (pivot, c_offset) = ([0.0, 0.0, -150.0], [0.0, 2.0, 50.0]);
     let (sa, ca) = a_deg.to_radians().sin_cos();
@@ -115,8 +115,8 @@ fn tcp_puts_the_tip_on_the_program_point_with_the_length_along_the_tool_axis() {
             closed_form([20.0, 5.0, -3.0], 30.0, 40.0, length),
         );
         // Every TCP sample: the forward kinematics with this tool puts the tip on the
-        // sampled program point and the tool axis at the programmed A and C (DESIGN.md:
-        // seen from the part, (sin A sin C, sin A cos C, cos A)).
+        // sampled program point and the tool axis at the programmed A and C (seen from
+        // the part, (sin A sin C, sin A cos C, cos A)).
         let machine = Machine::builtin("table-ac").unwrap();
         let mut checked = 0;
         for (s, control, _) in &out.samples {
@@ -268,9 +268,9 @@ fn with_tcp_off_an_axis_without_a_joint_is_refused_not_ignored() {
     );
 }
 
-/// DESIGN.md: under TCP a block that only turns the tool takes F in degrees per minute of the
+/// Under TCP a block that only turns the tool takes F in degrees per minute of the
 /// tool axis's rotation. At A30, a C turn of 90° moves the axis (sin A sin C, sin A cos C,
-/// cos A) on the great circle between its ends (reference 004 §2.3), through
+/// cos A) on the great circle between its ends (Kahraman et al., eqs 1–3), through
 /// 2·asin(sin 30°·sin 45°) = 41.41°: at F600 (10°/s) that is 4.14 s plus the speed's rise and
 /// fall, not the 9 s the C axis's own travel would take (nor the 4.5 s of the cone that linear
 /// angles would sweep). The A turn of 30°
@@ -298,8 +298,8 @@ fn a_block_that_only_turns_the_tool_takes_f_as_the_tool_axis_rotation() {
     );
 }
 
-/// Reference 004 end to end: a 5-axis polygon whose orientation changes along every side and
-/// at every corner, under TCP. At every sample the tool axis of the joints (forward
+/// Kahraman et al.'s five-axis path end to end: a 5-axis polygon whose orientation changes along
+/// every side and at every corner, under TCP. At every sample the tool axis of the joints (forward
 /// kinematics) is within the machine's angular tolerance (0.1°) of the programmed axis at the
 /// nearest programmed point — the great circle between the closed-form axes of the move's
 /// ends, at that point's fraction of the move — the tip within the path tolerance, every joint

@@ -13,7 +13,7 @@
 //!   (1e-6). With arcs, each block is bounded below by the slowest joint's own rest-to-rest
 //!   optimum and by length/feed. Run with `$TEZGAH_PYTHON` (`.ci/install-ruckig`).
 //!
-//! The ratios ours/bound are printed (`--nocapture`); they are recorded in NOTES-plan.md, not
+//! The ratios ours/bound are printed (`--nocapture`), not
 //! asserted beyond the bound itself and a generous ceiling for the lines-and-arcs pocket.
 
 #[path = "../benches/common/mod.rs"]

@@ -1,13 +1,14 @@
-//! Golden numbers from ../shared/reference/000_jerk_limited_trajectory.md §5 (Kelekçi 2021),
-//! items 8, 10, 13 and 14, recomputed with our 7-phase profile.
+//! Golden numbers from Kelekçi (2021, ch. 3), recomputed with our 7-phase profile: the arc of
+//! (3.25) rest to rest, the line of (3.17), the end speeds reachable by braking ((3.10), (3.14))
+//! and short-move peak speeds.
 //!
 //! The source's profile has five phases and no constant-acceleration phase, so its peak
 //! acceleration is √(J·Δv) whatever A is. For these items (J = 20000 mm/s³, A = 1000 mm/s², the
-//! thesis's machine at L1626 and L1740) that peak stays ≤ A — 774.6, exactly 1000 (item 10),
+//! thesis's machine of §3.1–3.2) that peak stays ≤ A — 774.6, exactly 1000 (the line),
 //! 736.8, 560.4, 204.3, 831.6 mm/s² — so the 7-phase optimum has no plateau and reproduces the
 //! source's values; each is checked to the digits the source prints and was also confirmed with
 //! Ruckig (tests/oracle/ruckig_batch.py) to ~1e-12. The last test takes the thesis's own
-//! multi-line machine (L1661: J = 1000, A = 100, V = 50), where the five-phase profile reaches
+//! multi-line machine of (3.20) (J = 1000, A = 100, V = 50), where the five-phase profile reaches
 //! 223.6 mm/s² > A: there the source-style value and ours differ, and ours is Ruckig's.
 
 use tezgah_motion::profile::{
@@ -30,7 +31,7 @@ fn peak(p: &Profile) -> (f64, f64) {
 /// Source: t_a = t_d = 0.0387298 s, peak 774.60 mm/s², accel distance 1.161895 mm,
 /// cruise 0.223614 s, T = 0.378534 s. Ours (= Ruckig): T = 0.37853366692.
 #[test]
-fn item_8_arc_rest_to_rest() {
+fn arc_3_25_rest_to_rest() {
     let l = Limits::new(30.0, 1000.0, 20000.0).unwrap();
     let p = solve(9.03222, 0.0, 0.0, &l).unwrap();
     let d = p.durations();
@@ -56,7 +57,7 @@ fn item_8_arc_rest_to_rest() {
 /// Ours (= Ruckig): T = 0.63851648071; the speed change 50 = A²/J sits exactly on the boundary
 /// where the plateau appears, so the plateau has length 0.
 #[test]
-fn item_10_line_rest_to_rest() {
+fn line_3_17_rest_to_rest() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let len = 725f64.sqrt();
     let p = solve(len, 0.0, 0.0, &l).unwrap();
@@ -85,7 +86,7 @@ fn item_10_line_rest_to_rest() {
 /// 1 mm → 47.9139 (lowest reachable). Ours: 27.144176166, 25.696036532, 47.913869023. Where
 /// the source then *raises* the requested end speed (3.14), ours reports it instead.
 #[test]
-fn item_13_reachable_end_speeds() {
+fn reachable_end_speeds_3_10_3_14() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let up0 = max_reachable_speed(0.0, 1.0, &l).unwrap();
     assert!(
@@ -121,7 +122,7 @@ fn item_13_reachable_end_speeds() {
 /// Source: rest to rest over 2 mm → Vp = 27.1442; 0 → 10 over 3 mm → Vp = 34.5744.
 /// Ours (= Ruckig): Vp = 27.144176166 (T = 0.14736125995 s), 34.574390513 (T = 0.15326193767 s).
 #[test]
-fn item_14_short_move_peaks() {
+fn short_move_peaks() {
     let l = Limits::new(50.0, 1000.0, 20000.0).unwrap();
     let p = solve(2.0, 0.0, 0.0, &l).unwrap();
     let vp = p.knots()[3].1.v;
@@ -140,7 +141,7 @@ fn item_14_short_move_peaks() {
     assert!(close(p.end().v, 10.0, 1e-12));
 }
 
-/// The thesis's multi-line machine (L1661: J = 1000, A = 100, V = 50), first segment of (3.20)
+/// The thesis's multi-line machine (J = 1000, A = 100, V = 50), first segment of (3.20)
 /// (L = 48.2183 mm) run rest to rest. The five-phase profile would take t_a = √(50/1000) =
 /// 0.22361 s per jerk phase with a peak of 223.6 mm/s² > A, T = 1.411580 s. The 7-phase profile
 /// holds A: jerk phases 0.1 s, plateau 0.4 s, ramp 0.6 s over 15 mm, cruise 0.364366 s,

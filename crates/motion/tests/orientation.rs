@@ -1,5 +1,5 @@
-//! The tool axis along the smoothed path under tool-centre-point control (5-axis, reference
-//! 004 §2.3–2.4): reference 004's derived values for the two-curve blend, and properties on
+//! The tool axis along the smoothed path under tool-centre-point control (5-axis, Kahraman
+//! et al., eqs 1–3 and §3): values computed from their two-curve blend, and properties on
 //! thousands of random 5-axis polylines and arc chains on the table-ac and table-bc
 //! trunnions — the axis is a unit vector everywhere, continuous at every joint (bit for bit),
 //! with continuous first and second derivatives by arc length at every smooth joint
@@ -24,7 +24,8 @@ use tezgah_motion::plan::PlanMachine;
 
 const TCP: ToolControl = ToolControl::CentrePoint { tool_length: 35.0 };
 
-/// Table-ac's tool axis in closed form (DESIGN.md): `(sin A sin C, sin A cos C, cos A)`.
+/// Table-ac's tool axis in closed form (docs/machine-files.md): `(sin A sin C, sin A cos C, cos
+/// A)`.
 fn table_ac_axis(a_deg: f64, c_deg: f64) -> Vec3 {
     let (a, c) = (a_deg.to_radians(), c_deg.to_radians());
     Vec3::new(a.sin() * c.sin(), a.sin() * c.cos(), a.cos())
@@ -122,12 +123,12 @@ fn the_machine_gives_the_closed_form_axis() {
     );
 }
 
-/// Reference 004 §2.4 Steps 5–7 and §5.4 in physical time: the 90° line–line corner with
+/// Kahraman et al.'s two-curve blend (§3) in physical time: the 90° line–line corner with
 /// ℓ = 1 mm at v = 10 mm/s (T = 0.2 s), the axis turning on both legs. The upper curve is the
 /// quintic of Step 6 through Step 5's rigid-body end data for a point h along the axis; Eq 7
 /// gives the axis. The library's blend must give the same axis for every h.
 #[test]
-fn two_curve_blend_matches_reference_004_steps_5_to_7() {
+fn two_curve_blend_matches_closed_form() {
     let (v, t_blend) = (10.0, 0.2);
     // Legs: the tool tilts about the path normal on each (θ̇ = 0.2 rad/s and −0.3 rad/s).
     let o0 = table_ac_axis(20.0, 0.0);
@@ -138,7 +139,7 @@ fn two_curve_blend_matches_reference_004_steps_5_to_7() {
     let o1 = GreatCircle::new(oc, tezgah_motion::path::orient::rotate(&oc, &k1, w1 / v))
         .unwrap()
         .at(1.0);
-    // Lower curve: §5.4's x(τ) = −1 + 10τ − 250τ³ + 625τ⁴, y(τ) = 250τ³ − 625τ⁴.
+    // Lower curve: the quintic's x(τ) = −1 + 10τ − 250τ³ + 625τ⁴, y(τ) = 250τ³ − 625τ⁴.
     let p = |tau: f64| {
         Vec3::new(
             -1.0 + 10.0 * tau - 250.0 * tau.powi(3) + 625.0 * tau.powi(4),
@@ -300,8 +301,8 @@ fn program(kind: Trunnion, steps: &[Step], tolerance: f64) -> Program {
 }
 
 /// The programmed axis at the point of move `m` (from `points[m − 1]` to `points[m]`; the
-/// move of source line L is m = L − 2) nearest `q`: the great circle between the closed-form axes of its ends, at the fraction of
-/// its length (reference 004 Eq 3). Returns (distance, axis).
+/// move of source line L is m = L − 2) nearest `q`: the great circle between the closed-form axes
+/// of its ends, at the fraction of its length (Kahraman et al., eq. 3). Returns (distance, axis).
 fn programmed(prog: &Program, m: usize, q: &Vec3) -> (f64, Vec3) {
     let (p0, a0, c0) = prog.points[m - 1];
     let (p1, a1, c1) = prog.points[m];

@@ -1,5 +1,5 @@
 //! A programmed NURBS move (G06.2, G5, G5.1, G5.2) through both path builders: one segment of
-//! the curve's own length (reference 000 §5 item 1), a corner or tangent junction at its ends
+//! the curve's own length (Kelekçi, 2021, data (2.39)), a corner or tangent junction at its ends
 //! chosen as for an arc, blended within the tolerance under G64, never compressed.
 
 mod path_support;
@@ -16,7 +16,7 @@ fn v(x: f64, y: f64, z: f64) -> Vec3 {
     Vec3::new(x, y, z)
 }
 
-/// Reference 000 (2.39): the clamped cubic from (0, 0) to (18, 1), 19.0203 mm long.
+/// Kelekçi (2021), data (2.39): the clamped cubic from (0, 0) to (18, 1), 19.0203 mm long.
 fn thesis_curve() -> Nurbs {
     let x = [0.0, 2.5, 4.0, 6.0, 8.0, 10.0, 12.0, 14.0, 16.0, 18.0];
     let y = [0.0, 2.3, 1.5, 2.4, 1.0, 2.0, 1.0, 2.0, 0.0, 1.0];

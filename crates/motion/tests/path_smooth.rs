@@ -1,4 +1,4 @@
-//! The smoothing builder on hand-made programs: reference 004's corner blend (§5.4) at the
+//! The smoothing builder on hand-made programs: Kahraman et al.'s corner blend (§3) at the
 //! tolerance-exact leg, G61 and G61.1, tangent and collinear junctions, reversals, zero-length
 //! and rotary-only moves, errors, streaming windows, and the compression ratio on a dense
 //! surfacing program.
@@ -29,8 +29,8 @@ fn square(tol: Option<f64>) -> Vec<Move> {
 }
 
 #[test]
-fn reference_004_corner_at_tolerance_exact_leg() {
-    // §5.4, tolerance-driven case: ε = 0.05 mm for the blend at 90° gives ℓ = 0.188562 mm and
+fn corner_at_tolerance_exact_leg() {
+    // Tolerance-driven case: ε = 0.05 mm for the blend at 90° gives ℓ = 0.188562 mm and
     // a corner deviation of exactly 0.05 mm. With the 40 % blend share, the program's tolerance
     // is 0.125 mm.
     let items = build(square(Some(0.125)), &SmoothOptions::default()).unwrap();
@@ -63,8 +63,8 @@ fn reference_004_corner_at_tolerance_exact_leg() {
 }
 
 #[test]
-fn reference_004_45_degree_corner() {
-    // §5.4 other case: 45° turn with ℓ = 0.5 gives δ = 0.071753. ℓ = 8ε/(3 sin 22.5°) = 0.5
+fn blend_45_degree_corner() {
+    // Another case: 45° turn with ℓ = 0.5 gives δ = 0.071753. ℓ = 8ε/(3 sin 22.5°) = 0.5
     // for ε = 0.0717530…; tolerance = ε / 0.4.
     let eps = 0.5 * 3.0 * (22.5f64.to_radians()).sin() / 8.0;
     let m = vec![

@@ -263,7 +263,7 @@ fn durations_match_ruckig() {
         let ours = solve(c.distance, c.v0, c.v1, &limits);
         if c.distance == 0.0 && c.v0 == c.v1 {
             // Already at the target: the optimum is no motion. Ruckig returns a detour through
-            // negative speeds instead when v0 > 0 (NOTES-profile.md, errata).
+            // negative speeds instead when v0 > 0 (docs/errata.md).
             trivial += 1;
             match ours {
                 Ok(p) if p.duration() == 0.0 && p.end().s == 0.0 => {}

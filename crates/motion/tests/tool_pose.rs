@@ -1,7 +1,7 @@
 //! Each sample's tool (`tool_pose::SampleTool`, what the samples CSV prints) against closed
-//! forms of DESIGN.md's kinematic conventions, end to end (G-code → path → plan → samples):
-//! with TCP off on table-ac, table-bc and yzca the tip is where the table or head puts the
-//! tool of the G43 length, not the program's X Y Z; with TCP on it is the program tip. And the
+//! forms of the kinematic conventions (docs/machine-files.md), end to end (G-code → path → plan →
+//! samples): with TCP off on table-ac, table-bc and yzca the tip is where the table or head puts
+//! the tool of the G43 length, not the program's X Y Z; with TCP on it is the program tip. And the
 //! take-up at a switch starts from the joints the interpolator reached (yzca's endless C).
 
 use std::sync::Arc;
@@ -79,7 +79,7 @@ enum Tilt {
     Y,
 }
 
-/// DESIGN.md: a part point p is at `pivot + R_tilt(θ)·(c_offset + Rz(C)·p)`, the gauge point
+/// The conventions: a part point p is at `pivot + R_tilt(θ)·(c_offset + Rz(C)·p)`, the gauge point
 /// `length` above the tip along machine +Z; so p = Rz(−C)·(R_tilt(−θ)·(q − length·ẑ − pivot)
 /// − c_offset). The axis seen from the part: table-ac (sin A sin C, sin A cos C, cos A),
 /// table-bc (−sin B cos C, sin B sin C, cos B).
@@ -364,7 +364,7 @@ M2
     );
 }
 
-/// The delta: the forward map of the carriage heights (reference 002), less
+/// The delta: the forward map of the carriage heights (Ayyıldız, 2017), less
 /// G43's 35 mm, is the program point; no tool axis but +Z.
 #[test]
 fn linear_delta_tip_is_the_program_point_under_g43() {

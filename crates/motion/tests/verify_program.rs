@@ -89,7 +89,7 @@ fn shifted(moves: &[Move], d: Vec3) -> Vec<Move> {
 
 /// `G64 P0.5` blends corners by up to 0.4 × 0.5 mm; stamped 0.01 mm, the path claims a
 /// tolerance it does not keep. Measured against the program the corner is the blend's
-/// deviation from the sampled path (the smoother's closed form, reference 004 §2.5; the
+/// deviation from the sampled path (the smoother's closed form, `path::smooth::blend`; the
 /// chords, on the blend's inner side, add at most the 0.2 × 0.01 mm chord error): 20 × the
 /// tolerance, which fails; measured against the smoothed path, as before, the samples are
 /// within the chord error and the failure cannot show.

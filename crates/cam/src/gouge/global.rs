@@ -1,6 +1,6 @@
 //! Global gouge (collision): the flutes above the cutting end, the shank and the holder —
 //! cylinders along the tool axis — against the whole surface, through the coarse index.
-//! 001 collects the holder's size but never checks it (§2.11c); this does.
+//! Can (2010) collects the holder's size but never checks it; this does.
 
 use nalgebra::Unit;
 use tezgah_geom::Vec3;

@@ -1,8 +1,8 @@
 //! Local gouge: curvature interference at the contact point. To second order the cutter
 //! clears the surface around the contact iff it is at least as curved in every tangent
 //! direction, i.e. `K_cutter − K_surface` is positive semi-definite (both in the tangent plane,
-//! curvature positive toward the tool; 001 §2.11a, Lo 1999, and its generalisation to all
-//! directions). A flat end's rim is infinitely curved along the meridian, leaving the single
+//! curvature positive toward the tool; Can, 2010, §3.4.7.2.2; Lo 1999; and its generalisation
+//! to all directions). A flat end's rim is infinitely curved along the meridian, leaving the single
 //! condition along the parallel.
 
 use nalgebra::Unit;

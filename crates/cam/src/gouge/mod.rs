@@ -57,7 +57,7 @@ pub enum Gouge {
 /// Settings of the rear and global checks.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GougeSettings {
-    /// Spacing of the surface samples of the rear check (mm); 001 scans at 0.15 mm.
+    /// Spacing of the surface samples of the rear check (mm); Can (2010) scans at 0.15 mm.
     pub rear_spacing: f64,
     /// Spacing of the samples for the shank/holder check (mm); the check keeps a clearance of
     /// this spacing so the surface between samples cannot reach the tool unseen.

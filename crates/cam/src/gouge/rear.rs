@@ -1,18 +1,18 @@
-//! Rear gouge: the whole cutting end against the surface. 001 §2.11b scans the shadow of a
-//! flat tool's bottom behind the contact (Lo 1999, extended to the full bottom); here the
+//! Rear gouge: the whole cutting end against the surface. Can (2010, §3.4.7.2.2) scans the shadow
+//! of a flat tool's bottom behind the contact (Lo 1999, extended to the full bottom); here the
 //! surface near the tool is tested against the solid of revolution of the cutting end — the
 //! flat, torus or ball bottom and the flutes up to two tool radii — so the heel, the middle
 //! of the bottom and the sides are all covered, for every cutter shape.
 //!
 //! Exact to the tolerance, not to the sample spacing: the cutting end is a convex solid (a
-//! core cylinder grown by the corner radius, 001 §3.4's torus as a Minkowski sum), so the
+//! core cylinder grown by the corner radius, Can's torus as a Minkowski sum), so the
 //! signed depth of a point in it is concave and its gradient bounds it everywhere:
 //! `e(x) ≤ e(p) + g·(x − p)` (a supergradient inequality). Over the surface near a sample
 //! `p` (its lattice cell, at most `c` away, bending off its tangent plane by at most `κc²/2`)
 //! that gives `e ≤ e(p) + |g_t|·c + |g_n|·κc²/2`; a cell whose bound exceeds the tolerance
 //! is split in four and its quarters evaluated on the surface itself (branch and bound, down
 //! to cells of [`FINEST_COVER`] of the tolerance). The closest point of the torus is closed
-//! form (the point's axial plane, then the corner circle: Lee & Chang 1995 / 001 §3.4.3).
+//! form (the point's axial plane, then the corner circle: Lee & Chang 1995; Can, 2010, §3.4.7.2.2).
 //! Session 5's scan of the samples alone missed heel contacts of 4–5 µm between its 0.3 mm
 //! samples: the torus's tube curves by 1/r, the flat's rim is a corner.
 //!

@@ -151,7 +151,7 @@ pub fn program(
             if inverse {
                 let prev = previous.unwrap_or(p);
                 let length = (p.tip - prev.tip).norm();
-                // A pure turn: its degrees at the feed read as deg/min (DESIGN.md "Feed").
+                // A pure turn: its degrees at the feed read as deg/min (docs/path-and-feed.md).
                 let amount = if length > 1e-9 {
                     length
                 } else {

@@ -3,7 +3,7 @@
 //! Called by the post-processor before the linear axes and the linearisation check.
 //!
 //! A tool axis away from the C axis has two solutions, (θ, C) with θ ≥ 0 and (−θ, C + π)
-//! (reference 001 §2.15, eq. 3.32 and its digest). Choosing per point by nearness to the
+//! (Can, 2010, §3.4.6, eq. 3.32). Choosing per point by nearness to the
 //! previous point (what the kinematics' `inverse` does) is greedy; here the branch sequence
 //! is chosen for the whole path at once (a two-state Viterbi search, least total rotary travel
 //! |Δθ| + |ΔC| within the tilt limits), so a path that crosses the pole flips the tilt's sign
@@ -284,7 +284,7 @@ mod tests {
 
     #[test]
     fn reference_t11_both_branches() {
-        // Reference 001 T11: n = (0, −0.5, 0.86603) has (30°, 180°) and (−30°, 0°).
+        // Can (2010), eq. 3.32: n = (0, −0.5, 0.86603) has (30°, 180°) and (−30°, 0°).
         let o = ac(-90.0, 90.0);
         let k = Vec3::new(0.0, -0.5, 0.75_f64.sqrt());
         let [b0, b1] = o.solutions(&k);

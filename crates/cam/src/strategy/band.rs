@@ -7,10 +7,10 @@
 //! run on past their ends (`run_out`). The strategies then size side steps for the scallop
 //! minus the band's outward width ([`Band::outward`]).
 //!
-//! The sag of a chord is the chord-height (sagitta) error of CAM stepping (Choi 1991, 001
-//! §2.8, `ε ≈ L²κ/8` on a path of curvature κ) taken on the CL surface, not on the contact
-//! curve: for a ball on a convex section of radius ρ the centre's chord sags `(1 + R/ρ)` times
-//! the contacts' chord, and lead changes between locations add their own. So it is measured,
+//! The sag of a chord is the chord-height (sagitta) error of CAM stepping (Choi 1991; Can,
+//! 2010, §3.4.3.1, `ε ≈ L²κ/8` on a path of curvature κ) taken on the CL surface, not on the
+//! contact curve: for a ball on a convex section of radius ρ the centre's chord sags `(1 + R/ρ)`
+//! times the contacts' chord, and lead changes between locations add their own. So it is measured,
 //! not modelled: at a contact `c(s)` between the two, the tip that touches there with the
 //! machine's interpolated axis is compared with the chord point it projects to; the normal
 //! component is the depth (positive inward). Maximised over the chord with geom's
@@ -261,10 +261,10 @@ impl Context<'_> {
     }
 }
 
-/// How one tolerance `T` (DESIGN.md "Tolerance": what the machine's motion may depart from
-/// the exact CL surface) is shared between the stages when the band is on: the strategy's
-/// chords `T/2`, the post's linearisation `T/8`, the controller's blending (`G64 P`) `T/8`.
-/// The band's motion is linearisation + blending (`T/4`), so its outward width
+/// How one tolerance `T` (what the machine's motion may depart from the exact CL surface;
+/// ARCHITECTURE.md, "One tolerance budget") is shared between the stages when the band is on: the
+/// strategy's chords `T/2`, the post's linearisation `T/8`, the controller's blending (`G64 P`)
+/// `T/8`. The band's motion is linearisation + blending (`T/4`), so its outward width
 /// `T/2 + 2·T/4` is exactly `T`: the motion runs between 0 and `T` outside the exact CL
 /// surface, and side steps are planned for `h − T`.
 #[derive(Debug, Clone, Copy, PartialEq)]

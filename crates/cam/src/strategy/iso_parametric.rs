@@ -1,10 +1,10 @@
-//! Iso-parametric zig-zag (001 §2.14 (1)–(2)): passes along the feed parameter at one
+//! Iso-parametric zig-zag (Can, 2010, §3.4.8–3.4.9): passes along the feed parameter at one
 //! constant parametric side step, chosen so the scallop stays within the target everywhere.
-//! 001 §2.9 sizes it at the point of tightest convex radius only; here, as its digest
-//! recommends, the step is the minimum over a lattice of the whole surface of the local
-//! allowed step `ω / |S_s · t|` (the side step's component across the feed per unit parameter).
-//! On a trimmed face the lattice and the passes cover the face's box, and only lattice points
-//! on the face count: a tight place of the surface beyond the trim does not narrow the step.
+//! Can (2010, §3.4.8) sizes it at the point of tightest convex radius only; here the step is the
+//! minimum over a lattice of the whole surface of the local allowed step `ω / |S_s · t|` (the side
+//! step's component across the feed per unit parameter). On a trimmed face the lattice and the
+//! passes cover the face's box, and only lattice points on the face count: a tight place of the
+//! surface beyond the trim does not narrow the step.
 
 use rayon::prelude::*;
 

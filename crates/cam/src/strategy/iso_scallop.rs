@@ -1,5 +1,5 @@
 //! Iso-scallop: each pass is offset from the previous one across the feed by the side step
-//! that leaves exactly the target scallop there (001 §2.14 (5), "iso-scallop II", done as a
+//! that leaves exactly the target scallop there (Can, 2010, §3.4.12, "iso-scallop II", done as a
 //! propagated front rather than fixed 0.001/0.0001 parametric marches). The front is a
 //! polyline in the parameter plane; every front point moves along the cross-feed direction
 //! `t = n × f` mapped to `(du, dv)`, by the surface distance `ω` from the exact scallop model,

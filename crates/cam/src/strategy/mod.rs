@@ -35,7 +35,7 @@ use crate::toolpath::{CutterLocation, Pass, ToolPath};
 pub use band::{Band, ChordSag, ToleranceShares};
 pub use iso_parametric::iso_parametric_side_step;
 
-/// The finishing strategy, by DESIGN.md's `tezgah cam --strategy NAME`.
+/// The finishing strategy, by `tezgah cam --strategy NAME`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StrategyKind {
     /// Iso-parametric passes at a constant parametric side step, alternating direction.
@@ -74,7 +74,7 @@ impl fmt::Display for StrategyKind {
 /// Which surface parameter the passes run along (the feed); the other is stepped over.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FeedDirection {
-    /// Passes along `v` at increasing `u` (001's convention).
+    /// Passes along `v` at increasing `u` (Can's, 2010, convention).
     #[default]
     AlongV,
     AlongU,
@@ -128,8 +128,8 @@ pub enum ToolAxis {
     Fixed(Vec3),
     /// 5-axis: the axis follows the surface normal, leaned `lead_deg` toward the feed and
     /// `tilt_deg` sideways. With `match_curvature`, flat and bull-nose cutters lean further
-    /// where the cross-feed section is concave, so their effective radius fits it (001 §2.6).
-    /// Gouges are corrected by leaning further, up to `max_lead_deg`.
+    /// where the cross-feed section is concave, so their effective radius fits it (Can, 2010,
+    /// §3.4.7.2.2). Gouges are corrected by leaning further, up to `max_lead_deg`.
     Surface {
         lead_deg: f64,
         tilt_deg: f64,
@@ -154,7 +154,7 @@ pub struct Settings {
     /// The surface's `S_u × S_v` points into the material: cut the other side.
     pub reverse_normal: bool,
     /// 5-axis only: the most the lead may change between consecutive cutter locations
-    /// (degrees; Jun 2003 in 001 §2.11c keeps orientation changes ≤ 5° per step). Where a
+    /// (degrees; Jun 2003, cited by Can 2010, keeps orientation changes ≤ 5° per step). Where a
     /// correction or curvature matching jumps further, the neighbours are leaned further too
     /// (never less: leaning more keeps a flat or bull-nose cutter clear of local gouges, and
     /// every raised location is checked again). Raising the lead shrinks a flat or bull-nose
@@ -167,8 +167,8 @@ pub struct Settings {
     /// surface (a sphere) this machines the cap that faces the spindle. `None`: no limit.
     pub max_axis_tilt_deg: Option<f64>,
     pub gouge: GougeSettings,
-    /// The one-sided tolerance band (DESIGN.md "Tolerance"): `Some` shifts every cutter
-    /// location out of the material by its chords' inward sag plus [`Band::motion`] (chords
+    /// The one-sided tolerance band (ARCHITECTURE.md, "One tolerance budget"): `Some` shifts every
+    /// cutter location out of the material by its chords' inward sag plus [`Band::motion`] (chords
     /// sagging more than `tolerance` either way are halved first), so the motion between the
     /// emitted points never cuts into the part, and plans side steps for
     /// `scallop − band.outward(tolerance)` so the scallop stays within `scallop`. `None`: the

@@ -11,7 +11,7 @@
 //! lowers it to where the dexel enters the cutter ([`solid`]). Afterwards a positive height is
 //! a scallop, a negative one a gouge.
 //!
-//! Error bounds (both one-sided, DESIGN.md asks that they be stated):
+//! Error bounds (both one-sided, and stated, so a report can be trusted):
 //! * sweep: the cutter is placed at discrete poses no point of it moving more than `δ`
 //!   between two; the material left between two placements is at most the sagitta of the
 //!   cutter's section where the dexel meets it: at a scallop of height h that section of the

@@ -1,4 +1,4 @@
-//! Tracking metrics of a run on a drive, as reference 000 §4 reports them (eq. 5.1): per joint
+//! Tracking metrics of a run on a drive, as Kelekçi (2021, ch. 5, eq. 5.1) reports them: per joint
 //! the RMSE, MSE and largest |following error|, and the contour error — the distance of the
 //! actual tool tip from the commanded *path*, not from the commanded point (a lag along the
 //! path is no contour error). The executor feeds them one period at a time after the drive's

@@ -2,7 +2,7 @@
 //! acceleration (torque) feed-forward around a velocity loop, driving a rigid inertia with
 //! viscous friction through a saturating actuator. It sits at the end of the executor's flow
 //! (set-point → [`Drive::apply`]) and produces the following error that the tracking metrics
-//! (reference 000 §4, eq. 5.1) report.
+//! (Kelekçi, 2021, eq. 5.1) report.
 //!
 //! Per joint, in internal units (mm or rad), with e = x_c − x the following error:
 //!   u = k_aff·(a_c + β·v_c) + K_v·(k_vff·v_c + K_p·e − v),   ẍ = sat(u) − β·ẋ,

@@ -1,5 +1,5 @@
 //! HOME: the homing sequence of the machine file (`[joint.home]`), joints in `sequence` order
-//! (Z first by default, reference 000 §1.3), joints of equal sequence together. Per joint:
+//! (Z first by default, as Kelekçi, 2021, §4.1), joints of equal sequence together. Per joint:
 //! search toward the switch at `search_velocity`, stop; back off at `latch_velocity` until the
 //! switch releases, stop; approach again at `latch_velocity` and latch the position where it
 //! trips, stop; then a rest-to-rest move to the home `position`. Every piece is jerk-limited (the

@@ -1,5 +1,5 @@
 //! INC: one press moves one joint by a fixed small step, rest to rest — position mode
-//! (reference 000 §1.3: X1 = 0.0001, X10 = 0.001, X100 = 0.01, X1000 = 0.1 mm; the same numbers
+//! (Kelekçi, 2021, §4.1: X1 = 0.0001, X10 = 0.001, X100 = 0.01, X1000 = 0.1 mm; the same numbers
 //! in degrees on a rotary joint). The move is the motion crate's time-optimal 7-phase profile
 //! (`tezgah_motion::profile::solve`) evaluated exactly at each period; the last set-point is the
 //! exact target, so steps add up without drift.

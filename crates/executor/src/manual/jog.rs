@@ -1,5 +1,5 @@
 //! JOG: one joint moves continuously at a set speed until told to stop — velocity mode
-//! (reference 000 §1.3). Starts, speed changes (override steps, 0–200 %) and stops are
+//! (Kelekçi, 2021, §4.1). Starts, speed changes (override steps, 0–200 %) and stops are
 //! jerk-limited [`VelocityRamp`]s taking effect at the next period; a stop takes exactly the
 //! jerk-limited minimum distance from the state it is asked in. Toward a soft limit the jog
 //! brakes on its own at the instant (found between periods) from which the time-optimal stop
@@ -361,7 +361,7 @@ mod tests {
     fn endless_rotary_jogs_in_degrees() {
         let m = Machine::builtin("yzca").unwrap();
         let start = Joints::zeros(4);
-        // C: 20 °/s default of reference 000
+        // C: 20 °/s default of Kelekçi (2021, §4.1)
         let mut jog = Jog::new(
             &m,
             2,

@@ -3,8 +3,8 @@
 //! once per period for the next [`SetPoint`](crate::SetPoint): jerk-limited, exact at every
 //! period, no allocation per period. Set-points carry line 0 (outside a program).
 //!
-//! Reference 000 §1.3: JOG and HND run in velocity control, INC/HOME/REF in position control;
-//! JOG defaults to 50 mm/s (linear) and 20 °/s (rotary); INC steps are 0.0001–0.1 mm; HOME
+//! As in Kelekçi (2021, §4.1): JOG and HND run in velocity control, INC/HOME/REF in position
+//! control; JOG defaults to 50 mm/s (linear) and 20 °/s (rotary); INC steps are 0.0001–0.1 mm; HOME
 //! moves Z first.
 //!
 //! ```
@@ -69,7 +69,7 @@ pub enum ManualError {
     Motion { name: String, reason: String },
 }
 
-/// Default JOG speed of reference 000 §1.3: 50 mm/s linear, 20 °/s rotary (file units).
+/// Default JOG speed of Kelekçi (2021, §4.1): 50 mm/s linear, 20 °/s rotary (file units).
 pub fn default_jog_speed(kind: JointKind) -> f64 {
     match kind {
         JointKind::Linear => 50.0,

@@ -1,10 +1,9 @@
 //! Arc centres for G2/G3: from a centre offset (I J K) or a radius (R), in the arc's plane.
 //!
 //! Both follow LinuxCNC (`arc_data_ijk`, `arc_data_r`): the centre-format radius check uses its
-//! absolute and relative tolerances (see `peers_gcode_delta.md`, "Arc radius tolerance"), and
-//! for R format the centre lies to the right of the chord for G2 with R > 0, to the left for G3,
-//! and a negative R takes the other centre, i.e. the arc of more than 180°.
-//! Coordinates are (first, second) in-plane coordinates, in program units.
+//! absolute and relative tolerances, and for R format the centre lies to the right of the chord for
+//! G2 with R > 0, to the left for G3, and a negative R takes the other centre, i.e. the arc of more
+//! than 180°. Coordinates are (first, second) in-plane coordinates, in program units.
 
 use crate::error::{ArcMismatch, ErrorKind};
 
@@ -172,7 +171,7 @@ mod tests {
         assert!(hypot(a, b) < tol, "{a:?} != {b:?}");
     }
 
-    /// Reference 000 §5 item 7: `G17 G02 X9.019 Y2.975 R5` from (0.24, 1.53).
+    /// Kelekçi (2021), example (2.21): `G17 G02 X9.019 Y2.975 R5` from (0.24, 1.53).
     #[test]
     fn golden_arc_2_21() {
         let (s, e) = ([0.24, 1.53], [9.019, 2.975]);
@@ -192,7 +191,7 @@ mod tests {
         assert!((5.0 * th - 20.4488).abs() < 5e-4);
     }
 
-    /// Reference 000 §5 item 8: `G02 X9.019 Y2.975 R14.976` from (0.2407, 1.533).
+    /// Kelekçi (2021), example (3.25): `G02 X9.019 Y2.975 R14.976` from (0.2407, 1.533).
     #[test]
     fn golden_arc_3_25() {
         let (s, e) = ([0.2407, 1.533], [9.019, 2.975]);
@@ -203,7 +202,7 @@ mod tests {
         assert!((14.976 * th - 9.03222).abs() < 1e-5);
     }
 
-    /// Reference 000 §5 item 9: helix `G17 G03 X14.94 Y1.749 Z2 R14.976` from (14.32, 5.66).
+    /// Kelekçi (2021), example (2.24): helix `G17 G03 X14.94 Y1.749 Z2 R14.976` from (14.32, 5.66).
     #[test]
     fn golden_helix_2_24() {
         let (s, e) = ([14.32, 5.66], [14.94, 1.749]);

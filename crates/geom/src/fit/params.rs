@@ -1,5 +1,5 @@
 //! Parameter values for data points (uniform, chord length, centripetal, universal) and the
-//! averaged knot vector (Piegl & Tiller eq. 9.8; reference 000 §2.4) that fitting builds on.
+//! averaged knot vector (Piegl & Tiller eq. 9.8; Kelekçi, 2021, §2.4) that fitting builds on.
 
 use crate::basis::{basis_funs, find_span, W};
 use crate::curve::Vec3;
@@ -8,7 +8,7 @@ use crate::error::CurveError;
 /// How data points are assigned parameters in `[0, 1]`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Parameterisation {
-    /// `t_k = k / m`: ignores spacing; overshoots on uneven data (reference 000 Table 2.6).
+    /// `t_k = k / m`: ignores spacing; overshoots on uneven data (Kelekçi, 2021, Table 2.6).
     Uniform,
     /// Proportional to the cumulative chord length.
     ChordLength,

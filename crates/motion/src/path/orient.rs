@@ -1,6 +1,7 @@
 //! The tool axis along the path (5-axis under tool-centre-point control): a unit vector in the
 //! workpiece frame, carried along a segment by Rodrigues rotation about the common normal of
-//! its end axes (reference 004 §2.3) and through a corner blend by the two-curve method (§2.4).
+//! its end axes (Kahraman et al., eqs 1–3) and through a corner blend by the two-curve method
+//! (their §3).
 //! The path builder attaches an [`AxisPath`] to each segment; the planner and the interpolator
 //! turn tip + axis into joints through the machine's inverse kinematics.
 
@@ -9,7 +10,7 @@ use std::fmt::Debug;
 use tezgah_geom::{Curve, Quintic, State, ToolControl, Vec3};
 
 /// Largest turn (rad) between the end axes of one move: at a reversal (π) the common normal,
-/// and so the rotation, is undefined (reference 004 §2.3 "V = −U: reject").
+/// and so the rotation, is undefined (Kahraman et al., eq. 1: opposite axes are refused).
 pub const MAX_TURN: f64 = std::f64::consts::PI - 1e-6;
 
 /// A programmed point: tip (mm, workpiece frame) and A B C (degrees).
@@ -43,7 +44,7 @@ pub trait ToolAxisMap: Debug + Send + Sync {
     ) -> bool;
 }
 
-/// Rodrigues' rotation of `v` about the unit axis `k` by `theta` (reference 004 Eq 2):
+/// Rodrigues' rotation of `v` about the unit axis `k` by `theta` (Kahraman et al., eq. 2):
 /// `v cos θ + (k × v) sin θ + k (k·v)(1 − cos θ)`. `k` must be a unit vector: the paper's
 /// Eq 1 takes the raw cross product, whose end value is neither the target nor of unit length.
 pub fn rotate(v: &Vec3, k: &Vec3, theta: f64) -> Vec3 {
@@ -120,7 +121,7 @@ impl GreatCircle {
     }
 
     /// First and second derivative of the axis by `f` at `f`: `θmax (k × O)` and
-    /// `θmax² k × (k × O)` (reference 004 §2.3's Ȯ, Ö with θ̇ = θmax, θ̈ = 0).
+    /// `θmax² k × (k × O)` (the derivatives of Kahraman et al.'s eq. 2 with θ̇ = θmax, θ̈ = 0).
     pub fn derivatives(&self, f: f64) -> [Vec3; 2] {
         let o = self.at(f);
         let n = self.k.cross(&o);
@@ -158,7 +159,7 @@ pub struct AxisEnd {
     pub d2: Vec3,
 }
 
-/// The tool axis across a corner blend, by the two-curve method (reference 004 §2.4): the
+/// The tool axis across a corner blend, by the two-curve method (Kahraman et al., §3): the
 /// lower curve `P(u)` is the tip blend, the upper `Q(u)` a point at distance `h` along the
 /// tool axis, both quintic Hermites in the same `u ∈ [0, 1]` whose end data are the
 /// neighbours' (Step 5: `Q = P + hO`, `Q′ = P′ + hO′`, `Q″ = P″ + hO″`), and the axis is
@@ -292,8 +293,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reference_004_rodrigues_5_1() {
-        // §5.1: V = (0,0,1), U = (0.5, 0, √3/2): k = (0,1,0), θmax = 30°.
+    fn rodrigues_30_degrees() {
+        // Eqs 1–3 by hand: V = (0,0,1), U = (0.5, 0, √3/2): k = (0,1,0), θmax = 30°.
         let v = Vec3::z();
         let u = Vec3::new(0.5, 0.0, 0.75f64.sqrt());
         let g = GreatCircle::new(v, u).unwrap();

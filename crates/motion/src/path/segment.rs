@@ -78,9 +78,9 @@ pub struct Segment {
     /// it at the planned speed whatever the override (M49, `M50 P0`, tapping).
     pub feed_override: bool,
     /// Under tool-centre-point control, the angle (degrees) the tool axis turns through on a
-    /// segment that only turns it, which times the segment (DESIGN.md: F is then degrees per
-    /// minute of that rotation). Set by the planner, which knows the machine; `None` times a
-    /// rotary-only segment by its largest axis travel.
+    /// segment that only turns it, which times the segment (F is then degrees per minute of
+    /// that rotation; docs/path-and-feed.md). Set by the planner, which knows the machine; `None`
+    /// times a rotary-only segment by its largest axis travel.
     pub tool_axis_travel: Option<f64>,
     /// Under tool-centre-point control on a machine whose rotaries orient the tool, the tool
     /// axis along the segment (workpiece frame): the joints then follow tip + axis, and the

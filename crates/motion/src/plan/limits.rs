@@ -6,7 +6,7 @@
 //! path speed v, acceleration a, jerk j moves with
 //!   q̇ = q'v,  q̈ = q''v² + q'a,  q⃛ = q'''v³ + 3q''va + q'j            (chain rule)
 //! so the profile limits (V, A, J) chosen below keep every joint inside its limits at every
-//! point of the segment ([`Geometry::cells`]); this is reference 000 §2.5–2.8's v ≤ √(A/κ),
+//! point of the segment ([`Geometry::cells`]); this is Kelekçi's (2021, §3.3.1) v ≤ √(A/κ),
 //! v ≤ (J/κ²)^⅓ per joint for the speed, with no fixed share of a joint's budget set aside for
 //! one term: the split between speed, path acceleration and jerk is chosen per segment (see
 //! [`segment_limits`]).
@@ -597,7 +597,7 @@ pub enum LimitedBy {
 /// the points, not the worst slope times the worst curvature.
 ///
 /// On a curved segment the speed at which a = j = 0 just fits, the least over the segment of
-/// √(b·Aᵢ/|q''|) and ∛(b·Jᵢ/|q'''|) (ref 000 §2.5–2.8, v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint; the
+/// √(b·Aᵢ/|q''|) and ∛(b·Jᵢ/|q'''|) (Kelekçi, 2021, §3.3.1, v ≤ √(A/κ), v ≤ (J/κ²)^⅓ per joint; the
 /// maximum-velocity curve of the phase plane, Bobrow et al. 1985), leaves nothing to change
 /// speed with. No fixed share of the budget is set aside: among speeds V = β·V_top (V_top the
 /// least of that curve, the feed, the joints' speeds and the chord error), and accelerations up
@@ -766,7 +766,7 @@ fn top_speed(
             by = LimitedBy::Curvature;
         }
         // Chord error at the period: the chord of a circle of radius ρ through two samples
-        // v·Ts apart sags δ when v = (2/Ts)·√(2ρδ − δ²) (ref 000 §2.7).
+        // v·Ts apart sags δ when v = (2/Ts)·√(2ρδ − δ²) (Kelekçi, 2021, §3.3.1).
         if geom.kappa_max > 0.0 {
             let rho = 1.0 / geom.kappa_max;
             let delta = (options.chord_share * seg.tolerance).min(rho);

@@ -1,5 +1,5 @@
-//! The tool axis across a corner blend (5-axis under TCP): the two-curve blend of reference
-//! 004 §2.4 built in step with the tip blend, and its angular deviation from the programmed
+//! The tool axis across a corner blend (5-axis under TCP): the two-curve blend of Kahraman
+//! et al. (§3) built in step with the tip blend, and its angular deviation from the programmed
 //! axis, which the builder keeps within the angular tolerance by shortening the legs.
 
 use tezgah_geom::deviation::{closest_point, maximise};

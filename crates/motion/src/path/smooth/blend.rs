@@ -1,15 +1,17 @@
 //! Corner blending: at a junction of two pieces, trim both back by a leg `ℓ` and insert a
-//! curvature-continuous (G2) quintic micro-spline between the trim points (reference 004 §2.4
-//! Steps 1, 4 and 6; Beudaert, Tulsyan & Altintas' corner smoothing in peers_motion.md).
+//! curvature-continuous (G2) quintic micro-spline between the trim points (Kahraman et
+//! al., §3; corner rounding as Beudaert, Lavernhe & Tournier, 2013, and Tulsyan & Altıntaş).
 //!
-//! The blend is the quintic Hermite of reference 004 Step 6 in a normalised parameter
+//! The blend is Kahraman et al.'s quintic Hermite (§3) in a normalised parameter
 //! `u ∈ [0, 1]` (duration 1): at each end it takes the neighbour's point, `λ·t` as first and
 //! `λ²·κn` as second derivative (`t` unit tangent, `κn` curvature vector of the neighbour in
 //! arc length). Then the blend's unit tangent is `t` and its curvature vector
 //! `(C'' − (C''·t)t)/|C'|² = κn`: position, tangent and curvature continue, whatever `λ`.
-//! With `λ = 2ℓ` it is exactly the reference's line–line blend with `T = 2ℓ/v` (§2.5), whose
-//! corner deviation is `δ = (3/8)·ℓ·sin(φ/2)`; so `ℓ = 8ε/(3 sin(φ/2))` puts it at the
-//! tolerance `ε` exactly (reference 004 §2.5 "tolerance-exact leg length").
+//! With `λ = 2ℓ` it is exactly the paper's line–line blend with `T = 2ℓ/v`, whose corner
+//! deviation is `δ = (3/8)·ℓ·sin(φ/2)` (the paper gives no closed form: integrating
+//! `C' = 2ℓ(t0 + (t1 − t0)w)` from `−ℓt0` puts the mid-blend point at `(3/16)·ℓ·(t1 − t0)`
+//! from the corner, and `|t1 − t0| = 2 sin(φ/2)`); so `ℓ = 8ε/(3 sin(φ/2))` puts it at the
+//! tolerance `ε` exactly: the tolerance-exact leg.
 
 use tezgah_geom::arclen::gauss_legendre;
 use tezgah_geom::deviation::{closest_point, maximise, point_segment_distance};
@@ -156,7 +158,7 @@ fn adaptive(f: &impl Fn(f64) -> f64, a: f64, b: f64, whole: f64, depth: u32) -> 
 }
 
 /// Length of the line–line blend with legs `ℓ` and turn `φ`, in closed form up to a scalar
-/// quadrature: `C'(u) = 2ℓ (t0 + (t1 − t0) w)`, `w = 3u² − 2u³` (reference 004 §2.5), so
+/// quadrature: `C'(u) = 2ℓ (t0 + (t1 − t0) w)`, `w = 3u² − 2u³` (the line–line quintic), so
 /// `|C'| = 2ℓ √(1 − 2w(1−w)(1 − cos φ))`, symmetric about `u = ½`. Same rule and acceptance as
 /// [`Blend::arc_length`], on a scalar instead of a vector integrand (the bench's hot spot).
 pub(crate) fn line_line_length(leg: f64, cos_phi: f64) -> f64 {
@@ -334,7 +336,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         )
         .ok_or_else(refuse)?;
         let deviation = if both_lines {
-            // Closed form (reference 004 §2.5): the corner's distance to the blend.
+            // Closed form (module doc): the corner's distance to the blend.
             0.375 * leg * half
         } else {
             // Both directions, measured: the corner to the blend, and the blend to the two
@@ -397,8 +399,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn reference_004_line_line_90() {
-        // §5.4: ℓ = 1, 90°: x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
+    fn quintic_line_line_90() {
+        // Kahraman et al.'s quintic at a 90° corner, ℓ = 1, v = 10 mm/s:
+        // x = −1 + 10τ − 250τ³ + 625τ⁴ with T = 0.2, i.e. u = 5τ.
         let z = Vec3::zeros();
         let b = Blend::g2(
             End {

@@ -126,7 +126,8 @@ fn fit_run(run: &[Piece], share: f64) -> Fit {
     // parametric speed stays even. Centripetal parameters (Lee 1989) are made for sharp turns;
     // on uneven 0.05–0.3 mm spacing they gave the least squares uneven speed to fix, and the
     // refined fit folded into the vertices: 1.0/mm peaks on a surface of 0.04/mm, 117/mm on a
-    // wavy one (NOTES-smooth.md). Chord length: 0.04/mm and 10/mm, with fewer control points.
+    // wavy one (measured when chord length replaced centripetal parameters). Chord length: 0.04/mm
+    // and 10/mm, with fewer control points.
     let Ok(fit) = approximate(&points, 3, tol, Parameterisation::ChordLength) else {
         return Fit::Failed;
     };

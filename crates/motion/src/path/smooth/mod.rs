@@ -7,11 +7,11 @@
 //! depends on the next move). Memory is O(window) whatever the program's length; a compressed
 //! run never spans two windows (the join of the two splines is then blended like any corner).
 //!
-//! **Tolerance budget** (DESIGN.md "Tolerance"): with `ε` the tolerance in force, compression
-//! keeps its splines within `compression_share·ε` (default 0.4) of the programmed polyline, a
-//! blend stays within `blend_share·ε` (0.4) of the curves it joins, and the planner's chord
-//! error gets the rest, at least [`CHORD_SHARE`]`·ε` (0.2). A blend next to a spline is measured
-//! against the spline, so by the triangle inequality the path stays within
+//! **Tolerance budget** (ARCHITECTURE.md, "One tolerance budget"): with `ε` the tolerance in force,
+//! compression keeps its splines within `compression_share·ε` (default 0.4) of the programmed
+//! polyline, a blend stays within `blend_share·ε` (0.4) of the curves it joins, and the planner's
+//! chord error gets the rest, at least [`CHORD_SHARE`]`·ε` (0.2). A blend next to a spline is
+//! measured against the spline, so by the triangle inequality the path stays within
 //! `(compression_share + blend_share)·ε` of the program, and the samples within `ε`.
 
 mod axis;
@@ -56,7 +56,7 @@ pub struct SmoothOptions {
     /// ends the run and stays a corner (to be blended). Default 30°.
     pub compress_corner_angle: f64,
     /// Largest turn (rad) that is blended; sharper (near-reversal) corners stay `Corner`: the
-    /// quintic's speed dips to `cos(φ/2)` at mid-blend (reference 004 §2.5), a cusp at 180°.
+    /// quintic's speed dips to `cos(φ/2)` at mid-blend (the line–line quintic), a cusp at 180°.
     /// Default 175°.
     pub blend_max_angle: f64,
     /// Share of the tolerance for compression. Default 0.4.

@@ -268,8 +268,9 @@ impl Piece {
     /// The trimmed range `[u0, u1]` cut into parameter ranges of similar curvature: for a
     /// spline, consecutive knot spans stay together while the largest span curvature of the
     /// group is at most [`CURVATURE_RATIO`] times the smallest (curvatures below
-    /// [`FLAT_CURVATURE`] count as that floor); lines and arcs stay whole. This is reference
-    /// 000 §2.6's split of a NURBS at its curvature peaks, done at knots so every cut is C².
+    /// [`FLAT_CURVATURE`] count as that floor); lines and arcs stay whole. This is Kelekçi's
+    /// (2021, §3.3.1, eq. 3.33) split of a NURBS at its curvature peaks, done at knots so every cut
+    /// is C².
     pub fn curvature_chunks(&self) -> Vec<(f64, f64)> {
         let Geo::Spline(c) = &self.geo else {
             return vec![(self.u0, self.u1)];
