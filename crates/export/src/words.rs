@@ -128,6 +128,14 @@ impl CanonSink for PassThrough {
         if let (Some(text), true) = (text, origin.line > 0) {
             self.push(origin, text);
         }
+        // The words of the end's own line: M2 stops the spindle and coolant itself.
+        if matches!(call, Canon::ProgramEnd) {
+            while self.words.last().is_some_and(|w| {
+                (w.line, w.file, w.after_motions) == (origin.line, origin.file, self.motions)
+            }) {
+                self.words.pop();
+            }
+        }
         if is_motion_call(&call) {
             self.motions += 1;
         }
