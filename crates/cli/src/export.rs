@@ -82,6 +82,9 @@ pub fn export(args: ExportArgs) -> Result<std::process::ExitCode> {
         s.blocks_out,
         letters.describe(&machine),
     );
+    if s.blocks_out == 0 {
+        return Ok(std::process::ExitCode::SUCCESS);
+    }
     println!(
         "joint-linear deviation {:.4} mm (line {}, budget {:.4} mm of tolerance {tolerance} mm); \
          longest block {:.3} mm (line {})",

@@ -55,8 +55,12 @@ pub enum Block {
     },
     /// G4 P seconds.
     Dwell { seconds: f64, line: u32 },
-    /// M0, M1, M60, M2.
-    Stop { kind: StopKind, line: u32 },
+    /// M0, M1, M60, or the end: M2, M30 (`rewind`, LinuxCNC's pallet shuttle and end).
+    Stop {
+        kind: StopKind,
+        rewind: bool,
+        line: u32,
+    },
     /// Carried-through words (spindle, coolant, tool, message).
     Words { text: String, line: u32 },
 }

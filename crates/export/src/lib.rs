@@ -179,8 +179,13 @@ pub fn export(
                     MoveKind::Stop(kind) => kind,
                     _ => StopKind::Pause,
                 };
+                // M30 reaches the moves as a pallet shuttle and the end, on one line.
+                let rewind = kind == StopKind::PalletPause
+                    && matches!(kinds.get(at + 1), Some(MoveKind::Stop(StopKind::End)))
+                    && lines.get(at + 1) == lines.get(at);
+                let kind = if rewind { StopKind::End } else { kind };
                 if !ended {
-                    conv.blocks.push(Block::Stop { kind, line });
+                    conv.blocks.push(Block::Stop { kind, rewind, line });
                 }
                 ended |= kind == StopKind::End;
             }

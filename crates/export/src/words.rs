@@ -128,11 +128,13 @@ impl CanonSink for PassThrough {
         if let (Some(text), true) = (text, origin.line > 0) {
             self.push(origin, text);
         }
-        // The words of the end's own line: M2 stops the spindle and coolant itself.
+        // The words of the end's own line: M2 and M30 stop the spindle and coolant themselves.
         if matches!(call, Canon::ProgramEnd) {
-            while self.words.last().is_some_and(|w| {
-                (w.line, w.file, w.after_motions) == (origin.line, origin.file, self.motions)
-            }) {
+            while self
+                .words
+                .last()
+                .is_some_and(|w| (w.line, w.file) == (origin.line, origin.file))
+            {
                 self.words.pop();
             }
         }

@@ -112,11 +112,12 @@ pub fn program(blocks: &[Block], letters: &AxisLetters, header: &Header<'_>) -> 
             Block::Dwell { seconds, line } => {
                 let _ = write!(out, "N{line} G4 P{}", number(*seconds, 4));
             }
-            Block::Stop { kind, line } => {
+            Block::Stop { kind, rewind, line } => {
                 let word = match kind {
                     StopKind::Pause => "M0",
                     StopKind::OptionalPause => "M1",
                     StopKind::PalletPause => "M60",
+                    StopKind::End if *rewind => "M30",
                     StopKind::End => "M2",
                 };
                 ended |= *kind == StopKind::End;
