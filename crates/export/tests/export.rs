@@ -9,7 +9,9 @@ mod support;
 use std::f64::consts::PI;
 
 use proptest::prelude::*;
-use support::programs::{delta_program, DELTA_ARCS, SAG, TABLE_AC, TABLE_AC_TOOLS};
+use support::programs::{
+    delta_program, table_ac_program, DELTA_ARCS, SAG, TABLE_AC, TABLE_AC_TOOLS,
+};
 use support::{export_program, measure, minutes_per_line, motion_blocks, read_back};
 use tezgah_export::Block;
 use tezgah_geom::Vec3;
@@ -199,6 +201,26 @@ fn table_ac_five_axis_within_tolerance_with_unwrapped_rotaries() {
         .contains("x=X y=Y z=Z a=A c=C"));
 }
 
+/// Every feed segment's G93 times add up to its length (its rotary travel, for a turn of
+/// the axis alone) at its feed.
+fn assert_segment_times(case: &support::Case, m: &support::Measured) -> Result<(), TestCaseError> {
+    for (i, minutes) in &m.minutes {
+        let seg = support::segment(case, *i);
+        let tezgah_motion::SegmentFeed::Feed(v) = seg.feed else {
+            unreachable!()
+        };
+        if seg.rotary_only() {
+            continue;
+        }
+        let want = seg.length / (v * 60.0);
+        prop_assert!(
+            close(*minutes, want, 1e-7),
+            "segment {i}: {minutes} vs {want}"
+        );
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 16, ..ProptestConfig::default() })]
 
@@ -210,11 +232,26 @@ proptest! {
         let m = measure(&case);
         prop_assert!(m.worst_ratio <= 1.0, "{m:?}\n{text}");
         prop_assert!(m.worst_time_error < 1e-7, "{m:?}\n{text}");
-        for (i, minutes) in &m.minutes {
-            let seg = support::segment(&case, *i);
-            let tezgah_motion::SegmentFeed::Feed(v) = seg.feed else { unreachable!() };
-            let want = seg.length / (v * 60.0);
-            prop_assert!(close(*minutes, want, 1e-7), "segment {i}: {minutes} vs {want}\n{text}");
+        assert_segment_times(&case, &m).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+
+    /// Five-axis programs under TCP on table-ac: the same, with the rotaries unwrapped
+    /// (consecutive C values never jump by a turn).
+    #[test]
+    fn random_table_ac_programs_within_tolerance_and_on_time(text in table_ac_program()) {
+        let case = export_program(&text, "table-ac", TABLE_AC_TOOLS, 0.01);
+        let m = measure(&case);
+        prop_assert!(m.worst_ratio <= 1.0, "{m:?}\n{text}");
+        prop_assert!(m.worst_time_error < 1e-7, "{m:?}\n{text}");
+        assert_segment_times(&case, &m).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
+        let (read, _) = read_back(&case);
+        for w in read.windows(2) {
+            let (c0, c1) = (w[0].joints[4], w[1].joints[4]);
+            prop_assert!((c1 - c0).abs() < 0.2, "C jumps {c0} → {c1}\n{text}");
         }
     }
 }

@@ -1,6 +1,7 @@
 //! LinuxCNC's own interpreter `rs274` reads every exported program: it accepts it, its
 //! traverses and feeds are the written joints (to its 4 printed decimals), and the time of each
 //! feed at the rate it derives from G93 (`SET_FEED_RATE` = length × F) is the block's time.
+//! Programs: the three of `tests/export.rs`, eight random delta and four random table-ac ones.
 //! The oracle is found as in the G-code crate's tests (`TEZGAH_RS274`, see `.ci/install-rs274`).
 
 #[path = "../../gcode/tests/support/mod.rs"]
@@ -12,7 +13,9 @@ use std::process::{Command, Stdio};
 
 use proptest::strategy::{Strategy, ValueTree};
 use proptest::test_runner::{Config as ProptestConfig, RngSeed, TestRunner};
-use support::programs::{delta_program, DELTA_ARCS, SAG, TABLE_AC, TABLE_AC_TOOLS};
+use support::programs::{
+    delta_program, table_ac_program, DELTA_ARCS, SAG, TABLE_AC, TABLE_AC_TOOLS,
+};
 use support::{export_program, motion_blocks, Case};
 use tezgah_export::Block;
 
@@ -132,6 +135,11 @@ fn rs274_reads_every_exported_program() {
         let (text, tol) = delta_program().new_tree(&mut runner).unwrap().current();
         let case = export_program(&text, "linear-delta", "", tol);
         check_with_rs274(&rs274, &dir, &format!("random-{i}"), &case);
+    }
+    for i in 0..4 {
+        let text = table_ac_program().new_tree(&mut runner).unwrap().current();
+        let case = export_program(&text, "table-ac", TABLE_AC_TOOLS, 0.01);
+        check_with_rs274(&rs274, &dir, &format!("random-table-ac-{i}"), &case);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -93,3 +93,39 @@ pub fn delta_program() -> impl Strategy<Value = (String, f64)> {
             (text, tol)
         })
 }
+
+/// A random five-axis program under TCP on table-ac, blended under G64: lines that tilt (A in
+/// 10–60°, away from the pole) and turn the table (C accumulating past ±180°, so the written C
+/// must unwrap), and flat arcs.
+pub fn table_ac_program() -> impl Strategy<Value = String> {
+    let step = (
+        0..3u8,
+        (-40.0..40.0f64, -40.0..40.0f64, -20.0..10.0f64),
+        (10.0..60.0f64, -90.0..90.0f64),
+        (5.0..20.0f64, 0.3..2.5f64),
+        300.0..3000.0f64,
+    );
+    prop::collection::vec(step, 2..6).prop_map(|steps| {
+        let mut text = String::from("G21 G90 G94 G64\nG43.4 H1\nG0 X0 Y0 Z10 A20 C0\n");
+        let (mut at, mut c) = (Vec3::new(0.0, 0.0, 10.0), 0.0);
+        for (kind, p, (a, dc), (r, sweep), feed) in steps {
+            if kind == 0 {
+                c += dc;
+                text += &format!(
+                    "G1 X{:.4} Y{:.4} Z{:.4} A{a:.4} C{c:.4} F{feed:.1}\n",
+                    p.0, p.1, p.2
+                );
+                at = Vec3::new(p.0, p.1, p.2);
+                continue;
+            }
+            // A flat arc of radius r about a centre beside the current point.
+            let centre = at.xy() + nalgebra::Vector2::new(-r, 0.0);
+            let turn = if kind == 1 { -sweep } else { sweep };
+            let end = centre + nalgebra::Vector2::new(r * turn.cos(), r * turn.sin());
+            let g = if kind == 1 { "G2" } else { "G3" };
+            text += &format!("{g} X{:.4} Y{:.4} I{:.4} J0 F{feed:.1}\n", end.x, end.y, -r);
+            at = Vec3::new(end.x, end.y, at.z);
+        }
+        text + "M2\n"
+    })
+}
