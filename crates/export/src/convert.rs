@@ -12,7 +12,7 @@
 
 use nalgebra::{Unit, Vector3};
 use tezgah_geom::curve::LENGTH_TOLERANCE;
-use tezgah_geom::deviation::{closest_point, max_distance_to_segment};
+use tezgah_geom::deviation::{closest_point, max_distance_to_segment, point_segment_distance};
 use tezgah_geom::{ArcLengthMap, Curve, StopKind, ToolControl, Vec3};
 use tezgah_kinematics::segment::{segment_line_by, SegmentOptions};
 use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Tool};
@@ -167,7 +167,8 @@ impl Converter<'_> {
         let total = map.as_ref().map_or(0.0, |m| m.length());
         let sigma = |u: f64| map.as_ref().map_or(0.0, |m| m.s_at(curve, u));
         let whole = max_distance_to_segment(curve, d0, d1, &curve.point(d0), &curve.point(d1), 16);
-        let (pieces, bow) = if rotary_only || whole.distance <= STRAIGHT {
+        let straight = rotary_only || whole.distance <= STRAIGHT;
+        let (pieces, bow) = if straight {
             (vec![(d0, d1, whole.distance)], budget)
         } else {
             let share = if direct { budget } else { 0.5 * budget };
@@ -208,7 +209,12 @@ impl Converter<'_> {
                 let deviation = if direct {
                     chord_deviation
                 } else {
-                    self.dense_deviation(curve, (u0, u1), rotary_only, &tool, q0, q1)?
+                    let shape = if straight {
+                        Programmed::Line(a, b)
+                    } else {
+                        Programmed::Curve(u0, u1)
+                    };
+                    self.dense_deviation(curve, shape, &tool, q0, q1)?
                 };
                 let piece = Piece {
                     segment: index,
@@ -217,6 +223,9 @@ impl Converter<'_> {
                     deviation,
                 };
                 let joints = *q1;
+                if !moves(q0, q1) {
+                    continue; // nothing to write: no joint moves (so neither does the tip)
+                }
                 self.blocks.push(match minutes {
                     None => Block::Rapid {
                         joints,
@@ -241,13 +250,7 @@ impl Converter<'_> {
     /// A joint-space rapid to `start` when the joints written last are elsewhere (the two
     /// readings of one point across a tool-centre-point switch).
     fn take_up(&mut self, start: &Joints, line: u32) {
-        let moved = self
-            .last
-            .as_slice()
-            .iter()
-            .zip(start.as_slice())
-            .any(|(a, b)| (a - b).abs() > SAME_JOINTS);
-        if moved {
+        if moves(&self.last, start) {
             self.blocks.push(Block::Rapid {
                 joints: *start,
                 line,
@@ -262,24 +265,37 @@ impl Converter<'_> {
     fn dense_deviation<C: Curve + ?Sized>(
         &self,
         curve: &C,
-        (u0, u1): (f64, f64),
-        rotary_only: bool,
+        shape: Programmed,
         tool: &Tool,
         q0: &Joints,
         q1: &Joints,
     ) -> Result<f64, KinematicsError> {
         let mut worst: f64 = 0.0;
-        let still: Vec3 = curve.point(u0);
         for k in 1..DENSE_CHECKS {
             let t = k as f64 / DENSE_CHECKS as f64;
             let tip = self.pm.model.forward(&q0.lerp(q1, t), tool)?.tip;
-            let d = if rotary_only {
-                (tip - still).norm()
-            } else {
-                closest_point(curve, &tip, u0, u1, 8).distance
+            let d = match shape {
+                Programmed::Line(a, b) => point_segment_distance(&tip, &a, &b),
+                Programmed::Curve(u0, u1) => closest_point(curve, &tip, u0, u1, 8).distance,
             };
             worst = worst.max(d);
         }
         Ok(worst)
     }
+}
+
+/// Whether any joint differs between `a` and `b` by more than [`SAME_JOINTS`].
+fn moves(a: &Joints, b: &Joints) -> bool {
+    a.as_slice()
+        .iter()
+        .zip(b.as_slice())
+        .any(|(x, y)| (x - y).abs() > SAME_JOINTS)
+}
+
+/// What a written move is measured against: the segment itself where it is straight (or a
+/// point, the tip standing still), else its curve between the chord's parameters.
+#[derive(Clone, Copy)]
+enum Programmed {
+    Line(Vec3, Vec3),
+    Curve(f64, f64),
 }

@@ -48,6 +48,18 @@ pub fn comment_text(s: &str) -> String {
         .collect()
 }
 
+/// LinuxCNC refuses N words past 99999 ("Line number greater than 99999").
+const LARGEST_N: u32 = 99_999;
+
+/// The source line a block starts with: its N word, or past [`LARGEST_N`] a comment.
+fn source(line: u32) -> String {
+    if line <= LARGEST_N {
+        format!("N{line} ")
+    } else {
+        format!("(line {line}) ")
+    }
+}
+
 /// A G93 F for a block of `minutes`: 1/minutes to [`FEED_DIGITS`] significant digits.
 pub fn inverse_time(minutes: f64) -> String {
     let f = 1.0 / minutes;
@@ -96,7 +108,7 @@ pub fn program(blocks: &[Block], letters: &AxisLetters, header: &Header<'_>) -> 
         }
         match b {
             Block::Rapid { joints, line, .. } => {
-                let _ = write!(out, "N{line} G0");
+                let _ = write!(out, "{}G0", source(*line));
                 joints_words(&mut out, joints, letters);
             }
             Block::Feed {
@@ -105,12 +117,12 @@ pub fn program(blocks: &[Block], letters: &AxisLetters, header: &Header<'_>) -> 
                 line,
                 ..
             } => {
-                let _ = write!(out, "N{line} G1");
+                let _ = write!(out, "{}G1", source(*line));
                 joints_words(&mut out, joints, letters);
                 let _ = write!(out, " F{}", inverse_time(*minutes));
             }
             Block::Dwell { seconds, line } => {
-                let _ = write!(out, "N{line} G4 P{}", number(*seconds, 4));
+                let _ = write!(out, "{}G4 P{}", source(*line), number(*seconds, 4));
             }
             Block::Stop { kind, rewind, line } => {
                 let word = match kind {
@@ -121,10 +133,10 @@ pub fn program(blocks: &[Block], letters: &AxisLetters, header: &Header<'_>) -> 
                     StopKind::End => "M2",
                 };
                 ended |= *kind == StopKind::End;
-                let _ = write!(out, "N{line} {word}");
+                let _ = write!(out, "{}{word}", source(*line));
             }
             Block::Words { text, line } => {
-                let _ = write!(out, "N{line} {text}");
+                let _ = write!(out, "{}{text}", source(*line));
             }
         }
         out.push('\n');
@@ -133,4 +145,21 @@ pub fn program(blocks: &[Block], letters: &AxisLetters, header: &Header<'_>) -> 
         out.push_str("M2\n");
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_and_source_lines() {
+        assert_eq!(number(-0.000001, 5), "0");
+        assert_eq!(number(12.5, 5), "12.5");
+        assert_eq!(number(-3.0, 6), "-3");
+        assert_eq!(inverse_time(0.1), "10");
+        assert_eq!(inverse_time(1.0 / 640.0717411), "640.0717411");
+        assert_eq!(source(99_999), "N99999 ");
+        assert_eq!(source(100_000), "(line 100000) ");
+        assert_eq!(comment_text("a(b)c→"), "a b c?");
+    }
 }
