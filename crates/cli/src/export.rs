@@ -85,8 +85,12 @@ pub fn export(args: ExportArgs) -> Result<std::process::ExitCode> {
     if s.blocks_out == 0 {
         return Ok(std::process::ExitCode::SUCCESS);
     }
+    let axis = match s.axis {
+        Some((worst, budget)) => format!("; tool axis {worst:.4}° (budget {budget:.4}°)"),
+        None => String::new(),
+    };
     println!(
-        "joint-linear deviation {:.4} mm (line {}, budget {:.4} mm of tolerance {tolerance} mm); \
+        "joint-linear deviation {:.4} mm (line {}, budget {:.4} mm of tolerance {tolerance} mm){axis}; \
          longest block {:.3} mm (line {})",
         s.worst_deviation, s.worst_line, s.budget, s.longest, s.longest_line
     );

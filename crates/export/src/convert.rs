@@ -29,11 +29,18 @@ pub struct Piece {
     /// The curve parameters of the chord the move lies along (the whole chord: the tip's
     /// nearest path point may be anywhere on it).
     pub u: (f64, f64),
+    /// The fractions of the chord at the move's ends: the joints are the program's at
+    /// `u.0 + (u.1 − u.0)·s` for `s` = each end.
+    pub s: (f64, f64),
     /// Tip path length the move covers, mm (0 when only rotary axes move the tool).
     pub length: f64,
     /// Largest distance of the joint-linear tip from the programmed piece, mm (measured at
     /// [`DENSE_CHECKS`] points, closer than the splitter checks).
     pub deviation: f64,
+    /// Under tool-centre-point control with a tool axis path: the largest angle (rad) of the
+    /// joint-linear tool axis from the path's axis at the same fraction of the move (the
+    /// tool is where the path puts it when the move is that far through); else 0.
+    pub axis_deviation: f64,
 }
 
 /// One written block.
@@ -80,6 +87,9 @@ const SAME_JOINTS: f64 = 1e-9;
 /// them, so rotary joints unwrap and stay on one branch).
 pub(crate) struct Converter<'a> {
     pub pm: &'a PlanMachine,
+    /// The tool axis's angular tolerance α, degrees; the blocks get [`CHORD_SHARE`] α, as the
+    /// planner's samples do (the path's axis blends take the rest).
+    pub axis_tolerance_deg: f64,
     pub last: Joints,
     pub blocks: Vec<Block>,
 }
@@ -141,6 +151,10 @@ impl Converter<'_> {
     ) -> Result<(), KinematicsError> {
         let pm = self.pm;
         let budget = seg.tolerance * CHORD_SHARE;
+        // The tool axis is checked where the path carries one (five-axis under TCP).
+        let axis_budget = seg
+            .axis
+            .map(|_| CHORD_SHARE * self.axis_tolerance_deg.to_radians());
         let tool = match seg.control {
             ToolControl::CentrePoint { tool_length } => Tool::with_length(tool_length),
             // TCP off: the moves' X Y Z are the gauge point (G43's length already in Z).
@@ -196,7 +210,7 @@ impl Converter<'_> {
             } else {
                 let options = SegmentOptions {
                     tolerance_mm: SPLIT_MARGIN * bow,
-                    axis_tolerance_rad: None,
+                    axis_tolerance_rad: axis_budget.map(|b| SPLIT_MARGIN * b),
                     checks_per_piece: SPLIT_CHECKS,
                     max_depth: 40,
                 };
@@ -206,21 +220,33 @@ impl Converter<'_> {
             for w in points.windows(2) {
                 let ((f0, q0), (f1, q1)) = (&w[0], &w[1]);
                 let length = (s1 - s0) * (f1 - f0);
-                let deviation = if direct {
-                    chord_deviation
+                let (deviation, axis_deviation) = if direct {
+                    (chord_deviation, 0.0)
                 } else {
                     let shape = if straight {
                         Programmed::Line(a, b)
                     } else {
                         Programmed::Curve(u0, u1)
                     };
-                    self.dense_deviation(curve, shape, &tool, q0, q1)?
+                    // The programmed axis at chord fraction s, where the path carries one.
+                    let axis_at = |s: f64| -> Option<Vec3> {
+                        let path = seg.axis?;
+                        let f = if rotary_only {
+                            s
+                        } else {
+                            (s0 + (s1 - s0) * s) / total
+                        };
+                        Some(path.at(u0 + (u1 - u0) * s, f.min(1.0)))
+                    };
+                    self.dense_deviation(curve, shape, &tool, (*f0, q0), (*f1, q1), &axis_at)?
                 };
                 let piece = Piece {
                     segment: index,
                     u: (u0, u1),
+                    s: (*f0, *f1),
                     length,
                     deviation,
+                    axis_deviation,
                 };
                 let joints = *q1;
                 if !moves(q0, q1) {
@@ -261,26 +287,33 @@ impl Converter<'_> {
     }
 
     /// The largest distance from the programmed piece of the tip moved joint-linearly from
-    /// `q0` to `q1`, at [`DENSE_CHECKS`] interior points.
+    /// `q0` (at chord fraction `f0`) to `q1` (at `f1`), at [`DENSE_CHECKS`] interior points,
+    /// and the largest angle of its tool axis from `axis_at` the same fraction (0 without).
     fn dense_deviation<C: Curve + ?Sized>(
         &self,
         curve: &C,
         shape: Programmed,
         tool: &Tool,
-        q0: &Joints,
-        q1: &Joints,
-    ) -> Result<f64, KinematicsError> {
-        let mut worst: f64 = 0.0;
+        (f0, q0): (f64, &Joints),
+        (f1, q1): (f64, &Joints),
+        axis_at: &dyn Fn(f64) -> Option<Vec3>,
+    ) -> Result<(f64, f64), KinematicsError> {
+        let (mut worst, mut worst_axis): (f64, f64) = (0.0, 0.0);
         for k in 1..DENSE_CHECKS {
             let t = k as f64 / DENSE_CHECKS as f64;
-            let tip = self.pm.model.forward(&q0.lerp(q1, t), tool)?.tip;
+            let pose = self.pm.model.forward(&q0.lerp(q1, t), tool)?;
             let d = match shape {
-                Programmed::Line(a, b) => point_segment_distance(&tip, &a, &b),
-                Programmed::Curve(u0, u1) => closest_point(curve, &tip, u0, u1, 8).distance,
+                Programmed::Line(a, b) => point_segment_distance(&pose.tip, &a, &b),
+                // A chord's stretch of curve is within the tolerance of a straight line:
+                // one minimum, which a few samples bracket.
+                Programmed::Curve(u0, u1) => closest_point(curve, &pose.tip, u0, u1, 4).distance,
             };
             worst = worst.max(d);
+            if let Some(want) = axis_at(f0 + (f1 - f0) * t) {
+                worst_axis = worst_axis.max(pose.axis.angle(&want));
+            }
         }
-        Ok(worst)
+        Ok((worst, worst_axis))
     }
 }
 

@@ -69,6 +69,10 @@ pub struct Summary {
     pub worst_line: u32,
     /// The written blocks' share of the tolerance (the largest in the program), mm.
     pub budget: f64,
+    /// Where the path carries a tool axis (five-axis under TCP): the largest angle of the
+    /// joint-linear tool axis from it and the blocks' share of the angular tolerance,
+    /// degrees; `None` without.
+    pub axis: Option<(f64, f64)>,
     /// The longest written move along the tip path, mm, and its line.
     pub longest: f64,
     pub longest_line: u32,
@@ -131,7 +135,7 @@ pub fn export(
             .unwrap_or(0)
     };
     let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
-    let path = smooth::Smoother::new(numbered, opts)
+    let path = smooth::Smoother::new(numbered, opts.clone())
         .map_err(|e| ExportError::Path {
             line: None,
             message: e.to_string(),
@@ -144,6 +148,7 @@ pub fn export(
 
     let mut conv = convert::Converter {
         pm: &pm,
+        axis_tolerance_deg: opts.angular_tolerance,
         last: start_joints,
         blocks: Vec::new(),
     };
@@ -197,7 +202,8 @@ pub fn export(
             line: w.line,
         });
     }
-    let summary = summarise(&conv.blocks, blocks_in, tolerance, &path);
+    let axis_budget = smooth::CHORD_SHARE * opts.angular_tolerance;
+    let summary = summarise(&conv.blocks, blocks_in, tolerance, axis_budget, &path);
     Ok(Exported {
         blocks: conv.blocks,
         path,
@@ -205,7 +211,13 @@ pub fn export(
     })
 }
 
-fn summarise(blocks: &[Block], blocks_in: usize, tolerance: f64, path: &[PathItem]) -> Summary {
+fn summarise(
+    blocks: &[Block],
+    blocks_in: usize,
+    tolerance: f64,
+    axis_budget: f64,
+    path: &[PathItem],
+) -> Summary {
     let mut s = Summary {
         blocks_in,
         blocks_out: 0,
@@ -214,10 +226,14 @@ fn summarise(blocks: &[Block], blocks_in: usize, tolerance: f64, path: &[PathIte
         budget: smooth::CHORD_SHARE * tolerance,
         longest: 0.0,
         longest_line: 0,
+        axis: None,
     };
     for item in path {
         if let PathItem::Segment(seg) = item {
             s.budget = s.budget.max(smooth::CHORD_SHARE * seg.tolerance);
+            if seg.axis.is_some() && s.axis.is_none() {
+                s.axis = Some((0.0, axis_budget));
+            }
         }
     }
     for b in blocks {
@@ -231,6 +247,9 @@ fn summarise(blocks: &[Block], blocks_in: usize, tolerance: f64, path: &[PathIte
         if let Some(p) = piece {
             if p.deviation > s.worst_deviation {
                 (s.worst_deviation, s.worst_line) = (p.deviation, line);
+            }
+            if let Some((worst, _)) = &mut s.axis {
+                *worst = worst.max(p.axis_deviation.to_degrees());
             }
             if p.length > s.longest {
                 (s.longest, s.longest_line) = (p.length, line);

@@ -141,6 +141,15 @@ fn table_ac_five_axis_within_tolerance_with_unwrapped_rotaries() {
     let case = export_program(TABLE_AC, "table-ac", TABLE_AC_TOOLS, 0.01);
     let m = measure(&case);
     assert!(m.worst_ratio <= 1.0, "{m:?}");
+    assert!(
+        m.worst_axis_ratio > 0.0 && m.worst_axis_ratio <= 1.0,
+        "{m:?}"
+    );
+    let (axis, budget) = case.exported.summary.axis.unwrap();
+    assert!(
+        axis <= budget && (budget - 0.02).abs() < 1e-12,
+        "{axis}° of {budget}°"
+    );
     assert!(m.worst_time_error < 1e-8, "{m:?}");
     let per_line = minutes_per_line(&case);
     let p = |x, y, z| Vec3::new(x, y, z);
@@ -246,6 +255,7 @@ proptest! {
         let case = export_program(&text, "table-ac", TABLE_AC_TOOLS, 0.01);
         let m = measure(&case);
         prop_assert!(m.worst_ratio <= 1.0, "{m:?}\n{text}");
+        prop_assert!(m.worst_axis_ratio <= 1.0, "{m:?}\n{text}");
         prop_assert!(m.worst_time_error < 1e-7, "{m:?}\n{text}");
         assert_segment_times(&case, &m).map_err(|e| TestCaseError::fail(format!("{e}\n{text}")))?;
         let (read, _) = read_back(&case);

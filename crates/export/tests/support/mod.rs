@@ -9,7 +9,7 @@ use tezgah_export::write::Header;
 use tezgah_export::{export, AxisLetters, Block, Exported, PassThrough};
 use tezgah_gcode::sources::{interpret, Pass, Sources};
 use tezgah_gcode::{AxisMask, Canon, CanonSink, Config, Interpreter, Origin, ToolTable};
-use tezgah_geom::{Curve, Pose, ToolControl, Vec3};
+use tezgah_geom::{ArcLengthMap, Curve, Pose, ToolControl, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, Machine, TcpSwitch, Tool};
 use tezgah_motion::path::smooth::CHORD_SHARE;
 use tezgah_motion::plan::PlanMachine;
@@ -189,6 +189,10 @@ pub struct Measured {
     /// (CHORD_SHARE of the segment's tolerance).
     pub worst_ratio: f64,
     pub worst_mm: f64,
+    /// Where the path carries a tool axis: the largest angle of the joint-linear tool axis
+    /// from the path's axis at the same fraction of the move, over its budget (CHORD_SHARE of
+    /// the angular tolerance).
+    pub worst_axis_ratio: f64,
     /// Feed blocks checked and the largest relative difference of a block's G93 time from
     /// its piece's length (or rotary share) at the programmed feed.
     pub feed_blocks: usize,
@@ -202,6 +206,8 @@ pub struct Measured {
 /// move ending on the segment's end point, and each feed block's time.
 pub fn measure(case: &Case) -> Measured {
     let pm = PlanMachine::from_machine(&case.machine).unwrap();
+    let alpha = case.machine.path.axis_tolerance_deg.unwrap_or(0.1);
+    let axis_budget = CHORD_SHARE * alpha.to_radians();
     let (read, _) = read_back(case);
     let blocks = motion_blocks(case);
     assert_eq!(read.len(), blocks.len(), "moves read back vs written");
@@ -234,14 +240,45 @@ pub fn measure(case: &Case) -> Measured {
             let seg = segment(case, p.segment);
             let budget = CHORD_SHARE * seg.tolerance;
             let (u0, u1) = p.u;
+            let lengths =
+                (!seg.rotary_only()).then(|| ArcLengthMap::new(&*seg.curve, 1e-10).unwrap());
             for j in 0..=FINE {
                 let t = j as f64 / FINE as f64;
-                let tip = program_point(&pm, &prev.lerp(&r.joints, t), seg.control);
+                let q = prev.lerp(&r.joints, t);
+                let tip = program_point(&pm, &q, seg.control);
                 let d = if seg.rotary_only() {
                     (tip - seg.curve.point(u0)).norm()
                 } else {
                     tezgah_geom::deviation::closest_point(&*seg.curve, &tip, u0, u1, 16).distance
                 };
+                // The tool axis against the path's at the same fraction of the move (the
+                // tip's nearest point is no reference where a blend turns the axis fast).
+                if let (Some(path), ToolControl::CentrePoint { tool_length }) =
+                    (seg.axis, seg.control)
+                {
+                    let got = pm
+                        .model
+                        .forward(&q, &Tool::with_length(tool_length))
+                        .unwrap()
+                        .axis;
+                    let s = p.s.0 + (p.s.1 - p.s.0) * t;
+                    let u = u0 + (u1 - u0) * s;
+                    let f = match &lengths {
+                        // The chord's arc length, in step with the tip along it.
+                        Some(map) => {
+                            let (a, b) = (map.s_at(&*seg.curve, u0), map.s_at(&*seg.curve, u1));
+                            (a + (b - a) * s) / map.length()
+                        }
+                        None => s,
+                    };
+                    let angle = got.angle(&path.at(u, f.min(1.0)));
+                    assert!(
+                        angle <= axis_budget + 1e-6,
+                        "block {k} (line {:?}) at t = {t}: tool axis {angle} rad off, budget {axis_budget}",
+                        r.n
+                    );
+                    m.worst_axis_ratio = m.worst_axis_ratio.max(angle / axis_budget);
+                }
                 assert!(
                     d <= budget + PRINT_SLACK,
                     "block {k} (line {:?}) at t = {t}: {d} mm from the path, budget {budget}",
