@@ -31,30 +31,20 @@ fn delta_sag_case_is_split_within_tolerance_and_keeps_its_feed() {
     assert!(m.worst_time_error < 1e-8, "{m:?}");
     // The diagonal's blocks (line 3): end point to end point they would sag 4.646 mm; the
     // bow of each is ∝ its length², so about √(4.646 / split tolerance) are needed.
-    let line3: Vec<_> = case
-        .exported
-        .blocks
-        .iter()
-        .filter_map(|b| match b {
-            Block::Feed {
-                joints, line: 3, ..
-            } => Some(*joints),
-            _ => None,
-        })
-        .collect();
+    let joints_of = |want: u32| -> Vec<_> {
+        motion_blocks(&case)
+            .into_iter()
+            .filter_map(|b| match b {
+                Block::Rapid { joints, line, .. } | Block::Feed { joints, line, .. } => {
+                    (*line == want).then_some(*joints)
+                }
+                _ => None,
+            })
+            .collect()
+    };
+    let line3 = joints_of(3);
     // Where the rapid of line 2 leaves the joints: the diagonal's start.
-    let rapid_end = case
-        .exported
-        .blocks
-        .iter()
-        .rev()
-        .find_map(|b| match b {
-            Block::Rapid {
-                joints, line: 2, ..
-            } => Some(*joints),
-            _ => None,
-        })
-        .unwrap();
+    let rapid_end = *joints_of(2).last().unwrap();
     let (a, b) = (
         Vec3::new(-31.654, -28.911, -0.2),
         Vec3::new(39.057, 41.8, -0.2),
