@@ -73,8 +73,8 @@ pub enum Block {
 }
 
 /// Joint-linear tip samples per written move for the deviation figure (the splitter itself
-/// checks [`SPLIT_CHECKS`] and aims at [`SPLIT_MARGIN`] of its share, so the peak between its
-/// checks stays inside the share).
+/// checks five points and aims at 0.9 of its share, so the peak between its checks stays
+/// inside the share).
 pub const DENSE_CHECKS: usize = 16;
 const SPLIT_CHECKS: usize = 5;
 const SPLIT_MARGIN: f64 = 0.9;

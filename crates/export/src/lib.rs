@@ -5,7 +5,7 @@
 //! the program's own geometry under G61), then [`convert`] writes each segment as G1 moves in
 //! joint coordinates, split so a joint-linear controller keeps the tip within the tolerance
 //! and timed in inverse time (G93) so the tip keeps the programmed feed; [`words`] carries
-//! spindle, coolant and tool words through; [`write`] prints the program.
+//! spindle, coolant and tool words through; [`mod@write`] prints the program.
 //!
 //! ```text
 //! moves ──motion::path::smooth──► segments ──convert (chords, kinematics::segment)──► Blocks

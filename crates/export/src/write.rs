@@ -60,7 +60,7 @@ fn source(line: u32) -> String {
     }
 }
 
-/// A G93 F for a block of `minutes`: 1/minutes to [`FEED_DIGITS`] significant digits.
+/// A G93 F for a block of `minutes`: 1/minutes to 10 significant digits.
 pub fn inverse_time(minutes: f64) -> String {
     let f = 1.0 / minutes;
     let magnitude = f.abs().log10().floor() as i32;
