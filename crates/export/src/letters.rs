@@ -74,3 +74,36 @@ impl AxisLetters {
             .join(" ")
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn letters(machine: &Machine) -> String {
+        AxisLetters::for_machine(machine)
+            .unwrap()
+            .letters
+            .iter()
+            .collect()
+    }
+
+    #[test]
+    fn own_letters_else_grblhal_order() {
+        let table_ac = Machine::builtin("table-ac").unwrap();
+        assert_eq!(letters(&table_ac), "XYZAC");
+        assert_eq!(letters(&Machine::builtin("table-bc").unwrap()), "XYZBC");
+        assert_eq!(letters(&Machine::builtin("yzca").unwrap()), "YZCA");
+        assert_eq!(letters(&Machine::builtin("linear-delta").unwrap()), "XYZ");
+        // Five joints not named by letters: grblHAL's X Y Z A B, degrees for the rotaries.
+        let text = Machine::builtin_text("table-ac")
+            .unwrap()
+            .replace("name = \"a\"", "name = \"tilt\"")
+            .replace("name = \"c\"", "name = \"turn\"");
+        let renamed = Machine::from_toml_str(&text).unwrap();
+        let l = AxisLetters::for_machine(&renamed).unwrap();
+        assert_eq!(l.letters.iter().collect::<String>(), "XYZAB");
+        assert_eq!(l.scale[0], 1.0);
+        assert!((l.scale[3] - 180.0 / std::f64::consts::PI).abs() < 1e-12);
+        assert_eq!(l.describe(&renamed), "x=X y=Y z=Z tilt=A turn=B");
+    }
+}
