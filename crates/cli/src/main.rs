@@ -6,6 +6,7 @@ mod access;
 mod cam;
 mod cam_tool;
 mod diagnostics;
+mod export;
 mod library;
 mod panel;
 mod plot;
@@ -55,6 +56,9 @@ enum Command {
     /// Finishing tool path on a surface, post-processed for a table-tilting machine and
     /// verified by a dexel simulation of the cut.
     Cam(cam::CamArgs),
+    /// Write a program in joint coordinates for a controller without kinematics: G1 moves
+    /// split to stay within the tolerance, feeds in inverse time (G93).
+    Export(export::ExportArgs),
     /// List the built-in machine definitions.
     Machines,
     /// Run the executor behind a WebSocket (JSON commands in, replies and status out).
@@ -82,6 +86,7 @@ fn main() -> ExitCode {
         } => check(&program, machine.as_deref(), &inputs),
         Command::Run(args) => run::run(args),
         Command::Cam(args) => cam::cam(args),
+        Command::Export(args) => export::export(args),
         Command::Machines => run::machines().map(|()| ExitCode::SUCCESS),
         Command::Serve(args) => serve::serve(args),
     };

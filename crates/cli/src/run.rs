@@ -145,6 +145,24 @@ pub fn load_machine(spec: Option<&str>) -> Result<Machine> {
     }
 }
 
+/// The interpreter's settings for a program run on `machine`: its units (mm) for the tool
+/// table and stored offsets, its program axes, its tool-centre-point switch.
+pub fn machine_config(
+    machine: &Machine,
+    tool_table: ToolTable,
+    extra: &crate::library::ProgramInputs,
+) -> Config {
+    Config {
+        tool_table,
+        subroutines: extra.subroutines.clone(),
+        ini: extra.ini.clone(),
+        parameters: extra.parameters.clone(),
+        tool_centre_point_always: machine.tcp == TcpSwitch::Always,
+        axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
+        ..Config::default()
+    }
+}
+
 /// `tezgah machines`.
 pub fn machines() -> Result<()> {
     for name in builtin_names() {
@@ -180,15 +198,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         table => crate::library::load_tool_table(table.as_deref())?,
     };
     let extra = args.inputs.program_inputs(args.program.as_deref())?;
-    let config = Config {
-        tool_table: table,
-        subroutines: extra.subroutines.clone(),
-        ini: extra.ini.clone(),
-        parameters: extra.parameters.clone(),
-        tool_centre_point_always: machine.tcp == TcpSwitch::Always,
-        axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
-        ..Config::default()
-    };
+    let config = machine_config(&machine, table, &extra);
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
     let done = interpret(
         Sources::new(path_name.display().to_string(), text),

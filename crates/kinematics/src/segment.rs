@@ -141,7 +141,7 @@ pub fn segment_pose_line<K: Kinematics + ?Sized>(
         };
         Ok((kinematics.inverse(&pose, tool, prev)?, axis))
     };
-    split(
+    segment_line_by(
         kinematics, tool, &start.tip, &end.tip, previous, options, &target,
     )
 }
@@ -160,19 +160,25 @@ pub fn segment_tcp_line<K: Kinematics + ?Sized>(
         let q = kinematics.tcp_inverse(&p.tip, &p.angles, tool, prev)?;
         Ok((q, kinematics.forward(&q, tool)?.axis))
     };
-    split(
+    segment_line_by(
         kinematics, tool, &start.tip, &end.tip, previous, options, &target,
     )
 }
 
-type Target<'a> =
+/// The joints (and tool axis) at fraction `s` ∈ [0, 1] of a straight tip move, solved nearest
+/// the given joints: how a caller tells [`segment_line_by`] what the program asks for.
+pub type Target<'a> =
     dyn Fn(f64, &Joints) -> Result<(Joints, Unit<Vector3<f64>>), KinematicsError> + 'a;
 
+/// Splits a straight tip move `a`–`b` whose joints along it come from `target` (the tip at
+/// fraction `s` must be `a + (b − a)·s`): the one splitter behind [`segment_pose_line`],
+/// [`segment_tcp_line`] and callers with their own pose law (a planned path's tool axis).
+///
 /// Walks to the end in a few steps so the end joints continue the path (a C table that turns
 /// more than half a turn during the move must not be unwrapped the short way), then halves
 /// the move until each piece meets the tolerance. Midpoints are solved with the joint-space
 /// midpoint as the continuity reference, so they stay on the same branch and turn.
-fn split<K: Kinematics + ?Sized>(
+pub fn segment_line_by<K: Kinematics + ?Sized>(
     kinematics: &K,
     tool: &Tool,
     a: &Vector3<f64>,
