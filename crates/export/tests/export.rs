@@ -255,3 +255,23 @@ proptest! {
         }
     }
 }
+
+/// The table-ac program with the tilt on B: the same code path for the other trunnion.
+#[test]
+fn table_bc_five_axis_within_tolerance() {
+    let program = TABLE_AC.replace(" A", " B");
+    let case = export_program(&program, "table-bc", TABLE_AC_TOOLS, 0.01);
+    let m = measure(&case);
+    assert!(m.worst_ratio <= 1.0, "{m:?}");
+    assert!(
+        m.worst_axis_ratio > 0.0 && m.worst_axis_ratio <= 1.0,
+        "{m:?}"
+    );
+    assert!(m.worst_time_error < 1e-8, "{m:?}");
+    // The tilting move is split: a joint-linear B-C move bows the tip off the line.
+    let tilting = motion_blocks(&case)
+        .iter()
+        .filter(|b| matches!(b, Block::Feed { line: 6, .. }))
+        .count();
+    assert!(tilting > 5, "{tilting} blocks for the tilting move");
+}
