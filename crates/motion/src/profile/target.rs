@@ -1,0 +1,316 @@
+//! The position interface from any state: the time-optimal motion from (v0, a0) over a signed
+//! distance L to end speed v1 at zero acceleration, under |v| ≤ V, |a| ≤ A, |j| ≤ J — Ruckig's
+//! one-axis step 1 (Berscheid & Kröger 2021, §III-A/B, the UDDU profiles of Fig. 3). The motion
+//! may run backward where that is faster (as Ruckig's does); a path asks [`super::solve`].
+//!
+//! A start outside the limits is braked first ([`super::brake`]). A UDDU profile then has
+//! jerk ±J, 0, ∓J, 0, ∓J, 0, ±J; the middle two jerk phases merge when there is no cruise.
+//! Where the acceleration crosses 0 inside them it is a velocity-interface change to a peak
+//! speed vp ([`Change`]), a cruise at vp, and a change from vp to v1: each half bang-bang, so
+//! vp alone fixes the shape, its distance is D(vp), and a cruise can only be at ±V (anywhere
+//! else a higher peak is faster). The duration grows as vp leaves the speeds v_r (where a0
+//! runs out at full jerk, v0 + a0|a0|/2J) and v1, so:
+//! * upper side, vp ≥ max(v_r, v1) (jerk +J first): the lowest vp with D(vp) = L, else cruise
+//!   at V when D(V) < L;
+//! * lower side, vp ≤ min(v_r, v1) (jerk −J first): the mirror image;
+//! * relaxed: where the acceleration does not reach 0 in the middle — a0 is relaxed toward 0
+//!   for τ ∈ [0, |a0|/J], then the change to v1 turns the other way. This exists only when v1
+//!   lies beyond v_r on the side a0 points to, and it joins the two sides' ends (τ = 0 is the
+//!   direct change to v1, τ = |a0|/J the peak at v_r); every root counts.
+//!
+//! The fastest candidate wins, as in Ruckig's enumeration of profile types.
+//!
+//! D has no convenient closed-form inverse once a0 ≠ 0 (Ruckig solves quartics per case); it is
+//! continuous and piecewise smooth in u = √|vp − side's base| (√τ), so the roots are bracketed on a
+//! fine grid in u, local extrema between grid points checked by golden section (a near-double
+//! root cannot hide between two samples), and refined by Brent's method to the last bits.
+
+use super::brake;
+use super::error::ProfileError;
+use super::knots::advance;
+use super::roots::brent;
+use super::solve::solve;
+use super::velocity::{check_start, Change};
+use super::{Limits, Profile, State};
+
+/// Grid intervals per side: D is a piecewise polynomial of low degree in u, with few extrema.
+const GRID: usize = 48;
+
+/// The time-optimal profile from `start` over `distance` (signed, mm) to speed `v1` at zero
+/// acceleration (see the module comment); `start.s` is where it starts, and it ends at
+/// `start.s + distance`. With a0 = 0, 0 ≤ v0, v1 ≤ V and a forward optimum it is exactly
+/// [`solve`]'s profile (the closed forms), so the look-ahead planner and this agree.
+///
+/// # Errors
+/// [`ProfileError::Start`] for a start state that is not finite, [`ProfileError::Target`] for
+/// an end speed that is not finite or beyond ±V, [`ProfileError::TargetDistance`] for a
+/// distance that is not finite.
+pub fn solve_from(
+    start: State,
+    distance: f64,
+    v1: f64,
+    limits: &Limits,
+) -> Result<Profile, ProfileError> {
+    check_start(&start)?;
+    if !distance.is_finite() {
+        return Err(ProfileError::TargetDistance(distance));
+    }
+    if !(v1.abs() <= limits.max_velocity()) {
+        return Err(ProfileError::Target(v1));
+    }
+    let v_max = limits.max_velocity();
+    if start.a == 0.0 && (0.0..=v_max).contains(&start.v) && v1 >= 0.0 && distance >= 0.0 {
+        if let Ok(p) = solve(distance, start.v, v1, limits) {
+            return Ok(Profile::from_phases(start, p.durations(), p.jerks()).ending_at(v1, 0.0));
+        }
+    }
+    let brake = brake::position(start.v, start.a, limits);
+    let x = brake::apply(start, &brake);
+    let rest = distance - (x.s - start.s);
+    let a_max = limits.max_acceleration();
+    let problem = Problem {
+        v0: x.v,
+        a0: x.a.clamp(-a_max, a_max),
+        v1,
+        distance: rest,
+        limits,
+    };
+    let best = [1.0, -1.0]
+        .into_iter()
+        .filter_map(|sign| {
+            problem
+                .mirrored(sign)
+                .outer_side()
+                .map(|c| c.mirrored(sign))
+        })
+        .chain(problem.relaxed())
+        .min_by(|a, b| a.duration.total_cmp(&b.duration));
+    // The outer sides together cover every distance (the cruise at ±V reaches any L), so a
+    // candidate exists; rounding aside, the upper side's cruise is the fallback.
+    let c = best.unwrap_or_else(|| problem.cruise_at(v_max));
+    let durations = c.phases.map(|p| p.0);
+    let jerks = c.phases.map(|p| p.1);
+    Ok(Profile::braked(start, brake, durations, jerks).ending_at(v1, 0.0))
+}
+
+/// The problem after the brake (a start within the limits), possibly mirrored.
+#[derive(Clone, Copy)]
+struct Problem<'a> {
+    v0: f64,
+    a0: f64,
+    v1: f64,
+    distance: f64,
+    limits: &'a Limits,
+}
+
+/// One profile of the families: its seven (duration, jerk) phases and duration.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    phases: [(f64, f64); 7],
+    duration: f64,
+}
+
+impl Candidate {
+    /// The phases of a change to a peak speed, a cruise, and a change to the end speed.
+    fn peaked(first: &Change, cruise: f64, second: &Change) -> Candidate {
+        let mut phases = [(0.0, 0.0); 7];
+        phases[..3].copy_from_slice(&first.phases());
+        phases[3] = (cruise, 0.0);
+        phases[4..].copy_from_slice(&second.phases());
+        Candidate {
+            phases,
+            duration: first.duration() + cruise + second.duration(),
+        }
+    }
+
+    /// The candidate of the mirror image (`sign` = −1 flips every jerk).
+    fn mirrored(self, sign: f64) -> Candidate {
+        Candidate {
+            phases: self.phases.map(|(d, j)| (d, sign * j)),
+            ..self
+        }
+    }
+
+    /// D − L: where the phases end from `start`, against the distance.
+    /// As the profile integrates it: the cruise at exactly zero acceleration.
+    fn excess(&self, start: State, distance: f64) -> f64 {
+        let mut x = start;
+        for (k, &(dt, jk)) in self.phases.iter().enumerate() {
+            if k == 3 && dt > 0.0 {
+                x.a = 0.0;
+            }
+            x = advance(x, jk, dt);
+        }
+        x.s - distance
+    }
+}
+
+impl Problem<'_> {
+    /// The same problem with speeds, acceleration and distance multiplied by `sign` (±1).
+    fn mirrored(&self, sign: f64) -> Self {
+        Problem {
+            v0: sign * self.v0,
+            a0: sign * self.a0,
+            v1: sign * self.v1,
+            distance: sign * self.distance,
+            ..*self
+        }
+    }
+
+    fn start(&self) -> State {
+        State {
+            s: 0.0,
+            v: self.v0,
+            a: self.a0,
+            j: 0.0,
+        }
+    }
+
+    /// The speed at which the start acceleration runs out at full jerk.
+    fn released(&self) -> f64 {
+        self.v0 + self.a0 * self.a0.abs() / (2.0 * self.limits.max_jerk())
+    }
+
+    /// Through peak speed `peak` with a cruise there of `cruise` s.
+    fn through(&self, peak: f64, cruise: f64) -> Candidate {
+        let first = Change::new(self.v0, self.a0, peak, self.limits);
+        let second = Change::new(peak, 0.0, self.v1, self.limits);
+        Candidate::peaked(&first, cruise, &second)
+    }
+
+    /// Peak `v` (±V) with the rest of the distance as cruise.
+    fn cruise_at(&self, v: f64) -> Candidate {
+        let g = self.through(v, 0.0).excess(self.start(), self.distance);
+        self.through(v, (-g / v).max(0.0))
+    }
+
+    /// The upper side (module comment): the lowest root above max(v_r, v1), else cruise at V.
+    fn outer_side(&self) -> Option<Candidate> {
+        let v_max = self.limits.max_velocity();
+        let base = self.released().max(self.v1).min(v_max);
+        let g = |peak: f64| self.through(peak, 0.0).excess(self.start(), self.distance);
+        let mut first = None;
+        scan(g, base, v_max, |peak| {
+            first = Some(peak);
+            false
+        });
+        match first {
+            Some(peak) => Some(self.through(peak, 0.0)),
+            None if g(v_max) < 0.0 => Some(self.cruise_at(v_max)),
+            None => None,
+        }
+    }
+
+    /// The start acceleration relaxed toward 0 for τ, then the change to v1 turning the other
+    /// way: the profiles whose acceleration never reaches 0 in the middle (module comment).
+    fn relax(&self, tau: f64) -> Candidate {
+        let jerk = -self.a0.signum() * self.limits.max_jerk();
+        let x = advance(self.start(), jerk, tau);
+        let change = Change::new(x.v, x.a, self.v1, self.limits);
+        let mut c = Candidate::peaked(&Change::new(0.0, 0.0, 0.0, self.limits), 0.0, &change);
+        c.phases[0] = (tau, jerk);
+        c.duration += tau;
+        c
+    }
+
+    /// The fastest relaxed profile that covers the distance, if the family exists: only when
+    /// the change to v1 turns against a0 (v1 beyond v_r on the side a0 points to).
+    fn relaxed(&self) -> Option<Candidate> {
+        if self.a0 == 0.0 || (self.v1 - self.released()) * self.a0 <= 0.0 {
+            return None;
+        }
+        let end = self.a0.abs() / self.limits.max_jerk();
+        let mut best: Option<Candidate> = None;
+        scan(
+            |tau| self.relax(tau).excess(self.start(), self.distance),
+            0.0,
+            end,
+            |tau| {
+                let c = self.relax(tau);
+                if best.is_none_or(|b| c.duration < b.duration) {
+                    best = Some(c);
+                }
+                true
+            },
+        );
+        best
+    }
+}
+
+/// Calls `found` with each root of `g` on [lo, hi] from `lo` upward while it returns true
+/// (grid in u = √(vp − lo), extrema by golden section, roots by Brent; see the module
+/// comment).
+fn scan(g: impl Fn(f64) -> f64, lo: f64, hi: f64, mut found: impl FnMut(f64) -> bool) {
+    let span = (hi - lo).max(0.0);
+    let at = |u: f64| lo + (u * u).min(span);
+    let h = |u: f64| g(at(u));
+    let top = span.sqrt();
+    let us: [f64; GRID + 1] = std::array::from_fn(|k| top * k as f64 / GRID as f64);
+    let hs: [f64; GRID + 1] = std::array::from_fn(|k| h(us[k]));
+    if hs[0] == 0.0 && !found(lo) {
+        return;
+    }
+    for k in 1..=GRID {
+        let (ua, ub, ha, hb) = (us[k - 1], us[k], hs[k - 1], hs[k]);
+        if ha != 0.0 && ha * hb <= 0.0 {
+            if !found(at(brent(h, ua, ub, ha, hb))) {
+                return;
+            }
+            continue;
+        }
+        // No sign change across this interval: a pair of roots may sit around an extremum of
+        // g toward 0, between this sample and the next.
+        if k < GRID && hb.abs() < ha.abs() && hb.abs() <= hs[k + 1].abs() && hb * hs[k + 1] > 0.0 {
+            let s = hb.signum();
+            let (um, hm) = golden_min(|u| s * h(u), ua, us[k + 1]);
+            if hm <= 0.0 {
+                let hm = s * hm;
+                let left = if ha * hm <= 0.0 && hm != 0.0 {
+                    brent(h, ua, um, ha, hm)
+                } else {
+                    um
+                };
+                if !found(at(left)) {
+                    return;
+                }
+                let right_h = hs[k + 1];
+                if hm != 0.0
+                    && hm * right_h < 0.0
+                    && !found(at(brent(h, um, us[k + 1], hm, right_h)))
+                {
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// The minimum of `f` on [a, b] by golden-section search (Kiefer 1953), as (x, f(x)).
+fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> (f64, f64) {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..80 {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+        if b - a <= 1e-15 * b.abs().max(1e-300) {
+            break;
+        }
+    }
+    if fc < fd {
+        (c, fc)
+    } else {
+        (d, fd)
+    }
+}
