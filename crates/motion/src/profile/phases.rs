@@ -100,6 +100,18 @@ impl Profile {
         }
     }
 
+    /// No motion: at rest at position `s` (duration 0).
+    pub fn at_rest(s: f64) -> Profile {
+        Profile::from_phases(
+            State {
+                s,
+                ..State::default()
+            },
+            [0.0; 7],
+            [0.0; 7],
+        )
+    }
+
     /// The same profile with its end speed and acceleration set to the target exactly, which
     /// the integration meets up to rounding (the motion after the end then runs at exactly
     /// the target speed).
