@@ -20,33 +20,21 @@
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 
+mod rng_support;
+use rng_support::Rng;
 use tezgah_motion::profile::{reach_velocity, solve_from, Limits, Profile, State};
 
 const CASES: usize = 40_000;
 const SAMPLES: usize = 7;
 
-/// xorshift64* (Vigna 2016), reproducible everywhere.
-struct Rng(u64);
-
-impl Rng {
-    fn unit(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        (lo.ln() + self.unit() * (hi.ln() - lo.ln())).exp()
-    }
-    /// A value on [−m, m], often exactly 0 or ±m, and one case in ten up to 2m (beyond).
-    fn around(&mut self, m: f64) -> f64 {
-        match self.unit() {
-            p if p < 0.12 => 0.0,
-            p if p < 0.18 => m,
-            p if p < 0.24 => -m,
-            p if p < 0.34 => (2.0 * self.unit() - 1.0) * 2.0 * m,
-            _ => (2.0 * self.unit() - 1.0) * m,
-        }
+/// A value on [−m, m], often exactly 0 or ±m, and one case in ten up to 2m (beyond).
+fn around(rng: &mut Rng, m: f64) -> f64 {
+    match rng.unit() {
+        p if p < 0.12 => 0.0,
+        p if p < 0.18 => m,
+        p if p < 0.24 => -m,
+        p if p < 0.34 => (2.0 * rng.unit() - 1.0) * 2.0 * m,
+        _ => (2.0 * rng.unit() - 1.0) * m,
     }
 }
 
@@ -73,9 +61,9 @@ fn cases() -> Vec<Case> {
             // J within 1e2–1e6 (Ruckig's absolute tolerances, ~1e-8, dominate motions of
             // microseconds and nanometres).
             let jmax = (amax * amax / (vmax * rng.log_uniform(0.01, 2.0))).clamp(1e2, 1e6);
-            let v0 = rng.around(vmax);
-            let a0 = rng.around(amax);
-            let mut v1 = rng.around(vmax);
+            let v0 = around(&mut rng, vmax);
+            let a0 = around(&mut rng, amax);
+            let mut v1 = around(&mut rng, vmax);
             if v1.abs() > vmax {
                 v1 = v1.clamp(-vmax, vmax);
             }

@@ -93,7 +93,7 @@ fn time_to(stop: &Profile, distance: f64) -> f64 {
 /// than the jerk can release: v + a|a|/(2J) < 0) — the path cannot be driven backward.
 fn stop_under(x: &State, l: &Limits) -> Option<Profile> {
     let a_max = l.max_acceleration();
-    if !(x.v >= 0.0) || x.a.abs() > a_max * (1.0 + SLACK) {
+    if x.v.is_nan() || x.v < 0.0 || x.a.abs() > a_max * (1.0 + SLACK) {
         return None;
     }
     let a = x.a.clamp(-a_max, a_max);

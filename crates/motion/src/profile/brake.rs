@@ -70,17 +70,7 @@ fn acceleration_brake(v0: f64, a0: f64, limits: &Limits, sign: f64) -> Brake {
     if v0 + a0 * a0 / (2.0 * j) > v {
         return speed_brake(v0, a0, limits, sign);
     }
-    let at_limit = advance(
-        State {
-            s: 0.0,
-            v: v0,
-            a: a0,
-            j: 0.0,
-        },
-        -j,
-        to_limit,
-    )
-    .v;
+    let at_limit = speed_after(v0, a0, -j, to_limit);
     let hold = if at_limit < -v {
         // Still below −V at A: hold A until the speed is back at −V, but not so long that
         // releasing A would pass V.
@@ -109,17 +99,7 @@ fn speed_brake(v0: f64, a0: f64, limits: &Limits, sign: f64) -> Brake {
     let jerk_time = to_max.min(to_min);
     let to_a_min = (a0 + a) / j;
     if to_a_min < jerk_time {
-        let at = advance(
-            State {
-                s: 0.0,
-                v: v0,
-                a: a0,
-                j: 0.0,
-            },
-            -j,
-            to_a_min,
-        )
-        .v;
+        let at = speed_after(v0, a0, -j, to_a_min);
         let hold_to_max = (at - v) / a;
         let hold_to_min = -a / (2.0 * j) + (at + v) / a;
         [
@@ -131,6 +111,11 @@ fn speed_brake(v0: f64, a0: f64, limits: &Limits, sign: f64) -> Brake {
     }
 }
 
+/// The speed after `t` s at jerk `jerk` from speed `v0` and acceleration `a0`.
+fn speed_after(v0: f64, a0: f64, jerk: f64, t: f64) -> f64 {
+    v0 + t * (a0 + 0.5 * t * jerk)
+}
+
 /// The state after `brake` from `start`.
 pub(crate) fn apply(start: State, brake: &Brake) -> State {
     brake.iter().fold(start, |x, &(dt, jk)| advance(x, jk, dt))
@@ -139,15 +124,7 @@ pub(crate) fn apply(start: State, brake: &Brake) -> State {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn at(v: f64, a: f64) -> State {
-        State {
-            s: 0.0,
-            v,
-            a,
-            j: 0.0,
-        }
-    }
+    use crate::profile::velocity::tests::at;
 
     #[test]
     fn brings_the_state_within_the_limits() {

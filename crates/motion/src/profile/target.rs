@@ -25,6 +25,8 @@
 //! fine grid in u, local extrema between grid points checked by golden section (a near-double
 //! root cannot hide between two samples), and refined by Brent's method to the last bits.
 
+use tezgah_geom::deviation::golden;
+
 use super::brake;
 use super::error::ProfileError;
 use super::knots::advance;
@@ -55,7 +57,7 @@ pub fn solve_from(
     if !distance.is_finite() {
         return Err(ProfileError::TargetDistance(distance));
     }
-    if !(v1.abs() <= limits.max_velocity()) {
+    if !v1.is_finite() || v1.abs() > limits.max_velocity() {
         return Err(ProfileError::Target(v1));
     }
     let v_max = limits.max_velocity();
@@ -268,7 +270,9 @@ fn scan(g: impl Fn(f64) -> f64, lo: f64, hi: f64, mut found: impl FnMut(f64) -> 
         // g toward 0, between this sample and the next.
         if k < GRID && hb.abs() < ha.abs() && hb.abs() <= hs[k + 1].abs() && hb * hs[k + 1] > 0.0 {
             let s = hb.signum();
-            let (um, hm) = golden_min(|u| s * h(u), ua, us[k + 1]);
+            // The extremum toward 0: the maximum of −s·g, shrunk to rounding (0.618⁸⁰).
+            let m = golden(|u| -s * h(u), ua, us[k + 1], 80);
+            let (um, hm) = (m.u, -m.distance);
             if hm <= 0.0 {
                 let hm = s * hm;
                 let left = if ha * hm <= 0.0 && hm != 0.0 {
@@ -291,49 +295,11 @@ fn scan(g: impl Fn(f64) -> f64, lo: f64, hi: f64, mut found: impl FnMut(f64) -> 
     }
 }
 
-/// The minimum of `f` on [a, b] by golden-section search (Kiefer 1953), as (x, f(x)).
-fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> (f64, f64) {
-    let r = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..80 {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = f(d);
-        }
-        if b - a <= 1e-15 * b.abs().max(1e-300) {
-            break;
-        }
-    }
-    if fc < fd {
-        (c, fc)
-    } else {
-        (d, fd)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::profile::velocity::tests::at;
     use proptest::prelude::*;
-
-    fn at(v: f64, a: f64) -> State {
-        State {
-            s: 0.0,
-            v,
-            a,
-            j: 0.0,
-        }
-    }
 
     /// Ends on the target (s, v; a = 0 by the last phase's own integration), |j| ≤ J, and
     /// after the brake |a| ≤ A and |v| ≤ V — or, where the brake leaves the speed beyond V

@@ -105,13 +105,14 @@ pub(crate) fn check_start(start: &State) -> Result<(), ProfileError> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::profile::knots::advance;
     use crate::profile::{min_stopping_distance, speed_change_time};
     use proptest::prelude::*;
 
-    fn at(v: f64, a: f64) -> State {
+    /// A state at s = 0 with speed `v` and acceleration `a` (the tests' start states).
+    pub(crate) fn at(v: f64, a: f64) -> State {
         State {
             s: 0.0,
             v,
