@@ -2,8 +2,8 @@
 //! the velocity interface (`reach_velocity`) and the position interface (`solve_from`), start
 //! speed and acceleration anywhere, within the limits or beyond them (then braked first).
 //!
-//! Seeded random cases go to one Python process (tests/oracle/ruckig_state.py) run with
-//! `$TEZGAH_PYTHON`; ignored by a plain `cargo test`, failing when that is unset or cannot
+//! 40 000 seeded random cases, half each, go to one Python process (tests/oracle/ruckig_state.py)
+//! run with `$TEZGAH_PYTHON`; ignored by a plain `cargo test`, failing when that is unset or cannot
 //! `import ruckig` (`.ci/install-ruckig`). Per case:
 //! * the same duration within 1e-9 relative (+1e-12 s);
 //! * the same state at 7 times along the way (p within 1e-8·(|v|max·T + |L| + 1), v within
@@ -14,12 +14,15 @@
 //!   knot and every speed extremum inside a phase — or, where the brake ends with the speed
 //!   still beyond V (a start acceleration that cannot run out sooner), no further out.
 //!
-//! Ruckig refuses a few start states (|a0| exactly A in the velocity interface); those are
-//! counted and must stay below 1e-3 of the cases.
+//! Ruckig refuses a few start states (|a0| exactly A in the velocity interface), and after a
+//! long brake its step 1 can fall back to a slower profile than the optimum (ours then valid
+//! and faster: listed, none in this seed); each must stay below 1e-3 of the cases. Start
+//! speeds and accelerations reach twice the limits; A²/J lies between 1 % and 2 V (far beyond,
+//! the brake's excursion grows to many V and Ruckig fails in a few percent of cases).
+//! Measured (seed below): worst relative duration difference 4.8e-11 (position), 5.5e-15
+//! (velocity); 5 117 of the cases start with a brake.
 
-use std::io::{BufRead, BufReader, Write};
-use std::process::{Command, Stdio};
-
+mod python_oracle;
 mod rng_support;
 use rng_support::Rng;
 use tezgah_motion::profile::{reach_velocity, solve_from, Limits, Profile, State};
@@ -150,41 +153,25 @@ fn check(c: &Case, p: &Profile) -> Result<(), String> {
 #[test]
 #[ignore = "needs Ruckig: set TEZGAH_PYTHON (see .ci/install-ruckig)"]
 fn any_start_state_matches_ruckig() {
-    let python = std::env::var_os("TEZGAH_PYTHON")
-        .expect("TEZGAH_PYTHON is not set: install Ruckig with .ci/install-ruckig");
-    let probe = Command::new(&python).args(["-c", "import ruckig"]).output();
-    assert!(
-        probe.is_ok_and(|o| o.status.success()),
-        "{python:?} cannot import ruckig (see .ci/install-ruckig)"
-    );
+    let python = python_oracle::python("TEZGAH_PYTHON", "ruckig", ".ci/install-ruckig");
     let cases = cases();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/oracle/ruckig_state.py");
-    let mut child = Command::new(&python)
-        .arg(script)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .expect("python runs");
-    {
-        let mut input = child.stdin.take().unwrap();
-        let mut text = String::new();
-        for c in &cases {
-            let kind = if c.position { "p" } else { "v" };
-            text += &format!(
-                "{kind} {} {} {} {} {} {} {} {SAMPLES}\n",
-                c.v0, c.a0, c.distance, c.v1, c.vmax, c.amax, c.jmax
-            );
-        }
-        input.write_all(text.as_bytes()).unwrap();
+    let mut text = String::new();
+    for c in &cases {
+        let kind = if c.position { "p" } else { "v" };
+        text += &format!(
+            "{kind} {} {} {} {} {} {} {} {SAMPLES}\n",
+            c.v0, c.a0, c.distance, c.v1, c.vmax, c.amax, c.jmax
+        );
     }
-    let out = BufReader::new(child.stdout.take().unwrap());
+    let out = python_oracle::ask(&python, script, text);
     let (mut checked, mut braked) = ([0usize; 2], 0);
     let mut worst = [(0.0f64, 0usize); 2];
     let (mut ruckig_failed, mut ruckig_slower) = (Vec::new(), Vec::new());
     let mut failures = Vec::new();
-    for (i, (c, line)) in cases.iter().zip(out.lines()).enumerate() {
+    assert_eq!(out.len(), cases.len(), "one line per case");
+    for (i, (c, line)) in cases.iter().zip(&out).enumerate() {
         let f: Vec<f64> = line
-            .unwrap()
             .split_whitespace()
             .map(|x| x.parse().unwrap())
             .collect();
@@ -232,7 +219,6 @@ fn any_start_state_matches_ruckig() {
         }
         checked[kind] += 1;
     }
-    assert!(child.wait().unwrap().success());
     println!(
         "position: {} cases, worst relative duration difference {:.2e} (#{}); velocity: {} \
          cases, worst {:.2e} (#{}); {braked} braked; Ruckig failed on {}, slower on {}: {:#?}",

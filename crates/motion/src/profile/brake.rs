@@ -1,6 +1,7 @@
 //! The brake that brings a start state outside the limits back within them before the
-//! time-optimal profile starts: Ruckig's brake pre-trajectory (Berscheid & Kröger 2021, §III-D
-//! "Brake pre-trajectory"), at most two phases — a jerk phase, then a constant-acceleration one.
+//! time-optimal profile starts: Ruckig's brake pre-trajectory (Berscheid & Kröger, "Jerk-limited
+//! Real-time Trajectory Generation with Arbitrary Target States", RSS 2021, and Ruckig's
+//! `brake.cpp`, re-derived here), at most two phases — a jerk phase, then a constant one.
 //!
 //! * Velocity interface: only |a0| > A matters (speed is the target itself): jerk ∓J until
 //!   |a| = A.

@@ -1,6 +1,7 @@
 //! The position interface from any state: the time-optimal motion from (v0, a0) over a signed
 //! distance L to end speed v1 at zero acceleration, under |v| ≤ V, |a| ≤ A, |j| ≤ J — Ruckig's
-//! one-axis step 1 (Berscheid & Kröger 2021, §III-A/B, the UDDU profiles of Fig. 3). The motion
+//! one-axis step 1 (Berscheid & Kröger, RSS 2021: the time-optimal profiles of one DoF, jerk
+//! pattern UDDU, and their case analysis by reached limits). The motion
 //! may run backward where that is faster (as Ruckig's does); a path asks [`super::solve`].
 //!
 //! A start outside the limits is braked first ([`super::brake`]). A UDDU profile then has

@@ -1,6 +1,6 @@
 //! The velocity interface: from any state (v0, a0) to a target speed at zero acceleration,
 //! time-optimally under |a| ≤ A and |j| ≤ J — Ruckig's velocity control for one axis
-//! (Berscheid & Kröger 2021, §IV "velocity interface"), used by JOG, homing and every stop.
+//! (Berscheid & Kröger, RSS 2021: the velocity interface), used by JOG, homing, every stop.
 //! [`Change`] is also the half-profile the position interface joins two of ([`super::target`]).
 //!
 //! With σ = ±1 the side the target lies on from the speed reached by bringing a to 0 at once,
