@@ -109,7 +109,8 @@ struct JointHoming {
     search_speed: f64,
     latch_speed: f64,
     phase: HomePhase,
-    /// The current piece: a velocity ramp from t0, or the final profile from t0.
+    /// The current piece: a velocity profile from t0 (search, back-off, latch, their stops),
+    /// or the final move's profile from t0.
     t0: f64,
     ramp: Profile,
     last: Option<FinalMove>,
