@@ -46,16 +46,18 @@ impl Profile {
     /// Integrates the phases from `start` (its jerk field is ignored). Durations must be ≥ 0;
     /// the solver guarantees it, so this is not public.
     pub(crate) fn from_phases(start: State, durations: [f64; 7], jerks: [f64; 7]) -> Profile {
-        Profile::braked(start, [(0.0, 0.0); 2], durations, jerks)
+        Profile::braked(start, [(0.0, 0.0); 2], durations, jerks, None)
     }
 
     /// A profile whose seven phases follow a brake of two (duration, jerk) phases (Ruckig's
-    /// brake pre-trajectory, [`super::brake`]); a brake of zero duration is no brake.
+    /// brake pre-trajectory, [`super::brake`]); a brake of zero duration is no brake. A cruise
+    /// runs at zero acceleration and, if given, exactly at `cruise_speed`.
     pub(crate) fn braked(
         start: State,
         brake: [(f64, f64); 2],
         durations: [f64; 7],
         jerks: [f64; 7],
+        cruise_speed: Option<f64>,
     ) -> Profile {
         let mut all_d = [0.0; PHASES];
         let mut all_j = [0.0; PHASES];
@@ -66,8 +68,8 @@ impl Profile {
         all_d[2..].copy_from_slice(&durations);
         all_j[2..].copy_from_slice(&jerks);
         let mut knots = [(0.0, State::default()); PHASES + 1];
-        // Up to the cruise, then on from it at exactly zero acceleration: a rounding residue
-        // there would be integrated over the whole cruise.
+        // Up to the cruise, then on from it at exactly zero acceleration (and at the cruise
+        // speed): a rounding residue there would be integrated over the whole cruise.
         knots::integrate(
             start,
             &all_d[..CRUISE],
@@ -77,6 +79,7 @@ impl Profile {
         let (t, mut at_cruise) = knots[CRUISE];
         if all_d[CRUISE] > 0.0 {
             at_cruise.a = 0.0;
+            at_cruise.v = cruise_speed.unwrap_or(at_cruise.v);
         }
         knots::integrate(
             at_cruise,

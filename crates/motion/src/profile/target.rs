@@ -99,7 +99,7 @@ fn general(start: State, distance: f64, v1: f64, limits: &Limits) -> Profile {
     let c = best.unwrap_or_else(|| problem.cruise_at(v_max));
     let durations = c.phases.map(|p| p.0);
     let jerks = c.phases.map(|p| p.1);
-    Profile::braked(start, brake, durations, jerks).ending_at(v1, 0.0)
+    Profile::braked(start, brake, durations, jerks, Some(c.peak)).ending_at(v1, 0.0)
 }
 
 /// The problem after the brake (a start within the limits), possibly mirrored.
@@ -112,16 +112,18 @@ struct Problem<'a> {
     limits: &'a Limits,
 }
 
-/// One profile of the families: its seven (duration, jerk) phases and duration.
+/// One profile of the families: its seven (duration, jerk) phases, duration, and the speed
+/// where the acceleration is 0 between its halves (the cruise speed if it cruises).
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     phases: [(f64, f64); 7],
     duration: f64,
+    peak: f64,
 }
 
 impl Candidate {
     /// The phases of a change to a peak speed, a cruise, and a change to the end speed.
-    fn peaked(first: &Change, cruise: f64, second: &Change) -> Candidate {
+    fn peaked(first: &Change, peak: f64, cruise: f64, second: &Change) -> Candidate {
         let mut phases = [(0.0, 0.0); 7];
         phases[..3].copy_from_slice(&first.phases());
         phases[3] = (cruise, 0.0);
@@ -129,6 +131,7 @@ impl Candidate {
         Candidate {
             phases,
             duration: first.duration() + cruise + second.duration(),
+            peak,
         }
     }
 
@@ -136,17 +139,19 @@ impl Candidate {
     fn mirrored(self, sign: f64) -> Candidate {
         Candidate {
             phases: self.phases.map(|(d, j)| (d, sign * j)),
+            peak: sign * self.peak,
             ..self
         }
     }
 
     /// D − L: where the phases end from `start`, against the distance.
-    /// As the profile integrates it: the cruise at exactly zero acceleration.
+    /// As the profile integrates it: the cruise at exactly zero acceleration and the peak.
     fn excess(&self, start: State, distance: f64) -> f64 {
         let mut x = start;
         for (k, &(dt, jk)) in self.phases.iter().enumerate() {
             if k == 3 && dt > 0.0 {
                 x.a = 0.0;
+                x.v = self.peak;
             }
             x = advance(x, jk, dt);
         }
@@ -184,7 +189,7 @@ impl Problem<'_> {
     fn through(&self, peak: f64, cruise: f64) -> Candidate {
         let first = Change::new(self.v0, self.a0, peak, self.limits);
         let second = Change::new(peak, 0.0, self.v1, self.limits);
-        Candidate::peaked(&first, cruise, &second)
+        Candidate::peaked(&first, peak, cruise, &second)
     }
 
     /// Peak `v` (±V) with the rest of the distance as cruise.
@@ -216,7 +221,8 @@ impl Problem<'_> {
         let jerk = -self.a0.signum() * self.limits.max_jerk();
         let x = advance(self.start(), jerk, tau);
         let change = Change::new(x.v, x.a, self.v1, self.limits);
-        let mut c = Candidate::peaked(&Change::new(0.0, 0.0, 0.0, self.limits), 0.0, &change);
+        let none = Change::new(0.0, 0.0, 0.0, self.limits);
+        let mut c = Candidate::peaked(&none, 0.0, 0.0, &change);
         c.phases[0] = (tau, jerk);
         c.duration += tau;
         c
@@ -404,6 +410,34 @@ mod tests {
                     "{} vs {}", p.duration(), q.duration());
                 prop_assert!(check(&p, distance, v1 * 50.0, &l).is_ok());
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod extremes {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Limits over many decades (V 1e-3–1e3, A 0.1–1e4, J 10–1e7), starts up to ten
+        /// times beyond them, distances 1e-9–1e9 either way: a finite profile that ends on
+        /// the target within 1e-9 of the largest position it passes.
+        #[test]
+        fn land_on_target(
+            ev in -3.0..3.0f64, ea in -1.0..4.0f64, ej in 1.0..7.0f64,
+            v0 in -10.0..10.0f64, a0 in -10.0..10.0f64, v1 in -1.0..=1.0f64,
+            ed in -9.0..9.0f64, forward in prop::bool::ANY,
+        ) {
+            let (vm, am, jm) = (10f64.powf(ev), 10f64.powf(ea), 10f64.powf(ej));
+            let l = Limits::new(vm, am, jm).unwrap();
+            let d = if forward { 10f64.powf(ed) } else { -10f64.powf(ed) };
+            let st = State { s: 0.0, v: v0 * vm, a: a0 * am, j: 0.0 };
+            let p = solve_from(st, d, v1 * vm, &l).unwrap();
+            prop_assert!(p.duration().is_finite());
+            let err = (p.end().s - d).abs();
+            let smax = p.knots().iter().map(|k| k.1.s.abs()).fold(0.0, f64::max);
+            prop_assert!(err <= 1e-9 * (d.abs() + smax), "ends at {} for {d}", p.end().s);
         }
     }
 }

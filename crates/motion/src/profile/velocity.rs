@@ -84,7 +84,7 @@ pub fn reach_velocity(start: State, target: f64, limits: &Limits) -> Result<Prof
         durations[k] = d;
         jerks[k] = j;
     }
-    Ok(Profile::braked(start, brake, durations, jerks).ending_at(target, 0.0))
+    Ok(Profile::braked(start, brake, durations, jerks, None).ending_at(target, 0.0))
 }
 
 /// Displacement of the time-optimal stop from `start` under `limits` (signed: the way the
