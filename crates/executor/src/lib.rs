@@ -14,7 +14,6 @@ pub mod job;
 pub mod manual;
 pub mod mdi;
 pub mod overspeed;
-pub mod path_stop;
 pub mod program;
 pub mod realtime;
 pub mod ring;

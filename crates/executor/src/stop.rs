@@ -1,7 +1,7 @@
 //! The joints' jerk-limited stop: every joint brought from its commanded position, velocity
-//! and acceleration to rest on its own time-optimal velocity ramp ([`VelocityRamp`] to speed
-//! 0, Kröger & Wahl's velocity-control case as Ruckig's velocity interface solves it), all
-//! starting together. One piece for the real-time side's underrun stop and the manual modes'
+//! and acceleration to rest on its own time-optimal profile (the one solver's velocity
+//! interface, [`reach_velocity`] to speed 0, as Ruckig's; a start acceleration past the limit
+//! is braked back to it first), all starting together. One piece for the real-time side's underrun stop and the manual modes'
 //! abort, hold and failed homing. Fixed size and closed form, no allocation: it runs inside
 //! the real-time period.
 //!
@@ -10,9 +10,9 @@
 
 use tezgah_kinematics::Joints;
 use tezgah_motion::plan::PlanMachine;
-use tezgah_motion::profile::State;
+use tezgah_motion::profile::{reach_velocity, stopping_displacement, Limits, State};
+use tezgah_motion::Profile;
 
-use crate::manual::ramp::{stopping_displacement, VelocityRamp};
 use crate::setpoint::SetPoint;
 
 const MAX: usize = tezgah_kinematics::pose::MAX_JOINTS;
@@ -20,6 +20,8 @@ const MAX: usize = tezgah_kinematics::pose::MAX_JOINTS;
 /// The joint limits a stop obeys (internal units, machine-file order).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StopLimits {
+    /// Only to build the solver's [`Limits`]: a stop never speeds up.
+    pub max_velocity: Joints,
     pub max_acceleration: Joints,
     pub max_jerk: Joints,
 }
@@ -29,22 +31,31 @@ impl StopLimits {
     pub fn of(machine: &PlanMachine) -> StopLimits {
         let j = |v: &[f64]| Joints::from_slice(v).unwrap_or_else(|_| Joints::zeros(0));
         StopLimits {
+            max_velocity: j(&machine.max_velocity),
             max_acceleration: j(&machine.max_acceleration),
             max_jerk: j(&machine.max_jerk),
         }
     }
 }
 
-/// Distance a jerk-limited stop from speed `v` and acceleration `a` travels under
-/// `max_acceleration`, `max_jerk` (the same closed form, along a path or a joint).
-pub fn stopping_distance(v: f64, a: f64, max_acceleration: f64, max_jerk: f64) -> f64 {
+/// Distance a jerk-limited stop from speed `v` and acceleration `a` travels under `limits`
+/// (the same solver, along a path or a joint; signed, the way the speed points).
+pub fn stopping_distance(v: f64, a: f64, limits: &Limits) -> f64 {
     let st = State {
         s: 0.0,
         v,
         a,
         j: 0.0,
     };
-    stopping_displacement(st, max_acceleration, max_jerk)
+    stopping_displacement(st, limits).unwrap_or(0.0)
+}
+
+/// The time-optimal change from `from` to speed `target` at zero acceleration (the solver's
+/// velocity interface): the stops here, JOG and the homing searches. A state that is not
+/// finite (which the executor's own profiles never produce) holds still where it can.
+pub fn velocity_profile(from: State, target: f64, limits: &Limits) -> Profile {
+    reach_velocity(from, target, limits)
+        .unwrap_or_else(|_| Profile::at_rest(if from.s.is_finite() { from.s } else { 0.0 }))
 }
 
 /// A joint state on the stop.
@@ -58,7 +69,7 @@ pub struct JointState {
 /// Every joint's stop, evaluated together.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointStop {
-    ramps: [Option<VelocityRamp>; MAX],
+    ramps: [Option<Profile>; MAX],
     len: usize,
 }
 
@@ -76,10 +87,14 @@ impl JointStop {
                 a: from.acceleration[i],
                 j: 0.0,
             };
-            let (a_max, j_max) = (g(&limits.max_acceleration), g(&limits.max_jerk));
+            let l = Limits::new(
+                g(&limits.max_velocity),
+                g(&limits.max_acceleration),
+                g(&limits.max_jerk),
+            );
             // A joint with no limits to stop with keeps its position (nothing to ramp).
-            if a_max > 0.0 && j_max > 0.0 {
-                *ramp = Some(VelocityRamp::new(start, 0.0, a_max, j_max));
+            if let Ok(l) = l {
+                *ramp = Some(velocity_profile(start, 0.0, &l));
             }
         }
         JointStop { ramps, len }
@@ -90,7 +105,7 @@ impl JointStop {
         self.ramps[..self.len]
             .iter()
             .flatten()
-            .map(VelocityRamp::duration)
+            .map(Profile::duration)
             .fold(0.0, f64::max)
     }
 
@@ -192,6 +207,7 @@ mod tests {
             acceleration: j(a),
         };
         let limits = StopLimits {
+            max_velocity: j(1000.0),
             max_acceleration: j(a_max),
             max_jerk: j(j_max),
         };
@@ -214,7 +230,8 @@ mod tests {
         let (p, ve, ae) = at(&s, t);
         assert!((p - (v * v / (2.0 * a_max) + v * a_max / (2.0 * j_max))).abs() < 1e-9);
         assert_eq!((ve, ae), (0.0, 0.0));
-        assert!((stopping_distance(v, 0.0, a_max, j_max) - p).abs() < 1e-12);
+        let l = Limits::new(v, a_max, j_max).unwrap();
+        assert!((stopping_distance(v, 0.0, &l) - p).abs() < 1e-12);
     }
 
     /// Played at the period: one state per period, the last at rest, then nothing.
@@ -229,6 +246,7 @@ mod tests {
             acceleration: Joints::zeros(2),
         };
         let limits = StopLimits {
+            max_velocity: j(1000.0),
             max_acceleration: j(1000.0),
             max_jerk: j(20_000.0),
         };
@@ -280,15 +298,17 @@ mod tests {
         }
 
         /// A start a little beyond the acceleration limit (a state estimate a hair past it)
-        /// is not clamped — that would be a jump in acceleration — but held or brought back
-        /// at the jerk limit; beyond the start's own magnitude it never goes.
+        /// is not clamped — that would be a jump in acceleration — but brought back at the
+        /// jerk limit first, as Ruckig's brake does; beyond the start's own magnitude it
+        /// never goes, and within A once back.
         #[test]
-        fn a_start_past_the_limit_is_not_clamped(v in -300.0..300.0f64, af in 1.0..1.05f64,
+        fn a_start_past_the_limit_is_braked_back(v in -300.0..300.0f64, af in 1.0..1.05f64,
                                                  sign in prop::bool::ANY) {
             let (a_max, j_max) = (2000.0, 50_000.0);
             let a0 = if sign { af * a_max } else { -af * a_max };
             let s = one(0.0, v, a0, a_max, j_max);
             let t_end = s.duration();
+            let back = (a0.abs() - a_max) / j_max;
             let n = 400;
             let mut prev = at(&s, 0.0).2;
             prop_assert_eq!(prev, a0);
@@ -296,6 +316,9 @@ mod tests {
                 let t = t_end * k as f64 / n as f64;
                 let aa = at(&s, t).2;
                 prop_assert!(aa.abs() <= a0.abs() * (1.0 + 1e-9), "a {aa}");
+                if t >= back * (1.0 + 1e-9) {
+                    prop_assert!(aa.abs() <= a_max * (1.0 + 1e-9), "a {aa} at {t}");
+                }
                 prop_assert!((aa - prev).abs() <= j_max * t_end / n as f64 * (1.0 + 1e-9) + 1e-9);
                 prev = aa;
             }

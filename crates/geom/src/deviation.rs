@@ -110,8 +110,9 @@ fn search(
     best
 }
 
-/// Golden-section search for the maximum of `f` on `[a, b]` (assumed unimodal there).
-fn golden(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, iterations: usize) -> Deviation {
+/// Golden-section search for the maximum of `f` on `[a, b]` (assumed unimodal there; Kiefer
+/// 1953): `iterations` shrink the bracket by 0.618 each.
+pub fn golden(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64, iterations: usize) -> Deviation {
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
     let (mut f1, mut f2) = (f(x1), f(x2));

@@ -29,6 +29,8 @@
 use std::io::{BufRead, BufReader, Write};
 use std::process::{Command, Stdio};
 
+mod rng_support;
+use rng_support::Rng;
 use tezgah_motion::profile::{solve, speed_change_distance, Limits, Profile, ProfileError};
 
 const CASES: usize = 160_000;
@@ -36,25 +38,6 @@ const SEED: u64 = 0x7e29_a4c1_5eed_0005;
 /// The first this many cases also compare the state along the way, at `SAMPLES` times.
 const SAMPLED_CASES: usize = 20_000;
 const SAMPLES: usize = 9;
-
-/// xorshift64* (Vigna 2016): enough for spreading test cases, and reproducible everywhere.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        (lo.ln() + self.unit() * (hi.ln() - lo.ln())).exp()
-    }
-}
 
 #[derive(Debug, Clone, Copy)]
 struct Case {

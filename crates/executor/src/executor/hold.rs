@@ -1,6 +1,7 @@
 //! Feed hold (and abort) as a stop along the path: from the re-timed state where the command
-//! meets the plan, the time-optimal jerk-limited stop ([`PathStop`]) under the path limits of
-//! the piece in hand, played along the same path; at rest the plan's time τ is found where the
+//! meets the plan (ṡ, s̈), the time-optimal jerk-limited stop under the path limits of the piece
+//! in hand (the one profile solver's velocity interface to speed 0, Kröger & Wahl's
+//! velocity-to-zero case as Ruckig solves it), played along the same path; at rest the plan's time τ is found where the
 //! stop ended, and resume re-times the plan from r = 0 there.
 //!
 //! A piece's limits hold for any speed up to its V, so the stop is admissible inside it. One
@@ -13,24 +14,24 @@
 
 use tezgah_motion::plan::limits::{analyse, inside_group};
 use tezgah_motion::plan::{Piece, Planned};
-use tezgah_motion::{Junction, Limits, Profile};
+use tezgah_motion::profile::reach_velocity;
+use tezgah_motion::{Junction, Limits, Profile, State};
 
 use super::{Current, Executor, Produced};
 use crate::command::RunState;
 use crate::error::ExecError;
 use crate::job::PlannedItem;
-use crate::path_stop::{PathStop, StopState};
 use crate::scale::TimeScale;
 
 /// A path stop in progress: its leg in the piece in hand and, if it crosses into the next
 /// piece, the leg there.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Hold {
-    first: PathStop,
+    first: Profile,
     /// Path coordinate in the piece where the first leg starts.
     s0: f64,
     /// The second leg and the time into the hold where it starts (the junction).
-    second: Option<(PathStop, f64)>,
+    second: Option<(Profile, f64)>,
     /// Time into the hold, s.
     t: f64,
     /// Whether the tool has passed into the second leg's piece.
@@ -71,14 +72,14 @@ fn time_at(profile: &Profile, s: f64, from: f64) -> f64 {
 }
 
 /// The time into `stop` where it has run `distance`, by bisection (s is non-decreasing).
-fn time_to(stop: &PathStop, distance: f64) -> f64 {
+fn time_to(stop: &Profile, distance: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, stop.duration());
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if mid <= lo || mid >= hi {
             break;
         }
-        if stop.at(mid).s < distance {
+        if stop.state_at(mid).s < distance {
             lo = mid;
         } else {
             hi = mid;
@@ -87,16 +88,25 @@ fn time_to(stop: &PathStop, distance: f64) -> f64 {
     hi
 }
 
-fn stop_under(x: &StopState, l: &Limits) -> Option<PathStop> {
-    if x.a.abs() > l.max_acceleration() * (1.0 + SLACK) {
+/// The stop from path state `x` (from s = 0) under `l`; `None` when the acceleration is past
+/// the limit beyond rounding, or the stop would need the speed to go negative (braking harder
+/// than the jerk can release: v + a|a|/(2J) < 0) — the path cannot be driven backward.
+fn stop_under(x: &State, l: &Limits) -> Option<Profile> {
+    let a_max = l.max_acceleration();
+    if x.v.is_nan() || x.v < 0.0 || x.a.abs() > a_max * (1.0 + SLACK) {
         return None;
     }
-    PathStop::new(
-        x.v,
-        x.a.clamp(-l.max_acceleration(), l.max_acceleration()),
-        l.max_acceleration(),
-        l.max_jerk(),
-    )
+    let a = x.a.clamp(-a_max, a_max);
+    if x.v + a * a.abs() / (2.0 * l.max_jerk()) < 0.0 {
+        return None;
+    }
+    let start = State {
+        s: 0.0,
+        v: x.v,
+        a,
+        j: 0.0,
+    };
+    reach_velocity(start, 0.0, l).ok()
 }
 
 impl Executor {
@@ -112,10 +122,11 @@ impl Executor {
         let piece = cursor.piece();
         let st = piece.profile.state_at(*tau);
         let (r, rd) = (self.scale.r, self.scale.rate);
-        let here = StopState {
+        let here = State {
             s: st.s,
             v: r * st.v,
             a: rd * st.v + r * r * st.a,
+            j: 0.0,
         };
         let Some(first) = stop_under(&here, &piece.limits) else {
             return false;
@@ -140,7 +151,7 @@ impl Executor {
     }
 
     /// The leg in the next piece of a stop that reaches the end of `piece` after `left`.
-    fn second_leg(&self, piece: &Piece, first: &PathStop, left: f64) -> Option<(PathStop, f64)> {
+    fn second_leg(&self, piece: &Piece, first: &Profile, left: f64) -> Option<(Profile, f64)> {
         let Some(PlannedItem {
             item: Planned::Motion(next),
             ..
@@ -153,7 +164,7 @@ impl Executor {
             return None;
         }
         let at = time_to(first, left);
-        let x = first.at(at);
+        let x = first.state_at(at);
         // No faster than the plan passes the junction (its cap holds up to that speed).
         if x.v > piece.profile.end().v * (1.0 + SLACK) {
             return None;
@@ -188,11 +199,11 @@ impl Executor {
                     self.fetch()?;
                     hold.crossed = true;
                 }
-                stop.at(hold.t - at)
+                stop.state_at(hold.t - at)
             }
             _ => {
-                let x = hold.first.at(hold.t);
-                StopState {
+                let x = hold.first.state_at(hold.t);
+                State {
                     s: hold.s0 + x.s,
                     ..x
                 }

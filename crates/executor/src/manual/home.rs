@@ -3,7 +3,7 @@
 //! search toward the switch at `search_velocity`, stop; back off at `latch_velocity` until the
 //! switch releases, stop; approach again at `latch_velocity` and latch the position where it
 //! trips, stop; then a rest-to-rest move to the home `position`. Every piece is jerk-limited (the
-//! velocity ramps of JOG, the 7-phase profile for the last move) and starts at the exact instant
+//! one profile solver: its velocity interface as JOG, its position interface for the last move) and starts at the exact instant
 //! the previous one ended, so the set-points are one continuous jerk-limited motion.
 //!
 //! Before homing the controller does not know where the machine is: its positions are machine
@@ -18,9 +18,9 @@ use tezgah_kinematics::pose::MAX_JOINTS;
 use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::profile::{solve, Limits, Profile, State};
 
-use super::ramp::VelocityRamp;
 use super::{check_start, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
+use crate::stop::velocity_profile;
 
 /// The home switches as the controller reads them, once per period.
 pub trait HomeSwitches {
@@ -98,6 +98,8 @@ struct FinalMove {
 #[derive(Debug, Clone)]
 struct JointHoming {
     axis: JointAxis,
+    /// The joint's limits (the search and latch speeds are within their speed).
+    limits: Limits,
     sequence: u32,
     /// Switch and home positions in machine coordinates (internal units).
     switch: f64,
@@ -107,9 +109,10 @@ struct JointHoming {
     search_speed: f64,
     latch_speed: f64,
     phase: HomePhase,
-    /// The current piece: a velocity ramp from t0, or the final profile from t0.
+    /// The current piece: a velocity profile from t0 (search, back-off, latch, their stops),
+    /// or the final move's profile from t0.
     t0: f64,
-    ramp: VelocityRamp,
+    ramp: Profile,
     last: Option<FinalMove>,
     search_from: f64,
     max_travel: f64,
@@ -141,7 +144,7 @@ impl JointHoming {
 
     fn begin(&mut self, t: f64, target: f64, phase: HomePhase) {
         let st = self.ramp.state_at(t - self.t0);
-        self.ramp = VelocityRamp::new(st, target, self.axis.max_acceleration, self.axis.max_jerk);
+        self.ramp = velocity_profile(st, target, &self.limits);
         self.t0 = t;
         self.phase = phase;
     }
@@ -246,6 +249,7 @@ impl Home {
         let mut joints = Vec::with_capacity(machine.joints.len());
         for (i, j) in machine.joints.iter().enumerate() {
             let axis = JointAxis::from_machine(machine, i)?;
+            let limits = axis.limits()?;
             let s = j.to_internal();
             let range = if (axis.max - axis.min).is_finite() {
                 axis.max - axis.min
@@ -257,7 +261,8 @@ impl Home {
                 ..State::default()
             };
             joints.push(JointHoming {
-                ramp: VelocityRamp::new(rest, 0.0, axis.max_acceleration, axis.max_jerk),
+                ramp: velocity_profile(rest, 0.0, &limits),
+                limits,
                 sequence: j.home.sequence,
                 switch: j.home.switch * s,
                 home: j.home.position * s,

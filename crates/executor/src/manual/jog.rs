@@ -1,17 +1,19 @@
 //! JOG: one joint moves continuously at a set speed until told to stop — velocity mode
 //! (Kelekçi, 2021, §4.1). Starts, speed changes (override steps, 0–200 %) and stops are
-//! jerk-limited [`VelocityRamp`]s taking effect at the next period; a stop takes exactly the
+//! jerk-limited velocity profiles (the one solver's velocity interface,
+//! [`crate::stop::velocity_profile`]) taking effect at the next period; a stop takes exactly the
 //! jerk-limited minimum distance from the state it is asked in. Toward a soft limit the jog
 //! brakes on its own at the instant (found between periods) from which the time-optimal stop
 //! ends exactly on the limit, so no set-point ever lies past it.
 
 use tezgah_kinematics::{Joints, Machine};
-use tezgah_motion::profile::State;
+use tezgah_motion::profile::{Limits, State};
+use tezgah_motion::Profile;
 
-use super::ramp::{stopping_displacement, VelocityRamp};
 use super::{check_start, JointAxis, ManualError};
 use crate::setpoint::SetPoint;
 use crate::speed_override::Override;
+use crate::stop::{stopping_distance, velocity_profile};
 
 /// Which way a manual move goes along its joint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -34,6 +36,7 @@ impl Direction {
 #[derive(Debug, Clone)]
 pub struct Jog {
     axis: JointAxis,
+    limits: Limits,
     joint: usize,
     /// Every joint's position (the jogged one is overwritten each period).
     held: Joints,
@@ -44,7 +47,7 @@ pub struct Jog {
     emitted: u64,
     /// Start time of the current ramp and the ramp (State.s is the joint's position).
     t0: f64,
-    ramp: VelocityRamp,
+    ramp: Profile,
     /// Set speed (internal units/s) and override factor.
     speed: f64,
     factor: f64,
@@ -67,6 +70,7 @@ impl Jog {
         index: u64,
     ) -> Result<Jog, ManualError> {
         let axis = JointAxis::from_machine(machine, joint)?;
+        let limits = axis.limits()?;
         check_start(machine, start)?;
         let speed = axis.speed(speed)?;
         let dir = direction.sign();
@@ -80,8 +84,9 @@ impl Jog {
             ..State::default()
         };
         let mut jog = Jog {
-            ramp: VelocityRamp::new(rest, 0.0, axis.max_acceleration, axis.max_jerk),
+            ramp: velocity_profile(rest, 0.0, &limits),
             axis,
+            limits,
             joint,
             held: *start,
             dir,
@@ -141,7 +146,7 @@ impl Jog {
     /// Where the joint would come to rest if a stop were asked now.
     pub fn stop_position(&self) -> f64 {
         let st = self.state();
-        st.s + stopping_displacement(st, self.axis.max_acceleration, self.axis.max_jerk)
+        st.s + stopping_distance(st.v, st.a, &self.limits)
     }
 
     fn now(&self) -> f64 {
@@ -156,14 +161,14 @@ impl Jog {
 
     fn begin(&mut self, t: f64, target: f64) {
         let st = self.ramp.state_at(t - self.t0);
-        self.ramp = VelocityRamp::new(st, target, self.axis.max_acceleration, self.axis.max_jerk);
+        self.ramp = velocity_profile(st, target, &self.limits);
         self.t0 = t;
     }
 
     /// How far past the limit a stop begun at `t` would end (≤ 0: it stops in time).
     fn overrun(&self, t: f64) -> f64 {
         let st = self.ramp.state_at(t - self.t0);
-        let stop = stopping_displacement(st, self.axis.max_acceleration, self.axis.max_jerk);
+        let stop = stopping_distance(st.v, st.a, &self.limits);
         self.dir * (st.s + stop - self.limit)
     }
 

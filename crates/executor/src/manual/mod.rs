@@ -31,17 +31,16 @@ pub mod active;
 pub mod home;
 pub mod inc;
 pub mod jog;
-pub mod ramp;
 
 use std::f64::consts::PI;
 
 use tezgah_kinematics::{JointKind, Machine};
+use tezgah_motion::profile::Limits;
 use thiserror::Error;
 
 pub use home::{Home, HomeSwitches, SimulatedSwitches};
 pub use inc::{Inc, IncStep};
 pub use jog::Jog;
-pub use ramp::VelocityRamp;
 
 /// Why a manual move was refused or failed. Joints are 0-based machine-file indices; values
 /// are in file units (mm or degrees).
@@ -112,6 +111,16 @@ impl JointAxis {
                 JointKind::Linear => 1.0,
                 JointKind::Rotary => 180.0 / PI,
             },
+        })
+    }
+
+    /// The joint's limits for the profile solver (JOG, homing, stops).
+    pub fn limits(&self) -> Result<Limits, ManualError> {
+        Limits::new(self.max_velocity, self.max_acceleration, self.max_jerk).map_err(|e| {
+            ManualError::Motion {
+                name: self.name.clone(),
+                reason: e.to_string(),
+            }
         })
     }
 

@@ -119,7 +119,7 @@ impl PlanRange {
     /// the speed's vertex (a = 0) where it falls inside a phase.
     fn profile(&mut self, p: &Profile, t0: f64, t1: f64) {
         let knots = p.knots();
-        for k in 0..7 {
+        for k in 0..knots.len() - 1 {
             let (ts, x) = knots[k];
             let te = knots[k + 1].0;
             let (lo, hi) = (t0.max(ts), t1.min(te));

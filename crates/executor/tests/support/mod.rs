@@ -219,8 +219,7 @@ pub fn hold_and_resume(program: &str, at: usize) -> (Vec<Produced>, Option<HoldD
                 tezgah_executor::stop::stopping_distance(
                     before.feed,
                     a.clamp(-l.max_acceleration(), l.max_acceleration()),
-                    l.max_acceleration(),
-                    l.max_jerk(),
+                    l,
                 )
             })
             .fold(0.0, f64::max);

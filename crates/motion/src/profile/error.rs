@@ -18,6 +18,17 @@ pub enum ProfileError {
         value: f64,
         max_velocity: f64,
     },
+    /// A start state (speed, acceleration or position) that is not finite.
+    #[error("start state must be finite, got speed {v} and acceleration {a}")]
+    Start { v: f64, a: f64 },
+    /// A target speed that is not finite, or (for a position target) beyond ±V.
+    #[error(
+        "target speed must be finite (and within the speed limit for a position target), got {0}"
+    )]
+    Target(f64),
+    /// A target distance that is not finite.
+    #[error("target distance must be finite, got {0}")]
+    TargetDistance(f64),
     /// A path length that is NaN, infinite or negative.
     #[error("distance must be finite and >= 0, got {0}")]
     Distance(f64),

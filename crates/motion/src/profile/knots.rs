@@ -1,7 +1,7 @@
 //! Piecewise-constant-jerk motion as a knot table: the time and state where each phase starts,
-//! and the end. The planner's seven-phase [`super::Profile`] and the executor's three-phase
-//! velocity ramp (JOG, homing, stops) are both such tables; this is their one integration and
-//! their one walk, so both replay exactly the same numbers.
+//! and the end. Every [`super::Profile`] (the planner's, and the executor's JOG, homing, stops
+//! and holds) is such a table; this is its one integration and its one walk, so every consumer
+//! replays exactly the same numbers.
 //!
 //! Within a phase of jerk j, from (s, v, a): v(τ) = v + aτ + jτ²/2,
 //! s(τ) = s + vτ + aτ²/2 + jτ³/6 (exact for constant jerk).

@@ -5,7 +5,9 @@
 //! Phase layout: jerk +σ₁J, 0, −σ₁J (speed change v0 → vm, σ₁ = ±1), cruise at vm (jerk 0),
 //! jerk +σ₂J, 0, −σ₂J (vm → v1). σ₁ = +1, σ₂ = −1 is the usual speed-up-then-slow-down; the
 //! other signs give slow-down-then-speed-up and monotone shapes. The phases are integrated and
-//! walked as a knot table ([`super::knots`], exact cubics), shared with the executor's ramp.
+//! walked as a knot table ([`super::knots`], exact cubics). A start state outside the limits
+//! is first brought back within them by a brake of up to two phases, as Ruckig does
+//! ([`super::brake`]); the seven phases follow it.
 
 use super::knots;
 use super::ramp::Ramp;
@@ -19,27 +21,108 @@ pub struct State {
     pub j: f64,
 }
 
-/// A timed 1-D motion of seven constant-jerk phases (see the module comment).
+/// A timed 1-D motion: an optional brake of up to two phases, then seven constant-jerk phases
+/// (see the module comment).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Profile {
-    durations: [f64; 7],
-    jerks: [f64; 7],
-    /// Time and (s, v, a) at the start of each phase and at the end (index 7), integrated once
-    /// from the start state; the jerk field holds the phase's jerk (0 at index 7).
-    knots: [(f64, State); 8],
+    /// The brake (two phases) and the seven main phases.
+    durations: [f64; PHASES],
+    jerks: [f64; PHASES],
+    /// Time and (s, v, a) at the start of each phase and at the end (index 9), integrated once
+    /// from the start state; the jerk field holds the phase's jerk (0 at the end).
+    knots: [(f64, State); PHASES + 1],
+    /// Index of the first knot [`Profile::knots`] shows: 0 with a brake, 2 without (the two
+    /// brake phases then last 0 s, and the table reads as the seven main phases alone).
+    first: usize,
 }
+
+/// Two brake phases and seven main phases.
+const PHASES: usize = 9;
+
+/// Index of the cruise phase (the main phases' fourth).
+const CRUISE: usize = 5;
 
 impl Profile {
     /// Integrates the phases from `start` (its jerk field is ignored). Durations must be ≥ 0;
     /// the solver guarantees it, so this is not public.
     pub(crate) fn from_phases(start: State, durations: [f64; 7], jerks: [f64; 7]) -> Profile {
-        let mut knots = [(0.0, State::default()); 8];
-        knots::integrate(start, &durations, &jerks, &mut knots);
-        Profile {
-            durations,
-            jerks,
-            knots,
+        Profile::braked(start, [(0.0, 0.0); 2], durations, jerks, None)
+    }
+
+    /// A profile whose seven phases follow a brake of two (duration, jerk) phases (Ruckig's
+    /// brake pre-trajectory, [`super::brake`]); a brake of zero duration is no brake. A cruise
+    /// runs at zero acceleration and, if given, exactly at `cruise_speed`.
+    pub(crate) fn braked(
+        start: State,
+        brake: [(f64, f64); 2],
+        durations: [f64; 7],
+        jerks: [f64; 7],
+        cruise_speed: Option<f64>,
+    ) -> Profile {
+        let mut all_d = [0.0; PHASES];
+        let mut all_j = [0.0; PHASES];
+        for (k, (d, j)) in brake.iter().enumerate() {
+            all_d[k] = *d;
+            all_j[k] = *j;
         }
+        all_d[2..].copy_from_slice(&durations);
+        all_j[2..].copy_from_slice(&jerks);
+        let mut knots = [(0.0, State::default()); PHASES + 1];
+        // Up to the cruise, then on from it at exactly zero acceleration (and at the cruise
+        // speed): a rounding residue there would be integrated over the whole cruise.
+        knots::integrate(
+            start,
+            &all_d[..CRUISE],
+            &all_j[..CRUISE],
+            &mut knots[..=CRUISE],
+        );
+        let (t, mut at_cruise) = knots[CRUISE];
+        if all_d[CRUISE] > 0.0 {
+            at_cruise.a = 0.0;
+            at_cruise.v = cruise_speed.unwrap_or(at_cruise.v);
+        }
+        knots::integrate(
+            at_cruise,
+            &all_d[CRUISE..],
+            &all_j[CRUISE..],
+            &mut knots[CRUISE..],
+        );
+        for k in &mut knots[CRUISE..] {
+            k.0 += t;
+        }
+        let first = if brake.iter().all(|b| b.0 == 0.0) {
+            2
+        } else {
+            0
+        };
+        Profile {
+            durations: all_d,
+            jerks: all_j,
+            knots,
+            first,
+        }
+    }
+
+    /// No motion: at rest at position `s` (duration 0).
+    pub fn at_rest(s: f64) -> Profile {
+        Profile::from_phases(
+            State {
+                s,
+                ..State::default()
+            },
+            [0.0; 7],
+            [0.0; 7],
+        )
+    }
+
+    /// The same profile with its end speed and acceleration set to the target exactly, which
+    /// the integration meets up to rounding (the motion after the end then runs at exactly
+    /// the target speed).
+    pub(crate) fn ending_at(mut self, v: f64, a: f64) -> Profile {
+        let end = &mut self.knots[PHASES].1;
+        end.v = v;
+        end.a = a;
+        self
     }
 
     /// Two ramps around a cruise: `first` takes the speed from v0 in direction `sign1` (±1),
@@ -74,14 +157,27 @@ impl Profile {
         )
     }
 
-    /// The seven phase durations (s).
+    /// The seven main phase durations (s), after the brake.
     pub fn durations(&self) -> [f64; 7] {
-        self.durations
+        let mut d = [0.0; 7];
+        d.copy_from_slice(&self.durations[2..]);
+        d
     }
 
-    /// The seven phase jerks (mm/s³).
+    /// The seven main phase jerks (mm/s³).
     pub fn jerks(&self) -> [f64; 7] {
-        self.jerks
+        let mut j = [0.0; 7];
+        j.copy_from_slice(&self.jerks[2..]);
+        j
+    }
+
+    /// The brake's two phases as (duration s, jerk mm/s³); zero durations when the start
+    /// state is within the limits.
+    pub fn brake(&self) -> [(f64, f64); 2] {
+        [
+            (self.durations[0], self.jerks[0]),
+            (self.durations[1], self.jerks[1]),
+        ]
     }
 
     /// The state at t = 0.
@@ -91,21 +187,22 @@ impl Profile {
 
     /// The state at t = duration (jerk 0).
     pub fn end(&self) -> State {
-        self.knots[7].1
+        self.knots[PHASES].1
     }
 
-    /// Time and state at the start of each phase, and at the end (index 7).
-    pub fn knots(&self) -> &[(f64, State); 8] {
-        &self.knots
+    /// Time and state at the start of each phase, and at the end (the last): the seven main
+    /// phases, preceded by the brake's two when there is a brake.
+    pub fn knots(&self) -> &[(f64, State)] {
+        &self.knots[self.first..]
     }
 
     pub fn duration(&self) -> f64 {
-        self.knots[7].0
+        self.knots[PHASES].0
     }
 
     /// Distance travelled from start to end.
     pub fn distance(&self) -> f64 {
-        self.knots[7].1.s - self.knots[0].1.s
+        self.knots[PHASES].1.s - self.knots[0].1.s
     }
 
     /// The state at time `t`, exactly (one cubic per phase). Before 0 this is the start state;

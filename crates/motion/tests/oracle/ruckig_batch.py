@@ -13,7 +13,9 @@ stdout: one line per case, "duration vmin end": Ruckig's optimal duration, the l
 """
 import sys
 
-from ruckig import InputParameter, Result, Ruckig, Trajectory
+from ruckig import Ruckig
+
+from ruckig_state import calculate
 
 
 def min_speed(traj):
@@ -34,8 +36,6 @@ def min_speed(traj):
 
 def main():
     otg = Ruckig(1)
-    inp = InputParameter(1)
-    traj = Trajectory(1)
     out = []
     for line in sys.stdin:
         f = line.split()
@@ -43,20 +43,8 @@ def main():
             continue
         dist, v0, v1, vmax, amax, jmax = map(float, f[:6])
         samples = int(f[6]) if len(f) > 6 else 0
-        inp.current_position = [0.0]
-        inp.current_velocity = [v0]
-        inp.current_acceleration = [0.0]
-        inp.target_position = [dist]
-        inp.target_velocity = [v1]
-        inp.target_acceleration = [0.0]
-        inp.max_velocity = [vmax]
-        inp.max_acceleration = [amax]
-        inp.max_jerk = [jmax]
-        try:
-            res = otg.calculate(inp, traj)
-        except Exception:  # RuckigError on invalid input
-            res = None
-        if res not in (Result.Working, Result.Finished):
+        traj = calculate(otg, "p", v0, 0.0, dist, v1, vmax, amax, jmax)
+        if traj is None:
             out.append("nan nan nan")
             continue
         end = traj.at_time(traj.duration)[0][0]
