@@ -3,11 +3,11 @@
 //! and the planner's joint limits all start here.
 //!
 //! This module reads the part every machine shares: `name`, `[motion]`, `[path]`,
-//! `[[joint]]` ([`joint`]) and the `type` and `tcp` keys of `[kinematics]`. The rest of
-//! `[kinematics]` belongs to the model that `type` names, which reads it itself
-//! ([`section::FromSection`], in the model's own file) and declares which program axis each
-//! joint carries ([`Kinematics::joint_axes`]). A new machine family is one model file plus a
-//! line in the list of models at the end of this file.
+//! `[[joint]]` (`machine/joint.rs`) and the `type` and `tcp` keys of `[kinematics]`. The rest
+//! of `[kinematics]` belongs to the model that `type` names, which reads it itself (its section
+//! struct and `FromSection`, `machine/section.rs`, in the model's own file) and declares which
+//! program axis each joint carries ([`Kinematics::joint_axes`]). A new machine family is one
+//! model file plus a line in the list of models at the end of this file.
 //!
 //! Every error names its field (`joint[2].max_jerk: must be > 0`); unknown fields are refused.
 
