@@ -3,6 +3,7 @@
 //! [`crate::machine::Machine`]; the interpolator calls `inverse` once per sample.
 
 use nalgebra::{Matrix6xX, Vector3, Vector6};
+use tezgah_geom::Axis;
 
 use crate::error::KinematicsError;
 use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
@@ -75,6 +76,17 @@ pub trait Kinematics {
         tool: &Tool,
         previous: &Joints,
     ) -> Result<Joints, KinematicsError>;
+
+    /// The program axis each joint carries when the program drives the joints directly (TCP
+    /// off), in joint order; `None` for a joint no program axis names (a delta's carriages).
+    /// The model's joint-to-axis map: it says which joint is Z (homed first), and with
+    /// [`Kinematics::tcp_joints`] which program axes the machine has.
+    fn joint_axes(&self) -> Vec<Option<Axis>>;
+
+    /// The joints whose values [`Kinematics::tcp_angles`] returns, in that order: the rotary
+    /// joints that tool-centre-point control takes from the program (their program axes are
+    /// [`Kinematics::joint_axes`] of these joints).
+    fn tcp_joints(&self) -> Vec<usize>;
 
     /// ∂(tip, axis)/∂q at `q` (analytic).
     fn jacobian(&self, q: &Joints, tool: &Tool) -> Result<Jacobian, KinematicsError>;

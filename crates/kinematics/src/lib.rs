@@ -8,7 +8,8 @@
 //! * [`kinematics`]: the [`Kinematics`] trait;
 //! * models: [`cartesian`], [`yzca`], [`trunnion`] with [`table_ac`] / [`table_bc`],
 //!   [`linear_delta`];
-//! * [`machine`]: the TOML machine file, validation, built-in machines;
+//! * [`machine`]: the TOML machine file's shared part, validation, built-in machines (each
+//!   model reads its own `[kinematics]` section, in its own file);
 //! * [`tcp`]: tool-centre-point control (program = tip + rotary angles);
 //! * [`segment`]: splitting moves by deviation for machines that interpolate in joints;
 //! * [`iso9283`]: pose accuracy AP and repeatability RP.

@@ -8,12 +8,16 @@
 //! remaining quadratic is the platform below the carriages.
 
 use nalgebra::{Matrix3, Vector3};
+use serde::Deserialize;
+use tezgah_geom::Axis;
 
 use crate::error::KinematicsError;
 use crate::kinematics::{
     check_input, check_pose, check_vertical_axis, Jacobian, Kinematics, Tolerances,
 };
-use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+use crate::machine::{check_joint_kinds, finite, finite3, invalid, limits, positive, refused};
+use crate::machine::{require, tolerances, FromSection, Joint, MachineError};
+use crate::pose::{check_limits, JointKind, JointLimit, Joints, Tool, ToolPose};
 
 /// Geometry of a linear delta.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,6 +51,80 @@ pub struct LinearDelta {
     /// Unit rod directions (platform → carriage) with the platform at the centre, and the
     /// cosine of the joint cone, when the cone is checked.
     cone: Option<([Vector3<f64>; 3], f64)>,
+}
+
+/// `[kinematics]` of a `linear-delta` machine: the geometry in mm and degrees.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DeltaSection {
+    /// Required, > 0.
+    radius: Option<f64>,
+    /// Required, > `radius`.
+    rod_length: Option<f64>,
+    /// Default 90°, 210°, 330° (LinuxCNC, Klipper).
+    tower_angles: Option<[f64; 3]>,
+    /// Default 0.
+    carriage_offsets: Option<[f64; 3]>,
+    /// Default 0, in [0, 90).
+    min_rod_angle_deg: Option<f64>,
+    /// Default unchecked, in (0, 180).
+    max_joint_angle_deg: Option<f64>,
+    axis_tolerance_deg: Option<f64>,
+}
+
+impl FromSection for LinearDelta {
+    type Section = DeltaSection;
+
+    /// Three linear joints, the carriages of towers 1, 2, 3.
+    fn from_section(
+        kind: &'static str,
+        s: DeltaSection,
+        joints: &[Joint],
+    ) -> Result<Self, MachineError> {
+        check_joint_kinds(kind, joints, &[JointKind::Linear; 3])?;
+        let field = |name: &str| format!("kinematics.{name}");
+        let radius = positive(&field("radius"), require(&field("radius"), kind, s.radius)?)?;
+        let rod_field = field("rod_length");
+        let rod_length = positive(&rod_field, require(&rod_field, kind, s.rod_length)?)?;
+        if rod_length <= radius {
+            return Err(invalid(
+                rod_field,
+                format!("must be greater than radius ({radius}) or the centre is unreachable"),
+            ));
+        }
+        let angles = finite3(
+            &field("tower_angles"),
+            s.tower_angles.unwrap_or([90.0, 210.0, 330.0]),
+        )?;
+        let offsets = finite3(
+            &field("carriage_offsets"),
+            s.carriage_offsets.unwrap_or([0.0; 3]),
+        )?;
+        let min_angle = finite(
+            &field("min_rod_angle_deg"),
+            s.min_rod_angle_deg.unwrap_or(0.0),
+        )?;
+        if !(0.0..90.0).contains(&min_angle) {
+            return Err(invalid(field("min_rod_angle_deg"), "must be in [0, 90)"));
+        }
+        let max_joint_angle = match s.max_joint_angle_deg {
+            Some(v) if v.is_finite() && v > 0.0 && v < 180.0 => Some(v.to_radians()),
+            Some(_) => return Err(invalid(field("max_joint_angle_deg"), "must be in (0, 180)")),
+            None => None,
+        };
+        let geometry = DeltaGeometry {
+            max_joint_angle,
+            radius,
+            rod_length,
+            tower_angles: [angles.x, angles.y, angles.z].map(f64::to_radians),
+            carriage_offsets: [offsets.x, offsets.y, offsets.z],
+            min_rod_angle: min_angle.to_radians(),
+        };
+        let tolerances = tolerances(s.axis_tolerance_deg, None, None)?;
+        // Towers on one line is the one refusal left to the constructor.
+        LinearDelta::new(geometry, limits(joints), tolerances)
+            .map_err(refused("kinematics.tower_angles"))
+    }
 }
 
 impl LinearDelta {
@@ -346,6 +424,15 @@ impl Kinematics for LinearDelta {
     ) -> Result<Joints, KinematicsError> {
         check_input(angles, 0)?;
         self.inverse(&ToolPose::vertical(*tip), tool, previous)
+    }
+
+    /// The carriages carry no program axis: X Y Z reach them only through the inverse.
+    fn joint_axes(&self) -> Vec<Option<Axis>> {
+        vec![None; 3]
+    }
+
+    fn tcp_joints(&self) -> Vec<usize> {
+        Vec::new()
     }
 
     fn jacobian(&self, q: &Joints, _tool: &Tool) -> Result<Jacobian, KinematicsError> {

@@ -4,11 +4,15 @@
 //! or B), C.
 
 use nalgebra::{Matrix3, Vector3};
+use serde::Deserialize;
+use tezgah_geom::Axis;
 
 use crate::angle::{atan2_pair, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{check_input, check_pose, check_tip, Jacobian, Kinematics, Tolerances};
-use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+use crate::machine::{check_joint_kinds, finite3, limits, refused, require, tolerances};
+use crate::machine::{FromSection, Joint, MachineError};
+use crate::pose::{check_limits, JointKind, JointLimit, Joints, Tool, ToolPose};
 use crate::{table_ac, table_bc};
 
 /// Which machine axis the table tilts about.
@@ -33,6 +37,43 @@ pub struct Trunnion {
 
 const TILT: usize = 3;
 const C: usize = 4;
+
+/// `[kinematics]` of a `table-ac` or `table-bc` machine.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct TrunnionSection {
+    /// Machine coordinates of a point on the tilt axis, mm (required).
+    pivot: Option<[f64; 3]>,
+    /// From that point to the C axis origin with the tilt at 0, mm (default 0: they meet).
+    c_offset: Option<[f64; 3]>,
+    axis_tolerance_deg: Option<f64>,
+    pole_cone_deg: Option<f64>,
+}
+
+impl FromSection for Trunnion {
+    type Section = TrunnionSection;
+
+    /// Joints x y z (linear), tilt and c (rotary); `table-ac` tilts about X, `table-bc` about Y.
+    fn from_section(
+        kind: &'static str,
+        section: TrunnionSection,
+        joints: &[Joint],
+    ) -> Result<Self, MachineError> {
+        use JointKind::{Linear as L, Rotary as R};
+        check_joint_kinds(kind, joints, &[L, L, L, R, R])?;
+        let field = "kinematics.pivot";
+        let pivot = finite3(field, require(field, kind, section.pivot)?)?;
+        let c_offset = finite3("kinematics.c_offset", section.c_offset.unwrap_or([0.0; 3]))?;
+        let tilt = if kind == "table-ac" {
+            TiltAxis::X
+        } else {
+            TiltAxis::Y
+        };
+        let tolerances = tolerances(section.axis_tolerance_deg, section.pole_cone_deg, None)?;
+        Trunnion::new(tilt, pivot, c_offset, limits(joints), tolerances)
+            .map_err(refused("kinematics"))
+    }
+}
 
 impl Trunnion {
     /// A trunnion; `limits` must hold five joints (X Y Z, tilt, C).
@@ -270,6 +311,20 @@ impl Kinematics for Trunnion {
         let q = Joints::new([m.x, m.y, m.z, angles[0], angles[1]]);
         check_limits(&q, &self.limits)?;
         Ok(q)
+    }
+
+    fn joint_axes(&self) -> Vec<Option<Axis>> {
+        let tilt = match self.tilt {
+            TiltAxis::X => Axis::A,
+            TiltAxis::Y => Axis::B,
+        };
+        [Axis::X, Axis::Y, Axis::Z, tilt, Axis::C]
+            .map(Some)
+            .to_vec()
+    }
+
+    fn tcp_joints(&self) -> Vec<usize> {
+        vec![TILT, C]
     }
 
     fn jacobian(&self, q: &Joints, tool: &Tool) -> Result<Jacobian, KinematicsError> {

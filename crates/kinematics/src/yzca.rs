@@ -13,13 +13,17 @@
 //!   (not the printed eq. 5.4, which gives +45° where −45° is meant), unwrapped.
 
 use nalgebra::Vector3;
+use serde::Deserialize;
+use tezgah_geom::Axis;
 
 use crate::angle::{atan2, atan2_pair, unwrap_near, unwrap_within};
 use crate::error::KinematicsError;
 use crate::kinematics::{
     check_input, check_pose, check_tip, choose_nearest, Jacobian, Kinematics, Tolerances,
 };
-use crate::pose::{check_limits, JointLimit, Joints, Tool, ToolPose};
+use crate::machine::{check_joint_kinds, finite, limits, refused, require, tolerances};
+use crate::machine::{FromSection, Joint, MachineError};
+use crate::pose::{check_limits, JointKind, JointLimit, Joints, Tool, ToolPose};
 
 const Y: usize = 0;
 const Z: usize = 1;
@@ -94,6 +98,39 @@ impl Yzca {
         } else {
             fallback
         }
+    }
+}
+
+/// `[kinematics]` of a `yzca` machine.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct YzcaSection {
+    /// A pivot to spindle gauge point along the tool, mm (required).
+    pivot_to_gauge: Option<f64>,
+    axis_tolerance_deg: Option<f64>,
+    pole_cone_deg: Option<f64>,
+    centre_tolerance_mm: Option<f64>,
+}
+
+impl FromSection for Yzca {
+    type Section = YzcaSection;
+
+    /// Joints y z (linear), c a (rotary).
+    fn from_section(
+        kind: &'static str,
+        section: YzcaSection,
+        joints: &[Joint],
+    ) -> Result<Self, MachineError> {
+        use JointKind::{Linear as L, Rotary as R};
+        check_joint_kinds(kind, joints, &[L, L, R, R])?;
+        let field = "kinematics.pivot_to_gauge";
+        let pivot_to_gauge = finite(field, require(field, kind, section.pivot_to_gauge)?)?;
+        let tolerances = tolerances(
+            section.axis_tolerance_deg,
+            section.pole_cone_deg,
+            section.centre_tolerance_mm,
+        )?;
+        Yzca::new(pivot_to_gauge, limits(joints), tolerances).map_err(refused("kinematics"))
     }
 }
 
@@ -278,6 +315,14 @@ impl Kinematics for Yzca {
         let q = choose_nearest(&cands, err, &reference, &[C], &self.limits)?;
         check_limits(&q, &self.limits)?;
         Ok(q)
+    }
+
+    fn joint_axes(&self) -> Vec<Option<Axis>> {
+        vec![Some(Axis::Y), Some(Axis::Z), Some(Axis::C), Some(Axis::A)]
+    }
+
+    fn tcp_joints(&self) -> Vec<usize> {
+        vec![C, A]
     }
 
     fn jacobian(&self, q: &Joints, tool: &Tool) -> Result<Jacobian, KinematicsError> {

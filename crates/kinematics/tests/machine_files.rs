@@ -208,11 +208,6 @@ fn bad_fields_are_named() {
             "not one of",
         ),
         (
-            edit(mill, "[kinematics]", "axis_tolerance_deg", "radius = 5.0"),
-            "kinematics.radius",
-            "not a parameter of cartesian",
-        ),
-        (
             edit(
                 mill,
                 "[kinematics]",
@@ -283,11 +278,6 @@ fn bad_fields_are_named() {
             "`sometimes` is not `program` or `always`",
         ),
         (
-            edit(ac, "[kinematics]", "pivot", "pivot_to_gauge = 1.0"),
-            "kinematics.pivot_to_gauge",
-            "not a parameter of table-ac",
-        ),
-        (
             edit(ac, "name = \"a\"", "kind", "kind = \"linear\""),
             "joint[3].kind",
             "rotary joint",
@@ -347,11 +337,6 @@ fn bad_fields_are_named() {
         (f.as_str(), r.as_str()),
         ("kinematics.max_joint_angle_deg", "must be in (0, 180)")
     );
-    let (f, _) = field_error(&mill.replace(
-        "[kinematics]\n",
-        "[kinematics]\nmax_joint_angle_deg = 20.0\n",
-    ));
-    assert_eq!(f, "kinematics.max_joint_angle_deg");
     // Joint count per model.
     let (f, r) = field_error(&mill[..mill.rfind("[[joint]]").unwrap()]);
     assert_eq!(f, "joint");
@@ -390,6 +375,122 @@ fn toml_level_errors_name_the_field() {
     assert!(m.contains("pivot") || m.contains("3"), "{m}");
     // not TOML at all
     toml_error("this is not toml = = =");
+}
+
+/// The 1-based line of `[kinematics]` in a built-in file (where a section error points).
+fn kinematics_line(text: &str) -> usize {
+    1 + text.lines().position(|l| l == "[kinematics]").unwrap()
+}
+
+/// Each model reads its own `[kinematics]` fields: a typo, or a field of another model, is
+/// refused with its name, the model's own fields, the model and the line of the section.
+#[test]
+fn each_model_refuses_an_unknown_field_of_its_section() {
+    // (machine, a field of another model, one of its own fields serde lists)
+    let cases = [
+        ("mill3", "radius = 5.0", "axis_tolerance_deg"),
+        ("mill3", "max_joint_angle_deg = 20.0", "axis_tolerance_deg"),
+        ("yzca", "pivot = [0.0, 0.0, 0.0]", "pivot_to_gauge"),
+        ("table-ac", "pivot_to_gauge = 1.0", "c_offset"),
+        ("table-bc", "centre_tolerance_mm = 1.0", "c_offset"),
+        ("linear-delta", "pole_cone_deg = 1.0", "rod_length"),
+    ];
+    for (name, line, own) in cases {
+        let text = Machine::builtin_text(name).unwrap();
+        let kind = Machine::builtin(name).unwrap().kinematics.type_name();
+        let field = line.split(' ').next().unwrap();
+        for bad in [line.to_owned(), format!("{field}x = 1.0")] {
+            let m = toml_error(&text.replace("[kinematics]\n", &format!("[kinematics]\n{bad}\n")));
+            let key = bad.split(' ').next().unwrap();
+            assert!(m.contains(&format!("unknown field `{key}`")), "{name}: {m}");
+            assert!(m.contains(&format!("`{own}`")), "{name}: {m}");
+            assert!(m.contains(&format!("(for type `{kind}`)")), "{name}: {m}");
+            assert!(
+                m.contains(&format!("line {}", kinematics_line(text))),
+                "{name}: {m}"
+            );
+        }
+    }
+}
+
+/// `type` and `tcp` are the machine's keys: every model's section lets them through.
+#[test]
+fn every_model_accepts_the_machine_keys_of_kinematics() {
+    use tezgah_kinematics::TcpSwitch;
+    for name in builtin_names() {
+        let text = Machine::builtin_text(name)
+            .unwrap()
+            .replace("[kinematics]\n", "[kinematics]\ntcp = \"always\"\n");
+        // table-ac already has a `tcp` line: keep one.
+        let text = text.replace("tcp = \"program\"", "");
+        let m = Machine::from_toml_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(m.tcp, TcpSwitch::Always, "{name}");
+    }
+}
+
+/// A field a model needs, left out, is named with the section and the model.
+#[test]
+fn each_model_names_a_missing_required_field() {
+    let cases = [
+        ("yzca", "pivot_to_gauge"),
+        ("table-ac", "pivot"),
+        ("table-bc", "pivot"),
+        ("linear-delta", "radius"),
+        ("linear-delta", "rod_length"),
+    ];
+    for (name, key) in cases {
+        let text = Machine::builtin_text(name).unwrap();
+        let (f, r) = field_error(&edit(text, "[kinematics]", key, "# left out"));
+        assert_eq!(f, format!("kinematics.{key}"), "{name}");
+        assert_eq!(r, format!("missing (required by {name})"));
+    }
+}
+
+/// Each model's joint-to-axis map and the joints TCP control takes from the program: the map
+/// gives the program axes, and `tcp_angles` returns exactly the joints `tcp_joints` names.
+#[test]
+fn models_declare_their_joint_axes_and_tcp_joints() {
+    use tezgah_geom::Axis::{self, *};
+    let some = |a: &[Axis]| a.iter().copied().map(Some).collect::<Vec<_>>();
+    let cases = [
+        ("mill3", some(&[X, Y, Z]), Vec::<usize>::new()),
+        ("yzca", some(&[Y, Z, C, A]), vec![2, 3]),
+        ("table-ac", some(&[X, Y, Z, A, C]), vec![3, 4]),
+        ("table-bc", some(&[X, Y, Z, B, C]), vec![3, 4]),
+        ("linear-delta", vec![None; 3], vec![]),
+    ];
+    for (name, axes, tcp) in cases {
+        let m = Machine::builtin(name).unwrap();
+        assert_eq!(m.kinematics.joint_axes(), axes, "{name}");
+        assert_eq!(m.kinematics.tcp_joints(), tcp, "{name}");
+        let q = m
+            .from_file_units(&[1.5, -2.0, 3.25, 40.0, -50.0][..m.joints.len()])
+            .unwrap();
+        let want: Vec<f64> = tcp.iter().map(|&i| q[i]).collect();
+        assert_eq!(m.kinematics.tcp_angles(&q).as_slice(), want, "{name}");
+    }
+    // A Cartesian machine's extra joints carry the axis their names give, or none.
+    let mill = Machine::builtin_text("mill3").unwrap();
+    let extra = |name: &str| {
+        format!(
+            "{mill}\n[[joint]]\nname = \"{name}\"\nkind = \"rotary\"\nendless = true\n\
+             max_velocity = 90.0\nmax_acceleration = 900.0\nmax_jerk = 9000.0\n"
+        )
+    };
+    let m = Machine::from_toml_str(&extra("B")).unwrap();
+    assert_eq!(m.kinematics.joint_axes(), some(&[X, Y, Z, B]));
+    assert_eq!(m.tcp_axes().unwrap(), [B]);
+    assert_eq!(m.program_axes(), [X, Y, Z, B]);
+    let m = Machine::from_toml_str(&extra("spindle")).unwrap();
+    assert_eq!(m.kinematics.joint_axes()[3], None);
+    match m.tcp_axes() {
+        Err(MachineError::Invalid { field, reason }) => {
+            assert_eq!(field, "joint[3].name");
+            assert!(reason.contains("no program axis"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(m.program_axes(), [X, Y, Z]);
 }
 
 proptest! {

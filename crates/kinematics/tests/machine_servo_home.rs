@@ -169,3 +169,30 @@ fn explicit_sequence_allows_joints_together() {
     assert_eq!(m.joints[2].home.search_velocity, -5.0);
     assert_eq!(m.joints[2].home.latch_velocity, 0.5);
 }
+
+/// Z is found by the model's joint-to-axis map, not by a joint's name: Y-Z-C-A's joint 1 and a
+/// table's joint 2 home first whatever they are called; a delta's carriages carry no axis and
+/// home in file order.
+#[test]
+fn the_joint_that_carries_z_homes_first_whatever_its_name() {
+    let seq = |text: &str| -> Vec<u32> {
+        let m = Machine::from_toml_str(text).unwrap();
+        m.joints.iter().map(|j| j.home.sequence).collect()
+    };
+    let rename = |name: &str, names: &[(&str, &str)]| {
+        let mut text = Machine::builtin_text(name).unwrap().to_owned();
+        for (from, to) in names {
+            text = text.replace(&format!("name = \"{from}\""), &format!("name = \"{to}\""));
+        }
+        text
+    };
+    let yzca = rename(
+        "yzca",
+        &[("y", "radial"), ("z", "vertical"), ("c", "table")],
+    );
+    assert_eq!(seq(&yzca), [1, 0, 2, 3]);
+    let ac = rename("table-ac", &[("z", "spindle"), ("x", "z")]);
+    assert_eq!(seq(&ac), [1, 2, 0, 3, 4]);
+    let delta = rename("linear-delta", &[("q2", "z")]);
+    assert_eq!(seq(&delta), [0, 1, 2]);
+}
