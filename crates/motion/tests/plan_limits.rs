@@ -176,9 +176,9 @@ fn limits_hold_every_cartesian_joint_on_random_curved_segments() {
 /// here by sampling α, the planner's closed form being what is checked.
 fn speed_times_acceleration(v: f64, a: f64, j: f64) -> f64 {
     let top = a.min((2.0 * j * v).sqrt());
-    (0..=100_000)
+    (0..=10_000)
         .map(|k| {
-            let alpha = top * k as f64 / 100_000.0;
+            let alpha = top * k as f64 / 10_000.0;
             (v - alpha * alpha / (2.0 * j)) * alpha
         })
         .fold(0.0, f64::max)
@@ -227,8 +227,8 @@ fn tight_corner_blends_get_the_pure_curvature_speed() {
                 let acc = g2 * v * v + g1 * a;
                 let jerk = g3 * v * v * v + 3.0 * g2 * p + g1 * j;
                 assert!(acc <= pm.max_acceleration[i] * (1.0 + 1e-12), "a {acc}");
-                // (The sampled peak is within ~1e-10 of the true one.)
-                assert!(jerk <= pm.max_jerk[i] * (1.0 + 1e-9), "j {jerk}");
+                // (The sampled peak is within ~1e-8 of the true one.)
+                assert!(jerk <= pm.max_jerk[i] * (1.0 + 1e-7), "j {jerk}");
             }
         }
     }

@@ -45,8 +45,8 @@ pub struct PlanMachine {
     /// The model (forward and inverse kinematics).
     pub model: Model,
     /// Program axes → joints where the joints follow them directly: a Cartesian machine's
-    /// joints, or with TCP off the joints of a machine whose rotaries orient the tool (by
-    /// joint name; `None` if a name is not an axis letter).
+    /// joints, or with TCP off the joints of a machine whose rotaries orient the tool (the
+    /// model's [`Kinematics::joint_axes`]; `None` where a joint carries no program axis).
     pub map: Option<Vec<JointMap>>,
     pub max_velocity: Vec<f64>,
     pub max_acceleration: Vec<f64>,
@@ -66,33 +66,19 @@ impl PlanMachine {
                 kind: machine.kinematics.type_name(),
                 supported: "machines whose rotary joints carry program axes",
             })?;
-        let by_name: Option<Vec<JointMap>> = machine
-            .joints
-            .iter()
-            .map(|j| match j.name.to_ascii_lowercase().as_str() {
-                "x" => Some(JointMap::Tip(0)),
-                "y" => Some(JointMap::Tip(1)),
-                "z" => Some(JointMap::Tip(2)),
-                "a" => Some(JointMap::Rotary(0)),
-                "b" => Some(JointMap::Rotary(1)),
-                "c" => Some(JointMap::Rotary(2)),
-                _ => None,
+        // The model's own joint-to-axis map: a joint that no program axis names (a delta's
+        // carriages) leaves the joints to the inverse kinematics.
+        let map: Option<Vec<JointMap>> = machine
+            .kinematics
+            .joint_axes()
+            .into_iter()
+            .map(|axis| {
+                axis.map(|x| match x.index() {
+                    i @ 0..=2 => JointMap::Tip(i),
+                    i => JointMap::Rotary(i - 3),
+                })
             })
             .collect();
-        let map = match machine.kinematics {
-            // The first three joints are x y z whatever their names; extras by name (a, b or
-            // c, which `tcp_axes` has checked).
-            Model::Cartesian(_) => Some(
-                (0..machine.joints.len())
-                    .map(|i| match i {
-                        0..=2 => JointMap::Tip(i),
-                        _ => JointMap::Rotary(axes[i - 3].index() - 3),
-                    })
-                    .collect(),
-            ),
-            Model::LinearDelta(_) => None,
-            _ => by_name,
-        };
         let (mut v, mut a, mut j) = (vec![], vec![], vec![]);
         for joint in &machine.joints {
             let s = joint.to_internal();
