@@ -62,13 +62,45 @@ pub enum Planned {
     Stop { line: u32 },
 }
 
-struct Group {
+/// Consecutive segments timed by one profile, each with its own path coordinate where the
+/// profile enters and leaves it (the first may be entered, the last left, part way along).
+struct Stretches {
     segments: Vec<Arc<Segment>>,
-    /// Each segment's own path coordinate where the group enters and leaves it.
     starts: Vec<f64>,
     ends: Vec<f64>,
-    length: f64,
+    /// Whether the last segment is left part way (a speed step follows on it).
     partial_end: bool,
+}
+
+impl Stretches {
+    /// The stretch `range` of `seg` alone.
+    fn one(seg: Arc<Segment>, range: (f64, f64), partial_end: bool) -> Stretches {
+        Stretches {
+            segments: vec![seg],
+            starts: vec![range.0],
+            ends: vec![range.1],
+            partial_end,
+        }
+    }
+
+    fn push(&mut self, seg: Arc<Segment>, range: (f64, f64)) {
+        self.segments.push(seg);
+        self.starts.push(range.0);
+        self.ends.push(range.1);
+    }
+
+    fn length(&self) -> f64 {
+        self.starts.iter().zip(&self.ends).map(|(a, b)| b - a).sum()
+    }
+
+    fn line(&self) -> u32 {
+        self.segments.first().map_or(0, |s| line_of(s))
+    }
+}
+
+struct Group {
+    stretches: Stretches,
+    length: f64,
     limits: Limits,
     end_cap: f64,
     /// Highest entry speed from which the rest of the window can still stop (backward pass):
@@ -86,11 +118,7 @@ enum Entry {
 }
 
 struct Open {
-    segments: Vec<Arc<Segment>>,
-    starts: Vec<f64>,
-    ends: Vec<f64>,
-    /// Whether the last segment is left part way (a speed step follows on it).
-    partial_end: bool,
+    stretches: Stretches,
     v: f64,
     a: f64,
     j: f64,
@@ -109,10 +137,7 @@ impl Open {
         partial_end: bool,
     ) -> Open {
         Open {
-            segments: vec![seg],
-            starts: vec![range.0],
-            ends: vec![range.1],
-            partial_end,
+            stretches: Stretches::one(seg, range, partial_end),
             v: limits.max_velocity(),
             a: limits.max_acceleration(),
             j: limits.max_jerk(),
@@ -365,7 +390,7 @@ impl Planner {
         let joins = |o: &Open| {
             let vg = o.v.min(v).min(o.last_end_cap);
             let close = |x: f64, y: f64, m: f64| m >= r * x.max(y);
-            o.segments.len() < self.options.max_group
+            o.stretches.segments.len() < self.options.max_group
                 && o.last_end_cap > 0.0
                 && close(o.v, v, vg)
                 && close(o.a, a, o.a.min(a))
@@ -373,13 +398,11 @@ impl Planner {
                 && inside_group(&o.last, &geom, o.a.max(a), &self.machine, &self.options)
         };
         match self.open.take() {
-            Some(mut o) if joins(&o) && !o.partial_end => {
+            Some(mut o) if joins(&o) && !o.stretches.partial_end => {
                 o.v = o.v.min(v).min(o.last_end_cap);
                 o.a = o.a.min(a);
                 o.j = o.j.min(j);
-                o.segments.push(seg);
-                o.starts.push(range.0);
-                o.ends.push(range.1);
+                o.stretches.push(seg, range);
                 o.last = geom;
                 o.last_end_cap = end_cap;
                 self.open = Some(o);
@@ -407,18 +430,15 @@ impl Planner {
     }
 
     fn close(&mut self, o: Open, end_cap: f64) -> Result<(), PlanError> {
-        let line = o.segments.first().map_or(0, |s| line_of(s));
+        let line = o.stretches.line();
         let limits = Limits::new(o.v, o.a, o.j).map_err(|e| PlanError::NoLimit {
             line,
             reason: e.to_string(),
         })?;
-        let length = o.starts.iter().zip(&o.ends).map(|(a, b)| b - a).sum();
+        let length = o.stretches.length();
         self.window.push_back(Entry::Group(Group {
-            segments: o.segments,
-            starts: o.starts,
-            ends: o.ends,
+            stretches: o.stretches,
             length,
-            partial_end: o.partial_end,
             limits,
             end_cap,
             backward: f64::NAN,
@@ -453,7 +473,7 @@ impl Planner {
             match entry {
                 Entry::Group(g) => {
                     let err = |e| PlanError::Profile {
-                        line: g.segments[0].line,
+                        line: g.stretches.line(),
                         source: e,
                     };
                     let cap = g.end_cap.min(g.limits.max_velocity());
@@ -497,7 +517,7 @@ impl Planner {
             Some(Entry::Group(n)) => (n.backward, n.aimed),
             _ => (0.0, 0.0),
         };
-        let line = g.segments[0].line;
+        let line = g.stretches.line();
         let err = |source| PlanError::Profile { line, source };
         let v0 = self.v_start.min(g.limits.max_velocity());
         let cap = g.end_cap.min(g.limits.max_velocity()).max(0.0);
@@ -511,19 +531,25 @@ impl Planner {
             Err(_) => solve_at_most(g.length, v0, cap.min(next_start), &g.limits).map_err(err)?,
         };
         self.v_start = profile.end().v.max(0.0);
-        let mut offsets = Vec::with_capacity(g.starts.len());
+        let Stretches {
+            segments,
+            starts,
+            ends,
+            partial_end,
+        } = g.stretches;
+        let mut offsets = Vec::with_capacity(starts.len());
         let mut acc = 0.0;
-        for (a, b) in g.starts.iter().zip(&g.ends) {
+        for (a, b) in starts.iter().zip(&ends) {
             offsets.push(acc - a);
             acc += b - a;
         }
         self.out.push_back(Planned::Motion(Box::new(Piece {
-            segments: g.segments,
+            segments,
             offsets,
-            lengths: g.ends,
+            lengths: ends,
             profile,
             limits: g.limits,
-            partial_end: g.partial_end,
+            partial_end,
         })));
         Ok(())
     }
