@@ -509,3 +509,104 @@ fn the_report_measures_against_the_program_and_gives_the_slack() {
     // The last move alone: 150 mm at 10 mm/s, 15 s at the feed.
     assert!(bins[10] > 15.0 - 0.06 && bins[10] < moving, "{bins:?}");
 }
+
+/// Runs `program` on mill3 with the probe file `probe`; the output and the report's path
+/// (the samples CSV beside it, `.csv`).
+fn run_probing(
+    name: &str,
+    program: &str,
+    probe: &str,
+) -> (std::process::Output, std::path::PathBuf) {
+    let (ngc, toml, json, csv) = (
+        tmp(&format!("{name}.ngc")),
+        tmp(&format!("{name}.toml")),
+        tmp(&format!("{name}.json")),
+        tmp(&format!("{name}.csv")),
+    );
+    std::fs::write(&ngc, program).unwrap();
+    std::fs::write(&toml, probe).unwrap();
+    let out = tezgah()
+        .arg("run")
+        .arg(&ngc)
+        .arg("--probe")
+        .arg(&toml)
+        .arg("--report")
+        .arg(&json)
+        .arg("--samples")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    (out, json)
+}
+
+/// The last row of a samples CSV (t, line, x, y, z, …).
+fn last_sample(json: &std::path::Path) -> Vec<f64> {
+    let text = std::fs::read_to_string(json.with_extension("csv")).unwrap();
+    let last = text.lines().last().unwrap();
+    last.split(',').map(|v| v.parse().unwrap()).collect()
+}
+
+/// The report's probe `k`: trip point (mm) and rest pose.
+fn probe_at(report: &serde_json::Value, k: usize) -> (Vec<f64>, Vec<f64>) {
+    let p = &report["probes"][k];
+    let v = |key: &str| -> Vec<f64> {
+        p[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    (v("trip_mm"), v("stopped"))
+}
+
+/// G38.2 down onto the plane z = −5 with a 2 mm ball at three feeds: the input is read once a
+/// period, so each trip is at most one period's travel (F/60 · 1 ms) past the contact
+/// z = −5 + 2, and the stop from that feed is the jerk-limited one of mill3's Z
+/// (J = 25000 mm/s³, from cruise: d = v·√(v/J)). The program then zeroes G54 Z at the rest
+/// point (G10 L20) and goes 1 mm above the probed point (#5063, program coordinates of the
+/// probe time), ending where the closed form says; the verifier holds every joint within its
+/// limits through the trips and stops.
+#[test]
+fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
+    let program = "G21 G90 G17\nG0 X10 Y10 Z10\nF120 G38.2 Z-20\nG0 Z10\nF300 G38.2 Z-20\n\
+                   G0 Z10\nF600 G38.2 Z-20\nG10 L20 P1 Z0\nG0 Z5\nG1 X20 F600\n\
+                   G0 X[10 + 5 * #5070] Z[#5063 + 1]\nM2\n";
+    let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
+    let (out, json) = run_probing("probe-plane", program, probe);
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-plane");
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("probe    G38.2 line 3: tripped at X10.0000 Y10.0000 Z-3.00"),
+        "{stdout}"
+    );
+    let mut last = (0.0, 0.0);
+    for (k, feed) in [120.0, 300.0, 600.0].into_iter().enumerate() {
+        let (trip, rest) = probe_at(&report, k);
+        let v = feed / 60.0;
+        assert_eq!((trip[0], trip[1]), (10.0, 10.0));
+        assert!(
+            trip[2] <= -3.0 && trip[2] > -3.0 - v * 0.001 - 1e-9,
+            "{feed}: {trip:?}"
+        );
+        let stop = v * (v / 25000.0).sqrt();
+        assert!(
+            (trip[2] - rest[2] - stop).abs() < 1e-9,
+            "{feed}: stopped {} past the trip, closed form {stop}",
+            trip[2] - rest[2]
+        );
+        last = (trip[2], rest[2]);
+    }
+    // Machine Z at the end: G54 Z is the rest point's machine Z; the last move goes to
+    // #5063 + 1 in it, X to 10 + 5·#5070 = 15.
+    let end = last_sample(&json);
+    let expected = last.1 + last.0 + 1.0;
+    assert_eq!(end[2], 15.0);
+    assert!(
+        (end[4] - expected).abs() < 1e-9,
+        "end z {}, closed form {expected}",
+        end[4]
+    );
+}

@@ -15,6 +15,7 @@ pub mod manual;
 pub mod mdi;
 pub mod overspeed;
 pub mod path_stop;
+pub mod probe;
 pub mod program;
 pub mod realtime;
 pub mod ring;

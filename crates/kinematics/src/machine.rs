@@ -97,6 +97,8 @@ struct RawMachine {
     path: RawPath,
     #[serde(default)]
     joint: Vec<RawJoint>,
+    #[serde(default)]
+    probe: Option<crate::probe::RawProbe>,
 }
 
 #[derive(Deserialize)]
@@ -327,6 +329,8 @@ pub struct Machine {
     pub joints: Vec<Joint>,
     /// `[kinematics] tcp`: when tool-centre-point control is on.
     pub tcp: TcpSwitch,
+    /// `[probe]` (optional): the simulated probe G38 moves touch.
+    pub probe: Option<crate::probe::ProbeModel>,
 }
 
 impl Machine {
@@ -545,6 +549,7 @@ fn build(raw: RawMachine) -> Result<Machine, MachineError> {
         path,
         joints,
         tcp,
+        probe: raw.probe.map(|p| p.build("probe.")).transpose()?,
     })
 }
 
