@@ -570,7 +570,8 @@ fn probe_at(report: &serde_json::Value, k: usize) -> (Vec<f64>, Vec<f64>) {
 #[test]
 fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
     let program = "G21 G90 G17\nG0 X10 Y10 Z10\nF120 G38.2 Z-20\nG0 Z10\nF300 G38.2 Z-20\n\
-                   G0 Z10\nF600 G38.2 Z-20\nG10 L20 P1 Z0\nG0 Z5\nG1 X20 F600\n\
+                   G0 Z10\nF600 G38.2 Z-20\nG0 Z-2.99\nG38.2 Z-20\n\
+                   G10 L20 P1 Z0\nG0 Z5\nG1 X20 F600\n\
                    G0 X[10 + 5 * #5070] Z[#5063 + 1]\nM2\n";
     let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
     let (out, json) = run_probing("probe-plane", program, probe);
@@ -582,7 +583,6 @@ fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
         stdout.contains("probe    G38.2 line 3: tripped at X10.0000 Y10.0000 Z-3.00"),
         "{stdout}"
     );
-    let mut last = (0.0, 0.0);
     for (k, feed) in [120.0, 300.0, 600.0].into_iter().enumerate() {
         let (trip, rest) = probe_at(&report, k);
         let v = feed / 60.0;
@@ -597,8 +597,13 @@ fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
             "{feed}: stopped {} past the trip, closed form {stop}",
             trip[2] - rest[2]
         );
-        last = (trip[2], rest[2]);
     }
+    // From 0.01 mm above the contact the trip comes while the speed still ramps up (jerk
+    // phase: a ≈ J·∛(6·0.01/J) ≈ 335 mm/s²); the stop starts from that acceleration.
+    let (trip, rest) = probe_at(&report, 3);
+    assert!(trip[2] <= -3.0 && trip[2] > -3.0 - 10.0 * 0.001, "{trip:?}");
+    assert!(rest[2] < trip[2]);
+    let last = (trip[2], rest[2]);
     // Machine Z at the end: G54 Z is the rest point's machine Z; the last move goes to
     // #5063 + 1 in it, X to 10 + 5·#5070 = 15.
     let end = last_sample(&json);
@@ -609,4 +614,99 @@ fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
         "end z {}, closed form {expected}",
         end[4]
     );
+}
+
+/// A machine file with a `[probe]` section: a box (X 20…40, Y −10…10, Z −30…0) and a 3 mm
+/// ball. G38.2 +X trips on the −X face at x = 20 − 3 (within a period's travel past it) and
+/// stops in mill3's X jerk-limited distance v·√(v/J), J = 50000 mm/s³; G38.4 backs off until
+/// the contact breaks, inside the same period's travel; G38.2 −Y trips on the +Y face at
+/// y = 10 + 3; G38.3 clear of the box runs to its end and the move after it uses #5070 = 0.
+#[test]
+fn probing_a_box_from_the_machine_file_finds_its_walls() {
+    let machine =
+        format!(
+        "{}\n[probe]\ntool_radius_mm = 3\n[[probe.box]]\nmin = [20, -10, -30]\nmax = [40, 10, 0]\n",
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines/mill3.toml"))
+            .unwrap()
+    );
+    let (ngc, file, json, csv) = (
+        tmp("probe-box.ngc"),
+        tmp("probe-box-machine.toml"),
+        tmp("probe-box.json"),
+        tmp("probe-box.csv"),
+    );
+    std::fs::write(&file, machine).unwrap();
+    std::fs::write(
+        &ngc,
+        "G21 G90\nG0 X0 Y0 Z-5\nF200 G38.2 X50\nG38.4 X0 F100\nG0 X30 Y30\nF200 G38.2 Y0\n\
+         G0 Y30\nG38.3 Y40\nG0 X[#5070 * 100 + 1]\nM2\n",
+    )
+    .unwrap();
+    let out = tezgah()
+        .arg("run")
+        .arg(&ngc)
+        .arg("--machine")
+        .arg(&file)
+        .arg("--report")
+        .arg(&json)
+        .arg("--samples")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-box");
+    let (v_in, v_out) = (200.0 / 60.0, 100.0 / 60.0);
+    let (trip, rest) = probe_at(&report, 0);
+    assert!(trip[0] >= 17.0 && trip[0] < 17.0 + v_in * 0.001, "{trip:?}");
+    let stop = v_in * (v_in / 50000.0f64).sqrt();
+    assert!((rest[0] - trip[0] - stop).abs() < 1e-9, "{rest:?}");
+    let (trip, _) = probe_at(&report, 1);
+    assert!(
+        trip[0] < 17.0 && trip[0] >= 17.0 - v_out * 0.001,
+        "{trip:?}"
+    );
+    let (trip, _) = probe_at(&report, 2);
+    assert!(trip[1] <= 13.0 && trip[1] > 13.0 - v_in * 0.001, "{trip:?}");
+    let untripped = &report["probes"][3];
+    assert_eq!(
+        (&untripped["tripped"], &untripped["trip_mm"]),
+        (&false.into(), &serde_json::Value::Null)
+    );
+    assert_eq!(
+        untripped["stopped"],
+        serde_json::json!([30.0, 40.0, -5.0, 0.0, 0.0, 0.0])
+    );
+    assert_eq!(last_sample(&json)[2..5], [1.0, 40.0, -5.0]);
+}
+
+/// LinuxCNC's motion errors at the probe's line: G38.2 that reaches its end, G38.4 that never
+/// leaves contact, G38.2 starting in contact, G38.5 starting clear.
+#[test]
+fn probing_errors_name_the_probe_line() {
+    let probe = "tool_radius_mm = 1\n[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 1]\n";
+    let cases = [
+        (
+            "G21 G0 Z10\nF100 G38.2 Z5\nM2\n",
+            "probe-miss.ngc:2:6: G38.2 move finished without making contact.",
+        ),
+        (
+            "G21 G0 Z0.5\nF100 G38.4 Z0.2\nM2\n",
+            "probe-stay.ngc:2:6: G38.4 move finished without breaking contact.",
+        ),
+        (
+            "G21 G0 Z0.5\nF100 G38.2 Z-1\nM2\n",
+            "probe-on.ngc:2:6: Probe is already tripped when starting G38.2 or G38.3 move",
+        ),
+        (
+            "G21 G0 Z5\nF100 G38.5 Z10\nM2\n",
+            "probe-off.ngc:2:6: Probe is already clear when starting G38.4 or G38.5 move",
+        ),
+    ];
+    for (program, message) in cases {
+        let name = message.split('.').next().unwrap();
+        let (out, _) = run_probing(name, program, probe);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(stderr.contains(message), "{stderr}");
+    }
 }
