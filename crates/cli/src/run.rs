@@ -342,7 +342,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let mut sink = sink;
     let (duration, segments, axis) =
         crate::run_probe::play(&probed, &machine, tolerance, &options, &mut sink)?;
-    drop(sink);
     let axis = axis.unwrap_or(AxisFigures {
         deviation_deg: 0.0,
         tolerance_deg: 0.0,

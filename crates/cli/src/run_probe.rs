@@ -96,7 +96,7 @@ pub fn interpret_probing(
         run_items(
             built.items,
             built.pm,
-            options.clone(),
+            *options,
             (tip, [start.0[3], start.0[4], start.0[5]]),
             |s: &Sample, seg: &[Arc<Segment>]| samples.push((*s, seg.to_vec())),
         )
@@ -164,7 +164,7 @@ pub fn play(
         run_items(
             items,
             pm,
-            options.clone(),
+            *options,
             (tip, [start.0[3], start.0[4], start.0[5]]),
             |s: &Sample, seg: &[Arc<Segment>]| emit(s, seg, &mut next, base),
         )

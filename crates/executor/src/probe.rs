@@ -112,7 +112,7 @@ pub fn run_probe_move(
     let stop = path_stop(&samples, k, &seg, machine, options)?;
     let mut out: Vec<Sampled> = samples[..=k].to_vec();
     let (rotary_start, rotary_end) = (first.rotary, samples[samples.len() - 1].0.rotary);
-    let mut joints = trip.joints.clone();
+    let mut joints = trip.joints;
     let steps = (stop.duration() / options.period).ceil() as u64;
     let mut s_rest = s_trip;
     for i in 1..=steps {
@@ -133,7 +133,7 @@ pub fn run_probe_move(
                 line,
                 tip,
                 rotary,
-                joints: joints.clone(),
+                joints,
                 feed: state.v,
             },
             vec![seg.clone()],
@@ -179,4 +179,162 @@ fn path_stop(
     PathStop::new(v0, a0.clamp(-a_max, a_max), a_max, j_max)
         .or_else(|| PathStop::new(v0, 0.0, a_max, j_max))
         .ok_or_else(|| error(format!("no stop from {v0} mm/s")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use tezgah_geom::{Move, MoveKind, Pose};
+    use tezgah_kinematics::probe::Solid;
+    use tezgah_kinematics::Machine;
+    use tezgah_motion::path::smooth::{self, SmoothOptions};
+
+    /// A straight feed from `start` to `end` at `feed` mm/min on mill3, planned and sampled
+    /// whole at 1 ms, then run against `model`.
+    fn probe_on_mill3(
+        start: Vec3,
+        end: Vec3,
+        feed: f64,
+        model: &ProbeModel,
+        seek: Seek,
+    ) -> (ProbeRun, Machine) {
+        let machine = Machine::default_machine();
+        let pm = PlanMachine::from_machine(&machine).unwrap();
+        let pose = |p: Vec3| Pose([p.x, p.y, p.z, 0.0, 0.0, 0.0]);
+        let opts = SmoothOptions::for_machine(&machine.path, &pm, 0.01, pose(start));
+        let moves = [
+            Move {
+                line: 1,
+                kind: MoveKind::FeedRate { value: feed },
+            },
+            Move {
+                line: 2,
+                kind: MoveKind::Feed { end: pose(end) },
+            },
+        ];
+        let items = smooth::build(moves, &opts).unwrap();
+        let options = PlanOptions {
+            period: 0.001,
+            ..PlanOptions::default()
+        };
+        let mut samples = Vec::new();
+        tezgah_motion::interpolate::run(items, pm.clone(), options, (start, [0.0; 3]), |s, seg| {
+            samples.push((*s, seg.to_vec()))
+        })
+        .unwrap();
+        let run = run_probe_move(samples, model, seek, &pm, &options).unwrap();
+        (run, machine)
+    }
+
+    /// Every joint's speed, acceleration and jerk by finite differences of the samples at the
+    /// period (as the run's verifier takes them) within 0.5 % of its limits.
+    fn assert_within_limits(run: &ProbeRun, machine: &Machine) {
+        let t = 0.001;
+        for (i, joint) in machine.joints.iter().enumerate() {
+            let q: Vec<f64> = run.samples.iter().map(|s| s.0.joints[i]).collect();
+            let d = |x: &[f64]| -> Vec<f64> { x.windows(2).map(|w| (w[1] - w[0]) / t).collect() };
+            let (v, a) = (d(&q), d(&d(&q)));
+            let j = d(&a);
+            let peak = |x: &[f64]| x.iter().fold(0.0f64, |m, y| m.max(y.abs()));
+            assert!(peak(&v) <= joint.max_velocity * 1.005, "{} v", joint.name);
+            assert!(
+                peak(&a) <= joint.max_acceleration * 1.005,
+                "{} a {}",
+                joint.name,
+                peak(&a)
+            );
+            assert!(
+                peak(&j) <= joint.max_jerk * 1.005,
+                "{} j {}",
+                joint.name,
+                peak(&j)
+            );
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// Down onto the plane z = h with a ball of radius r: the trip is the first sample at
+        /// or below z = h + r (so at most one period's travel past it), the machine comes to
+        /// rest below it within the joints' limits, and the fractions place both on the move.
+        #[test]
+        fn a_z_probe_trips_within_a_period_of_the_contact(
+            h in -40.0..0.0f64,
+            r in 0.0..5.0f64,
+            above in 0.05..15.0f64,
+            feed in 30.0..3000.0f64,
+        ) {
+            let model = ProbeModel {
+                tool_radius: r,
+                solids: vec![Solid::HalfSpace {
+                    point: Vec3::new(0.0, 0.0, h),
+                    normal: Vec3::z(),
+                }],
+            };
+            let start = Vec3::new(5.0, -3.0, h + r + above);
+            let end = Vec3::new(5.0, -3.0, h - 10.0);
+            let (run, machine) = probe_on_mill3(start, end, feed, &model, Seek::Contact);
+            let trip = run.trip.unwrap();
+            let contact = h + r;
+            prop_assert!(trip.z <= contact + 1e-12);
+            prop_assert!(trip.z > contact - feed / 60.0 * 0.001 - 1e-9, "{} vs {contact}", trip.z);
+            let ProbeOutcome::Tripped { at, stopped } = run.outcome else {
+                panic!("{:?}", run.outcome)
+            };
+            let length = start.z - end.z;
+            prop_assert!((start.z - at * length - trip.z).abs() < 1e-9);
+            let rest = run.samples.last().unwrap().0;
+            prop_assert!((start.z - stopped * length - rest.tip.z).abs() < 1e-9);
+            prop_assert!(rest.tip.z < trip.z && rest.feed == 0.0);
+            assert_within_limits(&run, &machine);
+        }
+    }
+
+    /// Off a box's −X face (x = 20, ball 3): G38.4 from inside the contact trips as the ball
+    /// leaves it, at x < 17 within a period's travel; a move that never changes the input
+    /// completes; one that starts in the sought state is answered at once.
+    #[test]
+    fn release_completion_and_a_probe_already_there() {
+        let model = ProbeModel {
+            tool_radius: 3.0,
+            solids: vec![Solid::Box {
+                min: Vec3::new(20.0, -10.0, -30.0),
+                max: Vec3::new(40.0, 10.0, 0.0),
+            }],
+        };
+        let z = -5.0;
+        let (run, machine) = probe_on_mill3(
+            Vec3::new(18.0, 0.0, z),
+            Vec3::new(0.0, 0.0, z),
+            100.0,
+            &model,
+            Seek::Release,
+        );
+        let trip = run.trip.unwrap();
+        assert!(
+            trip.x < 17.0 && trip.x >= 17.0 - 100.0 / 60.0 * 0.001,
+            "{trip:?}"
+        );
+        assert_within_limits(&run, &machine);
+        let (run, _) = probe_on_mill3(
+            Vec3::new(0.0, 0.0, z),
+            Vec3::new(10.0, 0.0, z),
+            300.0,
+            &model,
+            Seek::Contact,
+        );
+        assert_eq!((run.outcome, run.trip), (ProbeOutcome::Completed, None));
+        assert_eq!(run.samples.last().unwrap().0.tip, Vec3::new(10.0, 0.0, z));
+        let (run, _) = probe_on_mill3(
+            Vec3::new(0.0, 0.0, z),
+            Vec3::new(10.0, 0.0, z),
+            300.0,
+            &model,
+            Seek::Release,
+        );
+        assert_eq!(run.outcome, ProbeOutcome::AlreadyThere);
+        assert!(run.samples.is_empty());
+    }
 }
