@@ -510,33 +510,33 @@ fn the_report_measures_against_the_program_and_gives_the_slack() {
     assert!(bins[10] > 15.0 - 0.06 && bins[10] < moving, "{bins:?}");
 }
 
-/// Runs `program` on mill3 with the probe file `probe`; the output and the report's path
-/// (the samples CSV beside it, `.csv`).
+/// Runs `program` with `args` (the probe's source: `--probe FILE` or `--machine FILE`); the
+/// output and the report's path (the samples CSV beside it, `.csv`).
 fn run_probing(
     name: &str,
     program: &str,
-    probe: &str,
+    args: &[&std::path::Path],
 ) -> (std::process::Output, std::path::PathBuf) {
-    let (ngc, toml, json, csv) = (
-        tmp(&format!("{name}.ngc")),
-        tmp(&format!("{name}.toml")),
-        tmp(&format!("{name}.json")),
-        tmp(&format!("{name}.csv")),
-    );
+    let (ngc, json) = (tmp(&format!("{name}.ngc")), tmp(&format!("{name}.json")));
     std::fs::write(&ngc, program).unwrap();
-    std::fs::write(&toml, probe).unwrap();
     let out = tezgah()
         .arg("run")
         .arg(&ngc)
-        .arg("--probe")
-        .arg(&toml)
+        .args(args)
         .arg("--report")
         .arg(&json)
         .arg("--samples")
-        .arg(&csv)
+        .arg(json.with_extension("csv"))
         .output()
         .unwrap();
     (out, json)
+}
+
+/// `--probe FILE` with a probe file of `text`, written as `{name}.toml`.
+fn probe_option(name: &str, text: &str) -> [std::path::PathBuf; 2] {
+    let file = tmp(&format!("{name}.toml"));
+    std::fs::write(&file, text).unwrap();
+    ["--probe".into(), file]
 }
 
 /// The last row of a samples CSV (t, line, x, y, z, …).
@@ -574,7 +574,8 @@ fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
                    G10 L20 P1 Z0\nG0 Z5\nG1 X20 F600\n\
                    G0 X[10 + 5 * #5070] Z[#5063 + 1]\nM2\n";
     let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
-    let (out, json) = run_probing("probe-plane", program, probe);
+    let [flag, file] = probe_option("probe-plane", probe);
+    let (out, json) = run_probing("probe-plane", program, &[&flag, &file]);
     let report = succeeded_with_report(&out, &json);
     assert_joints_within_limits(&report, true, "probe-plane");
     assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
@@ -629,30 +630,12 @@ fn probing_a_box_from_the_machine_file_finds_its_walls() {
         std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines/mill3.toml"))
             .unwrap()
     );
-    let (ngc, file, json, csv) = (
-        tmp("probe-box.ngc"),
-        tmp("probe-box-machine.toml"),
-        tmp("probe-box.json"),
-        tmp("probe-box.csv"),
-    );
+    let file = tmp("probe-box-machine.toml");
     std::fs::write(&file, machine).unwrap();
-    std::fs::write(
-        &ngc,
-        "G21 G90\nG0 X0 Y0 Z-5\nF200 G38.2 X50\nG38.4 X0 F100\nG0 X30 Y30\nF200 G38.2 Y0\n\
-         G0 Y30\nG38.3 Y40\nG0 X[#5070 * 100 + 1]\nM2\n",
-    )
-    .unwrap();
-    let out = tezgah()
-        .arg("run")
-        .arg(&ngc)
-        .arg("--machine")
-        .arg(&file)
-        .arg("--report")
-        .arg(&json)
-        .arg("--samples")
-        .arg(&csv)
-        .output()
-        .unwrap();
+    let program = "G21 G90\nG0 X0 Y0 Z-5\nF200 G38.2 X50\nG38.4 X0 F100\nG0 X30 Y30\n\
+                   F200 G38.2 Y0\nG0 Y30\nG38.3 Y40\nG0 X[#5070 * 100 + 1]\nM2\n";
+    let flag = std::path::PathBuf::from("--machine");
+    let (out, json) = run_probing("probe-box", program, &[&flag, &file]);
     let report = succeeded_with_report(&out, &json);
     assert_joints_within_limits(&report, true, "probe-box");
     let (v_in, v_out) = (200.0 / 60.0, 100.0 / 60.0);
@@ -704,7 +687,8 @@ fn probing_errors_name_the_probe_line() {
     ];
     for (program, message) in cases {
         let name = message.split('.').next().unwrap();
-        let (out, _) = run_probing(name, program, probe);
+        let [flag, file] = probe_option(name, probe);
+        let (out, _) = run_probing(name, program, &[&flag, &file]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success());
         assert!(stderr.contains(message), "{stderr}");
