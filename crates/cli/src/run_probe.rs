@@ -219,15 +219,25 @@ fn position_before(moves: &[Move], index: usize) -> Pose {
         .unwrap_or(Pose::ZERO)
 }
 
-/// Each probe move of `steps` ending where the machine stopped.
+/// Each probe move of `steps` ending where the machine stopped. The move builder took the
+/// probe's target as the current point, so a tool-control switch before the next motion
+/// (`at`, e.g. G43 right after a probe) is moved by the same shift.
 fn with_stops(mut moves: Vec<Move>, steps: &[ProbeStep]) -> Vec<Move> {
     for step in steps {
-        if let Some(Move {
-            kind: MoveKind::Feed { end },
-            ..
-        }) = moves.get_mut(step.index)
-        {
-            *end = step.stopped;
+        let Some(MoveKind::Feed { end }) = moves.get_mut(step.index).map(|m| &mut m.kind) else {
+            continue;
+        };
+        let shift = step.stopped - *end;
+        *end = step.stopped;
+        for m in &mut moves[step.index + 1..] {
+            match &mut m.kind {
+                MoveKind::ToolControl { at, .. } => *at = *at + shift,
+                MoveKind::Rapid { .. }
+                | MoveKind::Feed { .. }
+                | MoveKind::Arc(_)
+                | MoveKind::Nurbs(_) => break,
+                _ => {}
+            }
         }
     }
     moves

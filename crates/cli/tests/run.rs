@@ -694,3 +694,21 @@ fn probing_errors_name_the_probe_line() {
         assert!(stderr.contains(message), "{stderr}");
     }
 }
+
+/// A tool-length change right after a probe (G43.1) takes the rest point as the current point:
+/// the next move starts there (no jump: joints within limits, the path within tolerance) and,
+/// as in LinuxCNC, the program Z shifts by the length while the machine's Z stays.
+#[test]
+fn a_tool_length_change_after_a_probe_starts_from_the_rest_point() {
+    let program = "G21 G90\nG0 X10 Y10 Z10\nF300 G38.2 Z-20\nG43.1 Z1\nG1 X20 F600\nM2\n";
+    let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
+    let [flag, file] = probe_option("probe-g43", probe);
+    let (out, json) = run_probing("probe-g43", program, &[&flag, &file]);
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-g43");
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
+    let (_, rest) = probe_at(&report, 0);
+    let end = last_sample(&json);
+    assert_eq!(end[2..4], [20.0, 10.0]);
+    assert!((end[4] - rest[2]).abs() < 1e-9, "{end:?} {rest:?}");
+}
