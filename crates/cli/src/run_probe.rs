@@ -9,6 +9,7 @@ use std::sync::Arc;
 
 use miette::{miette, Result};
 use tezgah_executor::probe::{run_probe_move, ProbeRun, Sampled, Seek};
+use tezgah_executor::probe_moves::{part, point_at, position_before, with_stops};
 use tezgah_gcode::error::ErrorKind;
 use tezgah_gcode::sources::{interpret, Interpreted, Pass, Sources};
 use tezgah_gcode::{Config, ProbeModel as Answers, ProbeOutcome};
@@ -65,7 +66,8 @@ pub fn interpret_probing(
             &locate,
             &mut tezgah_gcode::canon::Discard,
         );
-        let moves = with_stops(std::mem::take(&mut done.moves), &steps);
+        let stops: Vec<(usize, Pose)> = steps.iter().map(|s| (s.index, s.stopped)).collect();
+        let moves = with_stops(std::mem::take(&mut done.moves), &stops);
         let code = match done.errors.first().map(|e| &e.kind) {
             None => {
                 return Ok(Ok(Probed { done, moves, steps }));
@@ -103,7 +105,7 @@ pub fn interpret_probing(
         .map_err(|e| miette!("{e}"))?;
         let run = run_probe_move(samples, model, seek, &pm, options).map_err(|e| miette!("{e}"))?;
         let stopped = match run.outcome {
-            ProbeOutcome::Tripped { stopped, .. } => lerp(start, end, stopped),
+            ProbeOutcome::Tripped { stopped, .. } => point_at(start, end, stopped),
             ProbeOutcome::Completed => end,
             ProbeOutcome::AlreadyThere => start,
         };
@@ -183,72 +185,6 @@ pub fn play(
         segments,
         axis,
     ))
-}
-
-/// The moves `[from, to)` preceded by the settings the moves before them made (feed, modes,
-/// tool control), the tool-control switches among those placed at `start`.
-fn part(moves: &[Move], from: usize, to: usize, start: Pose) -> Vec<Move> {
-    let settings = moves[..from].iter().filter_map(|m| match m.kind {
-        MoveKind::FeedRate { .. }
-        | MoveKind::FeedMode(_)
-        | MoveKind::SpindleSpeed { .. }
-        | MoveKind::PathMode(_)
-        | MoveKind::Smoothing(_)
-        | MoveKind::FeedOverride(_) => Some(m.clone()),
-        MoveKind::ToolControl { control, .. } => Some(Move {
-            line: m.line,
-            kind: MoveKind::ToolControl { control, at: start },
-        }),
-        _ => None,
-    });
-    settings.chain(moves[from..to].iter().cloned()).collect()
-}
-
-/// Where the machine stands before `moves[index]`.
-fn position_before(moves: &[Move], index: usize) -> Pose {
-    moves[..index]
-        .iter()
-        .rev()
-        .find_map(|m| match &m.kind {
-            MoveKind::Rapid { end } | MoveKind::Feed { end } => Some(*end),
-            MoveKind::Arc(a) => Some(a.end),
-            MoveKind::Nurbs(n) => Some(n.end),
-            MoveKind::ToolControl { at, .. } => Some(*at),
-            _ => None,
-        })
-        .unwrap_or(Pose::ZERO)
-}
-
-/// Each probe move of `steps` ending where the machine stopped. The move builder took the
-/// probe's target as the current point, so a tool-control switch before the next motion
-/// (`at`, e.g. G43 right after a probe) is moved by the same shift.
-fn with_stops(mut moves: Vec<Move>, steps: &[ProbeStep]) -> Vec<Move> {
-    for step in steps {
-        let Some(MoveKind::Feed { end }) = moves.get_mut(step.index).map(|m| &mut m.kind) else {
-            continue;
-        };
-        let shift = step.stopped - *end;
-        *end = step.stopped;
-        for m in &mut moves[step.index + 1..] {
-            match &mut m.kind {
-                MoveKind::ToolControl { at, .. } => *at = *at + shift,
-                MoveKind::Rapid { .. }
-                | MoveKind::Feed { .. }
-                | MoveKind::Arc(_)
-                | MoveKind::Nurbs(_) => break,
-                _ => {}
-            }
-        }
-    }
-    moves
-}
-
-fn lerp(a: Pose, b: Pose, f: f64) -> Pose {
-    let mut p = a;
-    for i in 0..6 {
-        p.0[i] += f * (b.0[i] - a.0[i]);
-    }
-    p
 }
 
 /// The report's `probes`: per probe move its line, code, whether it tripped, the trip point

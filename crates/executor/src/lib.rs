@@ -16,6 +16,7 @@ pub mod mdi;
 pub mod overspeed;
 pub mod path_stop;
 pub mod probe;
+pub mod probe_moves;
 pub mod program;
 pub mod realtime;
 pub mod ring;
