@@ -243,6 +243,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     let program = ProgramPath::new(Pose::ZERO, pm.initial, &probed.moves);
     let start = Pose::ZERO;
+    let first = crate::run_probe::first_part(&probed, &machine, tolerance)?;
 
     // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
@@ -341,7 +342,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let mut sink = sink;
     let (duration, segments, axis) =
-        crate::run_probe::play(&probed, &machine, tolerance, &options, &mut sink)?;
+        crate::run_probe::play(&probed, first, &machine, tolerance, &options, &mut sink)?;
     let axis = axis.unwrap_or(AxisFigures {
         deviation_deg: 0.0,
         tolerance_deg: 0.0,

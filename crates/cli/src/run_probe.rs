@@ -120,11 +120,23 @@ pub fn interpret_probing(
     }
 }
 
+/// The path of the part before the first probe (the whole program when it does not probe),
+/// pre-flighted: built before anything is written or moves.
+pub fn first_part(probed: &Probed, machine: &Machine, tolerance: f64) -> Result<BuiltPath> {
+    let to = probed.steps.first().map_or(probed.moves.len(), |s| s.index);
+    let (sources, keys) = (&probed.done.sources, &probed.done.keys);
+    let moves = part(&probed.moves, 0, to, Pose::ZERO);
+    build_path(sources, keys, moves, machine, tolerance, Pose::ZERO)
+}
+
 /// Plays the probed program into `sink`: the parts between probe moves planned and sampled
-/// from rest to rest, each probe move as it ran; sample times and indices run on across the
-/// parts. Returns the duration, the segments planned and the worst tool-axis figures.
+/// from rest to rest (the first one is [`first_part`]; each later one is built and
+/// pre-flighted when it is reached), each probe move as it ran; sample times and indices run
+/// on across the parts. Returns the duration, the segments planned and the worst tool-axis
+/// figures.
 pub fn play(
     probed: &Probed,
+    first: BuiltPath,
     machine: &Machine,
     tolerance: f64,
     options: &PlanOptions,
@@ -145,15 +157,25 @@ pub fn play(
     let mut from = 0;
     let mut start = Pose::ZERO;
     let cuts = probed.steps.iter().map(Some).chain([None]);
+    let mut first = Some(first);
     for step in cuts {
         let to = step.map_or(moves.len(), |s| s.index);
-        let items = part(moves, from, to, start);
+        let built = match first.take() {
+            Some(built) => built,
+            None => build_path(
+                sources,
+                keys,
+                part(moves, from, to, start),
+                machine,
+                tolerance,
+                start,
+            )?,
+        };
         let BuiltPath {
             items,
             pm,
             axis: figures,
-            ..
-        } = build_path(sources, keys, items, machine, tolerance, start)?;
+        } = built;
         segments += items
             .iter()
             .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))

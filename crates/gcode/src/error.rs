@@ -385,7 +385,10 @@ pub enum ErrorKind {
     #[error("Start point too close to probe point")]
     ProbeStartAtTarget,
     /// tezgah's own: no probe to answer (`Config::probe`).
-    #[error("G{0} probing needs a probe: the machine file's [probe] section or `run --probe`")]
+    #[error(
+        "G{0} probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
+         --probe); check, serve and MDI do not probe yet"
+    )]
     ProbeUnavailable(String),
     /// tezgah's own: a pass driven by the executor reached a probe move it has no answer for
     /// yet (`ProbeModel::Answered`); the executor runs the moves so far and answers.
