@@ -712,3 +712,52 @@ fn a_tool_length_change_after_a_probe_starts_from_the_rest_point() {
     assert_eq!(end[2..4], [20.0, 10.0]);
     assert!((end[4] - rest[2]).abs() < 1e-9, "{end:?} {rest:?}");
 }
+
+/// `examples/probe.ngc` on `examples/probe.toml` (block top Z-20, left side X20, ball 2 mm):
+/// G54 Z0 goes on the top as the first probe found it (trip − radius), the second probe finds
+/// the side at X18, and the cut along Y (line 16) runs 0.5 mm under the found top, 1 mm inside
+/// the found side: X = 18 + 2 + 1, Z = trip − 2 − 0.5.
+#[test]
+fn the_probing_example_cuts_where_it_found_the_block() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let (json, csv) = (tmp("probe-example.json"), tmp("probe-example.csv"));
+    let out = tezgah()
+        .arg("run")
+        .arg(format!("{dir}/probe.ngc"))
+        .arg("--probe")
+        .arg(format!("{dir}/probe.toml"))
+        .arg("--report")
+        .arg(&json)
+        .arg("--samples")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe example");
+    let (top, _) = probe_at(&report, 0);
+    let (side, _) = probe_at(&report, 1);
+    assert!(top[2] <= -18.0 && top[2] > -18.0 - 5.0 * 0.001, "{top:?}");
+    assert_eq!(side[0], 18.0);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let cut: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap())
+                .collect::<Vec<f64>>()
+        })
+        .filter(|r| r[1] == 16.0)
+        .collect();
+    assert!(cut.len() > 100);
+    // Away from the corners at its ends (blended within the path tolerance), on the line.
+    let z = top[2] - 2.5;
+    let inner: Vec<_> = cut.iter().filter(|r| r[3].abs() <= 9.0).collect();
+    assert!(inner.len() > 100);
+    for r in inner {
+        assert!(
+            (r[2] - 21.0).abs() < 1e-9 && (r[4] - z).abs() < 1e-9,
+            "{r:?}"
+        );
+    }
+}
