@@ -20,6 +20,7 @@ use tezgah_motion::interpolate::{run as run_items, Sample};
 use tezgah_motion::plan::PlanOptions;
 use tezgah_motion::Segment;
 
+use crate::diagnostics::report_line;
 use crate::run::{build_path, AxisFigures, BuiltPath};
 
 /// One probe move as it ran.
@@ -82,14 +83,19 @@ pub fn interpret_probing(
             return Err(miette!("G{code}: no probe to answer"));
         };
         // The probe move is the last move of the pass that stopped at it.
-        let index = moves.len() - 1;
-        let line = done.keys.plain(moves[index].line);
-        let start = position_before(&moves, index);
-        let MoveKind::Feed { end } = moves[index].kind else {
-            return Err(miette!(
-                "line {line}: the probe move is not a straight feed"
-            ));
+        let Some((
+            index,
+            &Move {
+                line: key,
+                kind: MoveKind::Feed { end },
+            },
+        )) = moves.iter().enumerate().next_back()
+        else {
+            return Err(miette!("G{code}: the probe move is not a straight feed"));
         };
+        let at = |message: &str| report_line(&done.sources, done.keys.source(key), message);
+        let line = done.keys.plain(key);
+        let start = position_before(&moves, index);
         let alone = part(&moves, index, index + 1, start);
         let built = build_path(&done.sources, &done.keys, alone, machine, tolerance, start)?;
         let pm = built.pm.clone();
@@ -103,7 +109,8 @@ pub fn interpret_probing(
             |s: &Sample, seg: &[Arc<Segment>]| samples.push((*s, seg.to_vec())),
         )
         .map_err(|e| miette!("{e}"))?;
-        let run = run_probe_move(samples, model, seek, &pm, options).map_err(|e| miette!("{e}"))?;
+        let run =
+            run_probe_move(samples, model, seek, &pm, options).map_err(|e| at(&e.to_string()))?;
         let stopped = match run.outcome {
             ProbeOutcome::Tripped { stopped, .. } => point_at(start, end, stopped),
             ProbeOutcome::Completed => end,

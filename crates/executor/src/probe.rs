@@ -54,14 +54,15 @@ pub struct ProbeRun {
     pub trip: Option<Vec3>,
 }
 
+/// Why a probe move could not be run (the caller knows which move it was).
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum ProbeError {
-    #[error("line {line}: a probe move must move X, Y or Z")]
-    NoLinearTravel { line: u32 },
-    #[error("line {line}: the probe move's limits: {message}")]
-    Limits { line: u32, message: String },
-    #[error("line {line}: stopping after the trip: {source}")]
-    Kinematics { line: u32, source: KinematicsError },
+    #[error("a probe move must move X, Y or Z")]
+    NoLinearTravel,
+    #[error("the probe move's limits: {0}")]
+    Limits(String),
+    #[error("stopping after the trip: {0}")]
+    Kinematics(KinematicsError),
 }
 
 /// Runs a probe move whose planned `samples` (start to end, the machine at rest at both)
@@ -82,13 +83,13 @@ pub fn run_probe_move(
     };
     let line = first.line;
     let Some(seg) = segs.first().cloned() else {
-        return Err(ProbeError::NoLinearTravel { line });
+        return Err(ProbeError::NoLinearTravel);
     };
     let start = first.tip;
     let end = samples.last().map_or(start, |s| s.0.tip);
     let length = (end - start).norm();
     if length <= 0.0 {
-        return Err(ProbeError::NoLinearTravel { line });
+        return Err(ProbeError::NoLinearTravel);
     }
     if seek.found(model, &start) {
         return Ok(ProbeRun {
@@ -125,7 +126,7 @@ pub fn run_probe_move(
             std::array::from_fn(|r| rotary_start[r] + f * (rotary_end[r] - rotary_start[r]));
         joints = machine
             .joints(seg.control, &tip, &rotary, &joints)
-            .map_err(|source| ProbeError::Kinematics { line, source })?;
+            .map_err(ProbeError::Kinematics)?;
         out.push((
             Sample {
                 index: trip.index + i,
@@ -161,8 +162,7 @@ fn path_stop(
     machine: &PlanMachine,
     options: &PlanOptions,
 ) -> Result<PathStop, ProbeError> {
-    let line = seg.line;
-    let error = |message: String| ProbeError::Limits { line, message };
+    let error = ProbeError::Limits;
     let geometry = limits::analyse(seg, machine).map_err(|e| error(e.to_string()))?;
     let path = limits::segment_limits(seg, &geometry, machine, options, false)
         .map_err(|e| error(e.to_string()))?
