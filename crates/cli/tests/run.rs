@@ -697,20 +697,44 @@ fn probing_errors_name_the_probe_line() {
 
 /// A tool-length change right after a probe (G43.1) takes the rest point as the current point:
 /// the next move starts there (no jump: joints within limits, the path within tolerance) and,
-/// as in LinuxCNC, the program Z shifts by the length while the machine's Z stays.
+/// as in LinuxCNC, the program Z shifts by the length while the machine's Z stays. The next
+/// probe touches with the tool tip, 1 mm below the gauge point the moves carry: it trips with
+/// the tip at z = −5 + 2, and the machine's Z rests 1 mm above the tip.
 #[test]
 fn a_tool_length_change_after_a_probe_starts_from_the_rest_point() {
-    let program = "G21 G90\nG0 X10 Y10 Z10\nF300 G38.2 Z-20\nG43.1 Z1\nG1 X20 F600\nM2\n";
+    let program = "G21 G90\nG0 X10 Y10 Z10\nF300 G38.2 Z-20\nG43.1 Z1\nG1 X20 F600\n\
+                   G0 Z10\nG38.2 Z-20 F300\nM2\n";
     let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
     let [flag, file] = probe_option("probe-g43", probe);
     let (out, json) = run_probing("probe-g43", program, &[&flag, &file]);
     let report = succeeded_with_report(&out, &json);
     assert_joints_within_limits(&report, true, "probe-g43");
     assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
-    let (_, rest) = probe_at(&report, 0);
+    let (first, _) = probe_at(&report, 0);
+    let (second, rest) = probe_at(&report, 1);
+    for trip in [&first, &second] {
+        assert!(trip[2] <= -3.0 && trip[2] > -3.0 - 5.0 * 0.001, "{trip:?}");
+    }
+    let text = std::fs::read_to_string(json.with_extension("csv")).unwrap();
+    let at_x20 = text
+        .lines()
+        .find(|l| l.split(',').nth(1) == Some("7"))
+        .unwrap();
+    // The first row of line 7 (the second probe) starts where G1 X20 left the machine.
+    let row: Vec<f64> = at_x20.split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(row[2..4], [20.0, 10.0]);
     let end = last_sample(&json);
-    assert_eq!(end[2..4], [20.0, 10.0]);
-    assert!((end[4] - rest[2]).abs() < 1e-9, "{end:?} {rest:?}");
+    assert!(
+        (end[4] - rest[2]).abs() < 1e-9 && (end[4] - end[7] - 1.0).abs() < 1e-9,
+        "{end:?}"
+    );
+    // The tip at rest: the trip (a period's travel at most past z = −3) and the stop from
+    // 5 mm/s, v·√(v/J) with mill3's Z jerk 25000 mm/s³.
+    let stop = 5.0 * (5.0f64 / 25000.0).sqrt();
+    assert!(
+        end[7] < -3.0 && end[7] > -3.0 - 0.005 - stop - 1e-9,
+        "{end:?}"
+    );
 }
 
 /// `examples/probe.ngc` on `examples/probe.toml` (block top Z-20, left side X20, ball 2 mm):

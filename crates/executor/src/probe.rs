@@ -13,6 +13,7 @@ use tezgah_kinematics::probe::ProbeModel;
 use tezgah_kinematics::KinematicsError;
 use tezgah_motion::interpolate::Sample;
 use tezgah_motion::plan::{limits, PlanMachine, PlanOptions};
+use tezgah_motion::tool_pose::SampleTool;
 use tezgah_motion::Segment;
 
 use crate::path_stop::PathStop;
@@ -50,7 +51,7 @@ impl Seek {
 pub struct ProbeRun {
     pub samples: Vec<Sampled>,
     pub outcome: ProbeOutcome,
-    /// Where the input changed (tip, mm), when it did.
+    /// Where the input changed (the tool tip, workpiece frame, mm), when it did.
     pub trip: Option<Vec3>,
 }
 
@@ -91,7 +92,11 @@ pub fn run_probe_move(
     if length <= 0.0 {
         return Err(ProbeError::NoLinearTravel);
     }
-    if seek.found(model, &start) {
+    // The probe touches with the tool as the joints hold it (with G43's length taken off the
+    // gauge point the moves carry), not with the program point.
+    let mut tool = SampleTool::new(machine);
+    let mut tip = |s: &Sampled| tool.pose(&s.0, &s.1).map(|p| p.tip);
+    if seek.found(model, &tip(&samples[0]).map_err(ProbeError::Kinematics)?) {
         return Ok(ProbeRun {
             samples: Vec::new(),
             outcome: ProbeOutcome::AlreadyThere,
@@ -99,7 +104,15 @@ pub fn run_probe_move(
         });
     }
     // The input is read once a period, as a servo thread reads it.
-    let Some(k) = samples.iter().position(|s| seek.found(model, &s.0.tip)) else {
+    let mut found = None;
+    for (i, s) in samples.iter().enumerate() {
+        let p = tip(s).map_err(ProbeError::Kinematics)?;
+        if seek.found(model, &p) {
+            found = Some((i, p));
+            break;
+        }
+    }
+    let Some((k, tool_tip)) = found else {
         return Ok(ProbeRun {
             samples,
             outcome: ProbeOutcome::Completed,
@@ -147,7 +160,7 @@ pub fn run_probe_move(
             at: s_trip / length,
             stopped: s_rest / length,
         },
-        trip: Some(trip.tip),
+        trip: Some(tool_tip),
     })
 }
 
