@@ -4,8 +4,8 @@
 //!
 //! The solids are half-spaces bounded by planes (a table or part top, a side wall) and
 //! axis-aligned boxes (a part, a vise jaw). The stylus is a ball of `tool_radius_mm` centred on
-//! the controlled point the moves carry, so a Z-down probe onto the plane z = h trips at
-//! z = h + r and a +X probe onto a box's face at x = x₀ at x = x₀ − r.
+//! the tool tip, so a Z-down probe onto the plane z = h trips at z = h + r and a +X probe onto a
+//! box's face at x = x₀ at x = x₀ − r.
 
 use serde::Deserialize;
 use tezgah_geom::Vec3;
