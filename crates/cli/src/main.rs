@@ -12,6 +12,7 @@ mod panel;
 mod plot;
 mod preview;
 mod run;
+mod run_probe;
 mod serve;
 mod tracking;
 
@@ -182,7 +183,14 @@ fn check(program: &Path, machine: Option<&str>, inputs: &Inputs) -> Result<ExitC
         }
         if let Some(machine) = &machine {
             let tolerance = machine.motion.tolerance_mm;
-            run::build_path(&done.sources, &done.keys, done.moves, machine, tolerance)?;
+            run::build_path(
+                &done.sources,
+                &done.keys,
+                done.moves,
+                machine,
+                tolerance,
+                tezgah_geom::Pose::ZERO,
+            )?;
             println!("{}: OK on {}, {counts}", program.display(), machine.name);
             return Ok(ExitCode::SUCCESS);
         }

@@ -5,11 +5,11 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
-use tezgah_gcode::sources::{interpret, LineKeys, Pass, Sources};
+use tezgah_gcode::sources::{LineKeys, Sources};
 use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
 use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
-use tezgah_motion::interpolate::{run as run_items, Sample};
+use tezgah_motion::interpolate::Sample;
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
 use tezgah_motion::tool_pose::SampleTool;
@@ -25,8 +25,6 @@ use crate::tracking::{DriveKind, Tracker, Tracking};
 pub struct BuiltPath {
     pub items: Vec<tezgah_motion::PathItem>,
     pub pm: PlanMachine,
-    /// The program pose the machine starts from.
-    pub start: Pose,
     /// How far the blended tool axis strays from the programmed one.
     pub axis: AxisFigures,
 }
@@ -42,8 +40,8 @@ pub fn build_path(
     moves: Vec<tezgah_geom::Move>,
     machine: &Machine,
     tolerance: f64,
+    start: Pose,
 ) -> Result<BuiltPath> {
-    let start = Pose::ZERO;
     let pm = PlanMachine::from_machine(machine).map_err(|e| miette!("{e}"))?;
     let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
     let mut smoother =
@@ -72,12 +70,7 @@ pub fn build_path(
             *line = keys.plain(*line);
         }
     }
-    Ok(BuiltPath {
-        items,
-        pm,
-        start,
-        axis,
-    })
+    Ok(BuiltPath { items, pm, axis })
 }
 
 /// A path builder's error at the file, line and column of its move (the message without its
@@ -130,6 +123,10 @@ pub struct RunArgs {
     /// file's servo model; the report adds tracking RMSE, following and contour errors).
     #[arg(long, value_enum, default_value = "ideal")]
     pub drive: crate::tracking::DriveKind,
+    /// A probe file (the fields of a machine file's `[probe]` section) for G38 moves to
+    /// touch; default: the machine file's `[probe]`.
+    #[arg(long)]
+    pub probe: Option<PathBuf>,
     #[command(flatten)]
     pub inputs: crate::library::Inputs,
 }
@@ -200,20 +197,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let extra = args.inputs.program_inputs(args.program.as_deref())?;
     let config = machine_config(&machine, table, &extra);
     let path_name = args.program.clone().unwrap_or_else(|| "demo.ngc".into());
-    let done = interpret(
-        Sources::new(path_name.display().to_string(), text),
-        config,
-        Pass::Run,
-        |name| extra.locate(name),
-        &mut tezgah_gcode::canon::Discard,
-    );
-    if let Some(e) = done.errors.first() {
-        eprintln!("{:?}", crate::diagnostics::report(&done.sources, e));
-        return Ok(std::process::ExitCode::FAILURE);
-    }
-    for w in &done.warnings {
-        eprintln!("warning: {w}");
-    }
     let period = args.period.unwrap_or(machine.motion.period_s);
     if !(period > 0.0 && period.is_finite()) {
         return Err(miette!("--period must be > 0, got {period}"));
@@ -222,27 +205,45 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
-    // The program as the interpreter emitted it, which `verify` measures the samples against.
-    let initial = PlanMachine::from_machine(&machine)
-        .map_err(|e| miette!("{e}"))?
-        .initial;
-    let program = ProgramPath::new(Pose::ZERO, initial, &done.moves);
-    let BuiltPath {
-        items,
-        pm,
-        start,
-        axis,
-    } = build_path(&done.sources, &done.keys, done.moves, &machine, tolerance)?;
-    let segments = items
-        .iter()
-        .filter(|i| matches!(i, tezgah_motion::PathItem::Segment(_)))
-        .count();
     let options = PlanOptions {
         period,
         // The chord error gets what compression and blending leave of the tolerance.
         chord_share: smooth::CHORD_SHARE,
         ..PlanOptions::default()
     };
+    let probe = match &args.probe {
+        Some(p) => Some(
+            tezgah_kinematics::probe::ProbeModel::from_toml_str(&crate::library::read_text(p)?)
+                .map_err(|e| miette!("probe file {}: {e}", p.display()))?,
+        ),
+        None => machine.probe.clone(),
+    };
+    let probed = crate::run_probe::interpret_probing(
+        || Sources::new(path_name.display().to_string(), text.clone()),
+        config,
+        |name| extra.locate(name),
+        probe.as_ref(),
+        &machine,
+        tolerance,
+        &options,
+    )?;
+    let probed = match probed {
+        Ok(p) => p,
+        Err(done) => {
+            let e = &done.errors[0];
+            eprintln!("{:?}", crate::diagnostics::report(&done.sources, e));
+            return Ok(std::process::ExitCode::FAILURE);
+        }
+    };
+    for w in &probed.done.warnings {
+        eprintln!("warning: {w}");
+    }
+    // The program as the interpreter emitted it (probe moves ending where the machine
+    // stopped), which `verify` measures the samples against.
+    let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
+    let program = ProgramPath::new(Pose::ZERO, pm.initial, &probed.moves);
+    let start = Pose::ZERO;
+    let first = crate::run_probe::first_part(&probed, &machine, tolerance)?;
 
     // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
@@ -339,15 +340,13 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
             bar.tick();
         }
     };
-    let start_tip = Vec3::from(start.xyz());
-    let duration = run_items(
-        items,
-        pm,
-        options,
-        (start_tip, [start.0[3], start.0[4], start.0[5]]),
-        sink,
-    )
-    .map_err(|e| miette!("{e}"))?;
+    let mut sink = sink;
+    let (duration, segments, axis) =
+        crate::run_probe::play(&probed, first, &machine, tolerance, &options, &mut sink)?;
+    let axis = axis.unwrap_or(AxisFigures {
+        deviation_deg: 0.0,
+        tolerance_deg: 0.0,
+    });
     bar.finish_and_clear();
     match write_error {
         Some(SinkError::Write(e)) => {
@@ -371,6 +370,9 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         });
         if let Some(t) = &tracking {
             json["tracking"] = tracking_json(&machine, t);
+        }
+        if !probed.steps.is_empty() {
+            json["probes"] = crate::run_probe::probes_json(&probed);
         }
         crate::library::write_json(p, &json)?;
     }
@@ -396,6 +398,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if let Some(t) = &tracking {
         tracking_summary(&machine, t);
     }
+    crate::run_probe::probe_summary(&probed);
     let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
         || report.deviation_ratio > 1.0
         || tracking.as_ref().is_some_and(|t| t.fault.is_some());
@@ -465,9 +468,10 @@ fn tcp_name(machine: &Machine) -> &'static str {
 
 /// The tool axis's figures (5-axis under TCP): the largest angle between a corner blend's axis
 /// and the programmed axis, and the angular tolerance in force, degrees.
+#[derive(Debug, Clone, Copy)]
 pub struct AxisFigures {
-    deviation_deg: f64,
-    tolerance_deg: f64,
+    pub deviation_deg: f64,
+    pub tolerance_deg: f64,
 }
 
 fn report_json(

@@ -509,3 +509,279 @@ fn the_report_measures_against_the_program_and_gives_the_slack() {
     // The last move alone: 150 mm at 10 mm/s, 15 s at the feed.
     assert!(bins[10] > 15.0 - 0.06 && bins[10] < moving, "{bins:?}");
 }
+
+/// Runs `program` with `args` (the probe's source: `--probe FILE` or `--machine FILE`); the
+/// output and the report's path (the samples CSV beside it, `.csv`).
+fn run_probing(
+    name: &str,
+    program: &str,
+    args: &[&std::path::Path],
+) -> (std::process::Output, std::path::PathBuf) {
+    let (ngc, json) = (tmp(&format!("{name}.ngc")), tmp(&format!("{name}.json")));
+    std::fs::write(&ngc, program).unwrap();
+    let out = tezgah()
+        .arg("run")
+        .arg(&ngc)
+        .args(args)
+        .arg("--report")
+        .arg(&json)
+        .arg("--samples")
+        .arg(json.with_extension("csv"))
+        .output()
+        .unwrap();
+    (out, json)
+}
+
+/// `--probe FILE` with a probe file of `text`, written as `{name}.toml`.
+fn probe_option(name: &str, text: &str) -> [std::path::PathBuf; 2] {
+    let file = tmp(&format!("{name}.toml"));
+    std::fs::write(&file, text).unwrap();
+    ["--probe".into(), file]
+}
+
+/// The last row of a samples CSV (t, line, x, y, z, …).
+fn last_sample(json: &std::path::Path) -> Vec<f64> {
+    let text = std::fs::read_to_string(json.with_extension("csv")).unwrap();
+    let last = text.lines().last().unwrap();
+    last.split(',').map(|v| v.parse().unwrap()).collect()
+}
+
+/// The report's probe `k`: trip point (mm) and rest pose.
+fn probe_at(report: &serde_json::Value, k: usize) -> (Vec<f64>, Vec<f64>) {
+    let p = &report["probes"][k];
+    let v = |key: &str| -> Vec<f64> {
+        p[key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    (v("trip_mm"), v("stopped"))
+}
+
+/// G38.2 down onto the plane z = −5 with a 2 mm ball at three feeds: the input is read once a
+/// period, so each trip is at most one period's travel (F/60 · 1 ms) past the contact
+/// z = −5 + 2, and the stop from that feed is the jerk-limited one of mill3's Z
+/// (J = 25000 mm/s³, from cruise: d = v·√(v/J)). The program then zeroes G54 Z at the rest
+/// point (G10 L20) and goes 1 mm above the probed point (#5063, program coordinates of the
+/// probe time), ending where the closed form says; the verifier holds every joint within its
+/// limits through the trips and stops.
+#[test]
+fn probing_a_plane_trips_at_the_ball_radius_and_the_program_reads_on() {
+    let program = "G21 G90 G17\nG0 X10 Y10 Z10\nF120 G38.2 Z-20\nG0 Z10\nF300 G38.2 Z-20\n\
+                   G0 Z10\nF600 G38.2 Z-20\nG0 Z-2.99\nG38.2 Z-20\n\
+                   G10 L20 P1 Z0\nG0 Z5\nG1 X20 F600\n\
+                   G0 X[10 + 5 * #5070] Z[#5063 + 1]\nM2\n";
+    let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
+    let [flag, file] = probe_option("probe-plane", probe);
+    let (out, json) = run_probing("probe-plane", program, &[&flag, &file]);
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-plane");
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("probe    G38.2 line 3: tripped at X10.0000 Y10.0000 Z-3.00"),
+        "{stdout}"
+    );
+    for (k, feed) in [120.0, 300.0, 600.0].into_iter().enumerate() {
+        let (trip, rest) = probe_at(&report, k);
+        let v = feed / 60.0;
+        assert_eq!((trip[0], trip[1]), (10.0, 10.0));
+        assert!(
+            trip[2] <= -3.0 && trip[2] > -3.0 - v * 0.001 - 1e-9,
+            "{feed}: {trip:?}"
+        );
+        let stop = v * (v / 25000.0).sqrt();
+        assert!(
+            (trip[2] - rest[2] - stop).abs() < 1e-9,
+            "{feed}: stopped {} past the trip, closed form {stop}",
+            trip[2] - rest[2]
+        );
+    }
+    // From 0.01 mm above the contact the trip comes while the speed still ramps up (jerk
+    // phase: a ≈ J·∛(6·0.01/J) ≈ 335 mm/s²); the stop starts from that acceleration.
+    let (trip, rest) = probe_at(&report, 3);
+    assert!(trip[2] <= -3.0 && trip[2] > -3.0 - 10.0 * 0.001, "{trip:?}");
+    assert!(rest[2] < trip[2]);
+    let last = (trip[2], rest[2]);
+    // Machine Z at the end: G54 Z is the rest point's machine Z; the last move goes to
+    // #5063 + 1 in it, X to 10 + 5·#5070 = 15.
+    let end = last_sample(&json);
+    let expected = last.1 + last.0 + 1.0;
+    assert_eq!(end[2], 15.0);
+    assert!(
+        (end[4] - expected).abs() < 1e-9,
+        "end z {}, closed form {expected}",
+        end[4]
+    );
+}
+
+/// A machine file with a `[probe]` section: a box (X 20…40, Y −10…10, Z −30…0) and a 3 mm
+/// ball. G38.2 +X trips on the −X face at x = 20 − 3 (within a period's travel past it) and
+/// stops in mill3's X jerk-limited distance v·√(v/J), J = 50000 mm/s³; G38.4 backs off until
+/// the contact breaks, inside the same period's travel; G38.2 −Y trips on the +Y face at
+/// y = 10 + 3; G38.3 clear of the box runs to its end and the move after it uses #5070 = 0.
+#[test]
+fn probing_a_box_from_the_machine_file_finds_its_walls() {
+    let machine =
+        format!(
+        "{}\n[probe]\ntool_radius_mm = 3\n[[probe.box]]\nmin = [20, -10, -30]\nmax = [40, 10, 0]\n",
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../machines/mill3.toml"))
+            .unwrap()
+    );
+    let file = tmp("probe-box-machine.toml");
+    std::fs::write(&file, machine).unwrap();
+    let program = "G21 G90\nG0 X0 Y0 Z-5\nF200 G38.2 X50\nG38.4 X0 F100\nG0 X30 Y30\n\
+                   F200 G38.2 Y0\nG0 Y30\nG38.3 Y40\nG0 X[#5070 * 100 + 1]\nM2\n";
+    let flag = std::path::PathBuf::from("--machine");
+    let (out, json) = run_probing("probe-box", program, &[&flag, &file]);
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-box");
+    let (v_in, v_out) = (200.0 / 60.0, 100.0 / 60.0);
+    let (trip, rest) = probe_at(&report, 0);
+    assert!(trip[0] >= 17.0 && trip[0] < 17.0 + v_in * 0.001, "{trip:?}");
+    let stop = v_in * (v_in / 50000.0f64).sqrt();
+    assert!((rest[0] - trip[0] - stop).abs() < 1e-9, "{rest:?}");
+    let (trip, _) = probe_at(&report, 1);
+    assert!(
+        trip[0] < 17.0 && trip[0] >= 17.0 - v_out * 0.001,
+        "{trip:?}"
+    );
+    let (trip, _) = probe_at(&report, 2);
+    assert!(trip[1] <= 13.0 && trip[1] > 13.0 - v_in * 0.001, "{trip:?}");
+    let untripped = &report["probes"][3];
+    assert_eq!(
+        (&untripped["tripped"], &untripped["trip_mm"]),
+        (&false.into(), &serde_json::Value::Null)
+    );
+    assert_eq!(
+        untripped["stopped"],
+        serde_json::json!([30.0, 40.0, -5.0, 0.0, 0.0, 0.0])
+    );
+    assert_eq!(last_sample(&json)[2..5], [1.0, 40.0, -5.0]);
+}
+
+/// LinuxCNC's motion errors at the probe's line: G38.2 that reaches its end, G38.4 that never
+/// leaves contact, G38.2 starting in contact, G38.5 starting clear.
+#[test]
+fn probing_errors_name_the_probe_line() {
+    let probe = "tool_radius_mm = 1\n[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 1]\n";
+    let cases = [
+        (
+            "G21 G0 Z10\nF100 G38.2 Z5\nM2\n",
+            "probe-miss.ngc:2:6: G38.2 move finished without making contact.",
+        ),
+        (
+            "G21 G0 Z0.5\nF100 G38.4 Z0.2\nM2\n",
+            "probe-stay.ngc:2:6: G38.4 move finished without breaking contact.",
+        ),
+        (
+            "G21 G0 Z0.5\nF100 G38.2 Z-1\nM2\n",
+            "probe-on.ngc:2:6: Probe is already tripped when starting G38.2 or G38.3 move",
+        ),
+        (
+            "G21 G0 Z5\nF100 G38.5 Z10\nM2\n",
+            "probe-off.ngc:2:6: Probe is already clear when starting G38.4 or G38.5 move",
+        ),
+    ];
+    for (program, message) in cases {
+        let name = message.split('.').next().unwrap();
+        let [flag, file] = probe_option(name, probe);
+        let (out, _) = run_probing(name, program, &[&flag, &file]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(stderr.contains(message), "{stderr}");
+    }
+}
+
+/// A tool-length change right after a probe (G43.1) takes the rest point as the current point:
+/// the next move starts there (no jump: joints within limits, the path within tolerance) and,
+/// as in LinuxCNC, the program Z shifts by the length while the machine's Z stays. The next
+/// probe touches with the tool tip, 1 mm below the gauge point the moves carry: it trips with
+/// the tip at z = −5 + 2, and the machine's Z rests 1 mm above the tip.
+#[test]
+fn a_tool_length_change_after_a_probe_starts_from_the_rest_point() {
+    let program = "G21 G90\nG0 X10 Y10 Z10\nF300 G38.2 Z-20\nG43.1 Z1\nG1 X20 F600\n\
+                   G0 Z10\nG38.2 Z-20 F300\nM2\n";
+    let probe = "tool_radius_mm = 2\n[[plane]]\npoint = [0, 0, -5]\nnormal = [0, 0, 1]\n";
+    let [flag, file] = probe_option("probe-g43", probe);
+    let (out, json) = run_probing("probe-g43", program, &[&flag, &file]);
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe-g43");
+    assert!(report["max_deviation_mm"].as_f64().unwrap() <= 0.01);
+    let (first, _) = probe_at(&report, 0);
+    let (second, rest) = probe_at(&report, 1);
+    for trip in [&first, &second] {
+        assert!(trip[2] <= -3.0 && trip[2] > -3.0 - 5.0 * 0.001, "{trip:?}");
+    }
+    let text = std::fs::read_to_string(json.with_extension("csv")).unwrap();
+    let at_x20 = text
+        .lines()
+        .find(|l| l.split(',').nth(1) == Some("7"))
+        .unwrap();
+    // The first row of line 7 (the second probe) starts where G1 X20 left the machine.
+    let row: Vec<f64> = at_x20.split(',').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(row[2..4], [20.0, 10.0]);
+    let end = last_sample(&json);
+    assert!(
+        (end[4] - rest[2]).abs() < 1e-9 && (end[4] - end[7] - 1.0).abs() < 1e-9,
+        "{end:?}"
+    );
+    // The tip at rest: the trip (a period's travel at most past z = −3) and the stop from
+    // 5 mm/s, v·√(v/J) with mill3's Z jerk 25000 mm/s³.
+    let stop = 5.0 * (5.0f64 / 25000.0).sqrt();
+    assert!(
+        end[7] < -3.0 && end[7] > -3.0 - 0.005 - stop - 1e-9,
+        "{end:?}"
+    );
+}
+
+/// `examples/probe.ngc` on `examples/probe.toml` (block top Z-20, left side X20, ball 2 mm):
+/// G54 Z0 goes on the top as the first probe found it (trip − radius), the second probe finds
+/// the side at X18, and the cut along Y (line 16) runs 0.5 mm under the found top, 1 mm inside
+/// the found side: X = 18 + 2 + 1, Z = trip − 2 − 0.5.
+#[test]
+fn the_probing_example_cuts_where_it_found_the_block() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let (json, csv) = (tmp("probe-example.json"), tmp("probe-example.csv"));
+    let out = tezgah()
+        .arg("run")
+        .arg(format!("{dir}/probe.ngc"))
+        .arg("--probe")
+        .arg(format!("{dir}/probe.toml"))
+        .arg("--report")
+        .arg(&json)
+        .arg("--samples")
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let report = succeeded_with_report(&out, &json);
+    assert_joints_within_limits(&report, true, "probe example");
+    let (top, _) = probe_at(&report, 0);
+    let (side, _) = probe_at(&report, 1);
+    assert!(top[2] <= -18.0 && top[2] > -18.0 - 5.0 * 0.001, "{top:?}");
+    assert_eq!(side[0], 18.0);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let cut: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap())
+                .collect::<Vec<f64>>()
+        })
+        .filter(|r| r[1] == 16.0)
+        .collect();
+    assert!(cut.len() > 100);
+    // Away from the corners at its ends (blended within the path tolerance), on the line.
+    let z = top[2] - 2.5;
+    let inner: Vec<_> = cut.iter().filter(|r| r[3].abs() <= 9.0).collect();
+    assert!(inner.len() > 100);
+    for r in inner {
+        assert!(
+            (r[2] - 21.0).abs() < 1e-9 && (r[4] - z).abs() < 1e-9,
+            "{r:?}"
+        );
+    }
+}

@@ -14,6 +14,8 @@ pub mod job;
 pub mod manual;
 pub mod mdi;
 pub mod overspeed;
+pub mod probe;
+pub mod probe_moves;
 pub mod program;
 pub mod realtime;
 pub mod ring;

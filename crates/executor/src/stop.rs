@@ -58,6 +58,30 @@ pub fn velocity_profile(from: State, target: f64, limits: &Limits) -> Profile {
         .unwrap_or_else(|_| Profile::at_rest(if from.s.is_finite() { from.s } else { 0.0 }))
 }
 
+/// Relative slack on a path state's acceleration past the limit (the plan's own rounding).
+const PATH_STOP_SLACK: f64 = 1e-9;
+
+/// The stop from path state `x` (from s = 0) under `l`; `None` when the acceleration is past
+/// the limit beyond rounding, or the stop would need the speed to go negative (braking harder
+/// than the jerk can release: v + a|a|/(2J) < 0) — the path cannot be driven backward.
+pub fn path_stop(x: &State, l: &Limits) -> Option<Profile> {
+    let a_max = l.max_acceleration();
+    if x.v.is_nan() || x.v < 0.0 || x.a.abs() > a_max * (1.0 + PATH_STOP_SLACK) {
+        return None;
+    }
+    let a = x.a.clamp(-a_max, a_max);
+    if x.v + a * a.abs() / (2.0 * l.max_jerk()) < 0.0 {
+        return None;
+    }
+    let start = State {
+        s: 0.0,
+        v: x.v,
+        a,
+        j: 0.0,
+    };
+    reach_velocity(start, 0.0, l).ok()
+}
+
 /// A joint state on the stop.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointState {

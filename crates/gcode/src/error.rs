@@ -384,9 +384,25 @@ pub enum ErrorKind {
     ProbeFeedPerRev,
     #[error("Start point too close to probe point")]
     ProbeStartAtTarget,
-    /// tezgah's own: the executor has no probe input yet (`Config::probe`).
-    #[error("G{0} probing needs a probe input, which tezgah's executor does not have yet")]
+    /// tezgah's own: no probe to answer (`Config::probe`).
+    #[error(
+        "G{0} probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
+         --probe); check, serve and MDI do not probe yet"
+    )]
     ProbeUnavailable(String),
+    /// tezgah's own: a pass driven by the executor reached a probe move it has no answer for
+    /// yet (`ProbeModel::Answered`); the executor runs the moves so far and answers.
+    #[error("G{0} probe move awaits the machine's answer")]
+    ProbeAwaitsAnswer(String),
+    /// LinuxCNC's motion controller, when G38.2 or G38.4 reaches its end.
+    #[error("G38.2 move finished without making contact.")]
+    ProbeNoContact,
+    #[error("G38.4 move finished without breaking contact.")]
+    ProbeStillInContact,
+    #[error("Probe is already tripped when starting G38.2 or G38.3 move")]
+    ProbeAlreadyTripped,
+    #[error("Probe is already clear when starting G38.4 or G38.5 move")]
+    ProbeAlreadyClear,
     // --- polar coordinates (`@` radius, `^` angle) ---
     #[error("Cannot use polar coordinate except in G17 plane")]
     PolarNotXyPlane,

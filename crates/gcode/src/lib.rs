@@ -26,7 +26,7 @@ pub use block::AxisMask;
 pub use canon::{Canon, CanonSink, Origin, Units};
 pub use error::{ErrorKind, GcodeError};
 pub use ini::{IniError, IniFile};
-pub use interp::{check, check_into, Config, Interpreter, MissingEnd, ProbeModel};
+pub use interp::{check, check_into, Config, Interpreter, MissingEnd, ProbeModel, ProbeOutcome};
 pub use moves::{program_moves, MoveBuilder};
 pub use span::Span;
 pub use tooltable::{Tool, ToolTable, ToolTableError};

@@ -166,7 +166,10 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
                 let end = self.machine(p);
                 self.push(line, MoveKind::Rapid { end });
             }
-            Canon::StraightFeed(p) => {
+            // A probe move is a feed toward its target; the machine stops short of it where
+            // the probe trips, and whoever drives the run knows where (the program's next move
+            // starts from there).
+            Canon::StraightFeed(p) | Canon::StraightProbe(p) => {
                 let end = self.machine(p);
                 self.push(line, MoveKind::Feed { end });
             }

@@ -432,7 +432,92 @@ fn probing_errors_are_linuxcnc_s_and_runs_refuse_probing() {
         .unwrap_err();
     assert_eq!(
         err.kind.to_string(),
-        "G38.2 probing needs a probe input, which tezgah's executor does not have yet"
+        "G38.2 probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
+         --probe); check, serve and MDI do not probe yet"
     );
     assert_eq!((err.span.line, err.span.column), (2, 1));
+}
+
+/// The executor's hand-off (`ProbeModel::Answered`): a pass stops at the probe it has no
+/// answer for; with the answer, `#5061`… hold the trip point in program coordinates (G54
+/// offset and G91 included), `#5070` = 1, and the program reads on from where the machine
+/// stopped; an untripped G38.2/G38.4 and a probe already in the sought state fail as in
+/// LinuxCNC's motion controller, G38.3 goes on from the move's end with `#5070` = 0.
+#[test]
+fn probe_answers_drive_the_interpreter() {
+    use std::sync::Arc;
+    use tezgah_gcode::{Canon, Interpreter, Origin, ProbeModel, ProbeOutcome};
+    // Z from 10 down to -10 in G54 (Z offset 5): the trip at a quarter of the way, z = 5.
+    let program = "G21 G90 G10 L2 P1 Z5\nG0 X1 Z10\nF100 G38.2 Z-10\n\
+                   G10 L20 P1 Z[#5063 - #5063]\nG91 G1 X[#5070] Z[#5061]\nM2\n";
+    let run = |answers: &[ProbeOutcome]| {
+        let config = Config {
+            probe: ProbeModel::Answered(Arc::from(answers)),
+            ..Config::default()
+        };
+        let mut interp = Interpreter::new(config);
+        let mut calls = Vec::<(Origin, Canon)>::new();
+        let result = interp.run(program, &mut calls);
+        (result, interp, calls)
+    };
+    let (result, _, calls) = run(&[]);
+    let err = result.unwrap_err();
+    assert_eq!(
+        err.kind.to_string(),
+        "G38.2 probe move awaits the machine's answer"
+    );
+    assert_eq!(err.span.line, 3);
+    assert!(matches!(calls.last(), Some((_, Canon::TurnProbeOff))));
+    let tripped = ProbeOutcome::Tripped {
+        at: 0.25,
+        stopped: 0.3,
+    };
+    let (result, interp, calls) = run(&[tripped]);
+    result.unwrap();
+    let p = interp.params();
+    assert_eq!((p.get(5061), p.get(5063), p.get(5070)), (1.0, 5.0, 1.0));
+    // Stopped at 0.3 of the way (z = 4 in G54, 9 in machine Z); G10 L20 makes that Z0 of
+    // G54, so the G91 move from there goes X+1 (#5070) and Z+1 (#5061).
+    assert_eq!(p.get(5223), 9.0);
+    let last = calls
+        .iter()
+        .rev()
+        .find_map(|(_, c)| match c {
+            Canon::StraightFeed(e) => Some(*e),
+            _ => None,
+        })
+        .unwrap();
+    assert_eq!((last.x(), last.z()), (2.0, 1.0));
+    let failing = [
+        (
+            ProbeOutcome::Completed,
+            "G38.2 move finished without making contact.",
+        ),
+        (
+            ProbeOutcome::AlreadyThere,
+            "Probe is already tripped when starting G38.2 or G38.3 move",
+        ),
+    ];
+    for (outcome, text) in failing {
+        let (result, _, _) = run(&[outcome]);
+        let err = result.unwrap_err();
+        assert_eq!((err.kind.to_string().as_str(), err.span.line), (text, 3));
+    }
+    let g383 = |outcome| {
+        let config = Config {
+            probe: ProbeModel::Answered(Arc::from([outcome])),
+            ..Config::default()
+        };
+        let mut interp = Interpreter::new(config);
+        let text = "G21 F50 G38.3 X8\nG38.5 X0\nM2\n";
+        let result = interp.run(text, &mut Vec::<(Origin, Canon)>::new());
+        (result, interp.params().get(5061), interp.params().get(5070))
+    };
+    // G38.3 untripped: on from X8, #5070 = 0; the G38.5 after it awaits its own answer.
+    let (result, x, tripped) = g383(ProbeOutcome::Completed);
+    assert_eq!(
+        result.unwrap_err().kind.to_string(),
+        "G38.5 probe move awaits the machine's answer"
+    );
+    assert_eq!((x, tripped), (8.0, 0.0));
 }

@@ -27,6 +27,7 @@ pub mod kinematics;
 pub mod linear_delta;
 pub mod machine;
 pub mod pose;
+pub mod probe;
 pub mod segment;
 pub mod table_ac;
 pub mod table_bc;

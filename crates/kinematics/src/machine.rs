@@ -71,6 +71,8 @@ struct RawMachine {
     path: RawPath,
     #[serde(default)]
     joint: Vec<RawJoint>,
+    #[serde(default)]
+    probe: Option<crate::probe::RawProbe>,
 }
 
 /// `[kinematics]` as the machine reads it: the model's `type` and the `tcp` switch.
@@ -157,6 +159,8 @@ pub struct Machine {
     pub joints: Vec<Joint>,
     /// `[kinematics] tcp`: when tool-centre-point control is on.
     pub tcp: TcpSwitch,
+    /// `[probe]` (optional): the simulated probe G38 moves touch.
+    pub probe: Option<crate::probe::ProbeModel>,
 }
 
 impl Machine {
@@ -324,6 +328,7 @@ fn build(raw: RawMachine, text: &str) -> Result<Machine, MachineError> {
         path,
         joints,
         tcp,
+        probe: raw.probe.map(|p| p.build("probe.")).transpose()?,
     })
 }
 

@@ -14,8 +14,7 @@
 
 use tezgah_motion::plan::limits::{analyse, inside_group};
 use tezgah_motion::plan::{Piece, Planned};
-use tezgah_motion::profile::reach_velocity;
-use tezgah_motion::{Junction, Limits, Profile, State};
+use tezgah_motion::{Junction, Profile, State};
 
 use super::{Current, Executor, Produced};
 use crate::command::RunState;
@@ -88,27 +87,6 @@ fn time_to(stop: &Profile, distance: f64) -> f64 {
     hi
 }
 
-/// The stop from path state `x` (from s = 0) under `l`; `None` when the acceleration is past
-/// the limit beyond rounding, or the stop would need the speed to go negative (braking harder
-/// than the jerk can release: v + a|a|/(2J) < 0) — the path cannot be driven backward.
-fn stop_under(x: &State, l: &Limits) -> Option<Profile> {
-    let a_max = l.max_acceleration();
-    if x.v.is_nan() || x.v < 0.0 || x.a.abs() > a_max * (1.0 + SLACK) {
-        return None;
-    }
-    let a = x.a.clamp(-a_max, a_max);
-    if x.v + a * a.abs() / (2.0 * l.max_jerk()) < 0.0 {
-        return None;
-    }
-    let start = State {
-        s: 0.0,
-        v: x.v,
-        a,
-        j: 0.0,
-    };
-    reach_velocity(start, 0.0, l).ok()
-}
-
 impl Executor {
     /// Starts a path stop if the state where the hold meets the plan allows one that ends
     /// inside the piece in hand or the next; false leaves the stop to the time scale.
@@ -128,7 +106,7 @@ impl Executor {
             a: rd * st.v + r * r * st.a,
             j: 0.0,
         };
-        let Some(first) = stop_under(&here, &piece.limits) else {
+        let Some(first) = crate::stop::path_stop(&here, &piece.limits) else {
             return false;
         };
         let left = piece.length() - st.s;
@@ -180,7 +158,7 @@ impl Executor {
                 return None;
             }
         }
-        let second = stop_under(&x, &next.limits)?;
+        let second = crate::stop::path_stop(&x, &next.limits)?;
         (second.distance() < next.length()).then_some((second, at))
     }
 

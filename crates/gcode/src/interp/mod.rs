@@ -68,9 +68,10 @@ pub struct Config {
 
 /// What answers a probing move (G38.2–G38.5): the probe position (`#5061`…), whether it
 /// tripped (`#5070`) and where the move stopped. The program after a probe depends on the
-/// answer, so a run on a machine needs the executor's; until that hand-off exists, passes
-/// that make moves refuse probing rather than guess.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// answer, so a run on a machine is driven by the executor's: the interpreter stops at a probe
+/// it has no answer for ([`ErrorKind::ProbeAwaitsAnswer`]), the executor runs the moves so far
+/// and the probe move, and interprets again with one answer more (see `docs/dialect.md`).
+#[derive(Debug, Clone, PartialEq, Default)]
 pub enum ProbeModel {
     /// Refused with [`ErrorKind::ProbeUnavailable`], after LinuxCNC's own checks.
     #[default]
@@ -78,6 +79,23 @@ pub enum ProbeModel {
     /// LinuxCNC's standalone `rs274`: the probe never trips (`#5070` = 0), `#5061`… hold the
     /// target, and the move stops 0.01 in (0.254 mm) short of it, as its canon layer reports.
     Rs274,
+    /// The executor's answers to the program's probe moves so far, in order; the next probe
+    /// move stops the pass with [`ErrorKind::ProbeAwaitsAnswer`].
+    Answered(std::sync::Arc<[ProbeOutcome]>),
+}
+
+/// How the machine answered one probe move. Places are fractions of the move from its start
+/// (0) to its programmed end (1): the move is straight in every coordinate system the
+/// interpreter and the executor speak, so a fraction means the same point in both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ProbeOutcome {
+    /// The probe input changed at fraction `at`; the machine came to rest at `stopped`.
+    Tripped { at: f64, stopped: f64 },
+    /// The move ran to its end without the input changing.
+    Completed,
+    /// The input was already in the state the move looks for when it started (LinuxCNC
+    /// refuses the move).
+    AlreadyThere,
 }
 
 /// What the end of the text without M2, M30 or a closing `%` does.
@@ -157,6 +175,9 @@ pub struct Interpreter {
     missing_end: Option<GcodeError>,
     /// What M70/M73 saved at each call level.
     saved_modes: modes::ModeStack,
+    /// Probe moves run so far: the index of the next one's answer in
+    /// [`ProbeModel::Answered`].
+    probes: usize,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -223,6 +244,7 @@ impl Interpreter {
             spline_memory: Default::default(),
             missing_end: None,
             saved_modes: Default::default(),
+            probes: 0,
         };
         interp.restore_parameters();
         interp

@@ -165,17 +165,56 @@ impl Interpreter {
         if matches!(g, 382 | 384) && end == start {
             return Err((ErrorKind::ProbeStartAtTarget, at));
         }
-        if self.cfg.probe == super::ProbeModel::Unavailable {
-            return Err((
-                ErrorKind::ProbeUnavailable(format!("{}.{}", g / 10, g % 10)),
-                at,
-            ));
-        }
+        let name = || format!("{}.{}", g / 10, g % 10);
+        let outcome = match &self.cfg.probe {
+            super::ProbeModel::Unavailable => {
+                return Err((ErrorKind::ProbeUnavailable(name()), at));
+            }
+            super::ProbeModel::Rs274 => None,
+            super::ProbeModel::Answered(answers) => Some(answers.get(self.probes).copied()),
+        };
         self.emit(sink, Canon::TurnProbeOn);
         self.emit(sink, Canon::StraightProbe(end));
         self.emit(sink, Canon::TurnProbeOff);
-        // rs274's canon: never tripped, the target as the probe position, and the machine
-        // 0.01 in short of it along the XYZ direction of the move.
+        let Some(outcome) = outcome else {
+            self.rs274_probe(start, end);
+            return Ok(());
+        };
+        let Some(outcome) = outcome else {
+            return Err((ErrorKind::ProbeAwaitsAnswer(name()), at));
+        };
+        self.probes += 1;
+        let toward = matches!(g, 382 | 383);
+        let point = |f: f64| {
+            let mut p = start;
+            for i in 0..6 {
+                p.0[i] += f * (end.0[i] - start.0[i]);
+            }
+            p
+        };
+        let (probed, stopped, tripped) = match outcome {
+            super::ProbeOutcome::Tripped { at: f, stopped } => (point(f), point(stopped), true),
+            super::ProbeOutcome::Completed if matches!(g, 382) => {
+                return Err((ErrorKind::ProbeNoContact, at))
+            }
+            super::ProbeOutcome::Completed if matches!(g, 384) => {
+                return Err((ErrorKind::ProbeStillInContact, at))
+            }
+            // G38.3 and G38.5 go on untripped from the end of the move.
+            super::ProbeOutcome::Completed => (end, end, false),
+            super::ProbeOutcome::AlreadyThere if toward => {
+                return Err((ErrorKind::ProbeAlreadyTripped, at))
+            }
+            super::ProbeOutcome::AlreadyThere => return Err((ErrorKind::ProbeAlreadyClear, at)),
+        };
+        self.set_probe_parameters(probed, tripped);
+        self.state.pos = stopped;
+        Ok(())
+    }
+
+    /// rs274's canon: never tripped, the target as the probe position, and the machine
+    /// 0.01 in short of it along the XYZ direction of the move.
+    fn rs274_probe(&mut self, start: Pose, end: Pose) {
         let d = [
             start.0[0] - end.0[0],
             start.0[1] - end.0[1],
@@ -189,15 +228,21 @@ impl Interpreter {
                 stop.0[i] = end.0[i] + backoff * (di / distance);
             }
         }
-        for (i, v) in end.0.iter().enumerate() {
+        self.set_probe_parameters(end, false);
+        self.state.pos = stop;
+    }
+
+    /// `#5061`…`#5066` the probed point (program coordinates), `#5067`…`#5069` (U V W) zero,
+    /// `#5070` whether it tripped.
+    fn set_probe_parameters(&mut self, probed: Pose, tripped: bool) {
+        for (i, v) in probed.0.iter().enumerate() {
             self.params.set(params::PROBE_POSITION + i, *v);
         }
         for i in 6..9 {
             self.params.set(params::PROBE_POSITION + i, 0.0);
         }
-        self.params.set(params::PROBE_TRIPPED, 0.0);
-        self.state.pos = stop;
-        Ok(())
+        self.params
+            .set(params::PROBE_TRIPPED, if tripped { 1.0 } else { 0.0 });
     }
 
     /// An inverse-time move's rate becomes the feed rate in force, as in LinuxCNC.
