@@ -12,7 +12,8 @@ use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{
-    Band, CheckFace, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
+    Band, CheckFace, Cutter, CutterShape, Settings, StrategyKind, ToleranceShares, ToolAxis,
+    ToolPath,
 };
 use tezgah_geom::{NurbsSurface, Vec3};
 use tezgah_kinematics::{Kinematics, Machine};
@@ -39,18 +40,32 @@ pub struct CamArgs {
     /// (shared by chords, linearisation and blending; taken from the scallop budget).
     #[arg(long)]
     pub tolerance: f64,
-    /// Lead angle: the tool tilted from the normal toward the feed, degrees.
-    #[arg(long = "lead", default_value_t = 0.0, allow_hyphen_values = true)]
-    pub lead_deg: f64,
+    /// Lead angle: the tool tilted from the normal toward the feed, degrees. Default: 15° for
+    /// a ball end mill (along the normal a ball cuts with its centre, where the cutting speed
+    /// is zero: it rubs rather than cuts, and the finish suffers; at 15° the contact turns at
+    /// R·sin 15° = 0.26 R from the axis), 0° for flat and bull-nose ends.
+    #[arg(long = "lead", allow_hyphen_values = true)]
+    pub lead_deg: Option<f64>,
+    /// How far a ball end mill's axis may turn from the planned one (lead and tilt about
+    /// the normal), degrees, so that the table turns little and slowly where the surface
+    /// faces up (the pole, where C would otherwise spin): the ball's centre, and so the cut,
+    /// stays. 0 keeps the planned axis.
+    #[arg(long = "axis-cone", default_value_t = AXIS_CONE_DEG)]
+    pub axis_cone_deg: f64,
     /// Tilt angle: the tool tilted from the normal across the feed, degrees.
     #[arg(long = "tilt", default_value_t = 0.0, allow_hyphen_values = true)]
     pub tilt_deg: f64,
     /// Cutting feed, mm/min (the tip's speed on the part).
     #[arg(long, default_value_t = 1000.0)]
     pub feed: f64,
-    /// Write feeds in inverse time (G93).
+    /// Write feeds in inverse time (G93): every block's F is 1/(its minutes at the feed on
+    /// the part). The default with --joints, where a G94 feed would apply to the machine's
+    /// X Y Z instead of the tip on the part.
     #[arg(long)]
     pub inverse_time: bool,
+    /// Write feeds per minute (G94) even with --joints.
+    #[arg(long, conflicts_with = "inverse_time")]
+    pub feed_per_minute: bool,
     /// Write machine joints (G43, no tool-centre-point control) instead of G43.4 output.
     #[arg(long)]
     pub joints: bool,
@@ -97,6 +112,21 @@ pub struct CamArgs {
 /// along the tool axis to a clearance sphere and turn the table only there, which is safe
 /// for any tilt.
 pub const MAX_TILT_DEG: f64 = 180.0;
+
+/// The default lead of a ball end mill, degrees (`--lead`): off the normal the contact leaves
+/// the ball's centre, where the cutting speed is zero.
+pub const BALL_LEAD_DEG: f64 = 15.0;
+
+/// The default `--axis-cone`, degrees: two thirds of the ball's default lead, so the contact
+/// stays at least 5° off the ball's centre.
+pub const AXIS_CONE_DEG: f64 = 10.0;
+
+/// Whether feeds are written in inverse time: asked for, or by default without
+/// tool-centre-point control (`--joints`), where the controller would apply a G94 feed to the
+/// machine's X Y Z.
+fn inverse_time(args: &CamArgs) -> bool {
+    args.inverse_time || (args.joints && !args.feed_per_minute)
+}
 
 /// What the strategy is asked for.
 pub struct PlanRequest {
@@ -406,7 +436,17 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         ));
     }
     let feed = positive("--feed", args.feed)?;
-    for (name, v) in [("--lead", args.lead_deg), ("--tilt", args.tilt_deg)] {
+    if !(args.axis_cone_deg.is_finite() && (0.0..90.0).contains(&args.axis_cone_deg)) {
+        return Err(miette!(
+            "--axis-cone must be an angle in [0°, 90°), got {}",
+            args.axis_cone_deg
+        ));
+    }
+    let lead_deg = args.lead_deg.unwrap_or(match spec {
+        ToolSpec::Given(CutterShape::Ball { .. }) | ToolSpec::Auto => BALL_LEAD_DEG,
+        ToolSpec::Given(_) => 0.0,
+    });
+    for (name, v) in [("--lead", lead_deg), ("--tilt", args.tilt_deg)] {
         if !(v.is_finite() && v.abs() < 90.0) {
             return Err(miette!("{name} must be an angle in (−90°, 90°), got {v}"));
         }
@@ -485,7 +525,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             None => tolerance,
         },
         band: Some(shares.band()),
-        lead_deg: args.lead_deg,
+        lead_deg,
         tilt_deg: args.tilt_deg,
         max_tilt_deg,
         direction,
@@ -506,7 +546,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         } else {
             OutputForm::CentrePoint
         },
-        feed_output: if args.inverse_time {
+        feed_output: if inverse_time(&args) {
             FeedOutput::InverseTime
         } else {
             FeedOutput::PerMinute
@@ -522,6 +562,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             scallop
         ),
         blend_mm: Some(shares.blend),
+        ball_axis_cone_deg: (args.axis_cone_deg > 0.0).then_some(args.axis_cone_deg),
         ..PostOptions::new(feed, shares.linearisation)
     };
     // The program is judged on everything it is meant to machine: the whole face, less what
@@ -770,7 +811,7 @@ fn report_json(
         "machine": machine.name,
         "output": if args.joints { "joints" } else { "tcp" },
         "feed_mm_per_min": args.feed,
-        "inverse_time": args.inverse_time,
+        "inverse_time": inverse_time(args),
         "tolerance_mm": args.tolerance,
         "scallop_target_mm": scallop,
         "passes": path.passes.len(),
@@ -780,6 +821,9 @@ fn report_json(
         "plunge_length_mm": s.plunge_length_mm,
         "rapid_length_mm": s.rapid_length_mm,
         "machining_time_s": s.feed_time_s,
+        "cycle_time_s": s.cycle_time_s,
+        "max_axis_change_deg": s.max_axis_change_deg,
+        "cycle_over_path_time": s.cycle_time_s.map(|c| c / s.feed_time_s),
         "output_points": s.points,
         "inserted_points": s.inserted,
         "max_linearisation_mm": s.max_linearisation_mm,
@@ -837,15 +881,23 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64) {
     let s = &done.posted.stats;
     let v = &done.verification;
     println!(
-        "{} → {}: {} points ({} inserted), path {:.1} mm, {:.1} s at F{}",
+        "{} → {}: {} points ({} inserted), path {:.1} mm, {:.1} s at F{}, links {:.1} mm",
         args.surface.display(),
         args.output.display(),
         s.points,
         s.inserted,
         s.cutting_length_mm,
         s.feed_time_s,
-        args.feed
+        args.feed,
+        s.rapid_length_mm
     );
+    if let Some(c) = s.cycle_time_s {
+        println!(
+            "cycle on {}: {c:.1} s through tezgah's planning of the program ({:.2} × path/feed)",
+            args.machine.as_deref().unwrap_or("table-ac"),
+            c / s.feed_time_s
+        );
+    }
     println!(
         "verified on {} dexels (cell {:.4} mm): max scallop {:.4} mm (target {scallop}), \
          gouge {:.4} mm (limit {GOUGE_LIMIT_MM}), bounds −{:.4}/+{:.4} mm, uncut {}",

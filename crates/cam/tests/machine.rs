@@ -1,0 +1,151 @@
+//! Programs a five-axis machine runs well (issue 23), on free-form faces whose normals pass
+//! through the vertical (`saddle_bump`, `wavy_patch`, `bowl_patch`, written by OpenCascade:
+//! `tests/oracle/make_step_fixtures.py`): every posted program is taken by tezgah's own runner
+//! on table-ac and table-bc (the post's tryout would refuse it otherwise), the steered ball
+//! turns the table less, and inverse-time feeds give the tip the programmed feed.
+
+use std::path::PathBuf;
+
+use tezgah_cam::post::{post, tryout, FeedOutput, OutputForm, PostOptions, Posted};
+use tezgah_cam::{
+    Cutter, CutterShape, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
+};
+use tezgah_kinematics::Machine;
+
+/// A coarse iso-scallop finish of fixture `name` with a 6 mm ball at 15° lead, h 1 mm,
+/// T 0.05 mm (coarse, to keep the test short; the issue's h 0.02 runs in the CLI).
+fn finish(name: &str) -> ToolPath {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures")
+        .join(format!("{name}.stp"));
+    let model = tezgah_cam::step::read_file(path).unwrap();
+    let face = &model.faces[0];
+    let shares = ToleranceShares::of(0.05);
+    let mut settings = Settings::new(StrategyKind::IsoScallop, 1.0, shares.chord);
+    if let ToolAxis::Surface { lead_deg, .. } = &mut settings.axis {
+        *lead_deg = 15.0;
+    }
+    settings.reverse_normal = !face.same_sense;
+    settings.band = Some(shares.band());
+    let cutter = Cutter::standard(CutterShape::Ball { radius: 3.0 });
+    tezgah_cam::plan(&face.surface, &cutter, &settings)
+        .unwrap()
+        .path
+}
+
+fn options(cone: Option<f64>) -> PostOptions {
+    PostOptions {
+        ball_axis_cone_deg: cone,
+        ..PostOptions::new(4000.0, ToleranceShares::of(0.05).linearisation)
+    }
+}
+
+/// C's travel over the program's cutting blocks, degrees.
+fn c_travel(p: &Posted) -> f64 {
+    p.points
+        .windows(2)
+        .filter(|w| w[1].motion == tezgah_cam::post::links::Motion::Cut)
+        .map(|w| (w[1].angles.c - w[0].angles.c).abs().to_degrees())
+        .sum()
+}
+
+#[test]
+fn every_program_runs_on_table_ac_and_table_bc() {
+    for name in ["saddle_bump", "wavy_patch", "bowl_patch"] {
+        let path = finish(name);
+        for machine in ["table-ac", "table-bc"] {
+            let m = Machine::builtin(machine).unwrap();
+            // The post's tryout: refused by the runner, refused here.
+            let posted = post(&path, &m, &options(Some(10.0)))
+                .unwrap_or_else(|e| panic!("{name} on {machine}: {e}"));
+            let s = &posted.stats;
+            let cycle = s.cycle_time_s.expect("the tryout's cycle");
+            // The machine takes at least path/feed, and its rapids on top.
+            assert!(cycle > s.feed_time_s, "{name} on {machine}: {s:?}");
+            assert!(s.max_axis_change_deg <= 10.0 + 1e-9, "{s:?}");
+        }
+    }
+}
+
+#[test]
+fn the_steered_ball_turns_the_table_less() {
+    let path = finish("wavy_patch");
+    let m = Machine::builtin("table-ac").unwrap();
+    let planned = post(
+        &path,
+        &m,
+        &PostOptions {
+            tryout: false,
+            ..options(None)
+        },
+    )
+    .unwrap();
+    let steered = post(
+        &path,
+        &m,
+        &PostOptions {
+            tryout: false,
+            ..options(Some(10.0))
+        },
+    )
+    .unwrap();
+    let (before, after) = (c_travel(&planned), c_travel(&steered));
+    assert!(after < 0.8 * before, "C travel {before:.0}° → {after:.0}°");
+    // The cut is the same: every cutting point's ball centre is where it was planned.
+    let centres = |p: &Posted| -> Vec<tezgah_geom::Vec3> {
+        p.points
+            .iter()
+            .filter(|q| q.motion == tezgah_cam::post::links::Motion::Cut && !q.inserted)
+            .map(|q| q.tip + q.axis * 3.0)
+            .collect()
+    };
+    let (a, b) = (centres(&planned), centres(&steered));
+    assert_eq!(a.len(), b.len());
+    for (p, q) in a.iter().zip(&b) {
+        assert!((p - q).norm() < 1e-9, "{p:?} vs {q:?}");
+    }
+}
+
+#[test]
+fn inverse_time_gives_the_tip_the_feed() {
+    let path = finish("bowl_patch");
+    let m = Machine::builtin("table-ac").unwrap();
+    for form in [OutputForm::Joints, OutputForm::CentrePoint] {
+        let o = PostOptions {
+            form,
+            feed_output: FeedOutput::InverseTime,
+            tryout: false,
+            ..options(Some(10.0))
+        };
+        let posted = post(&path, &m, &o).unwrap();
+        // Every G1 block's time is 1/F minutes: their sum is the tip's cutting and plunging
+        // length at the feed.
+        let minutes: f64 = posted
+            .program
+            .lines()
+            .filter(|l| l.starts_with("G1 "))
+            .map(|l| {
+                let f = l.split(' ').find_map(|w| w.strip_prefix('F')).unwrap();
+                1.0 / f.parse::<f64>().unwrap()
+            })
+            .sum();
+        let want = posted.stats.feed_time_s / 60.0;
+        assert!(
+            ((minutes - want) / want).abs() < 1e-6,
+            "{form:?}: {minutes} min vs {want} min"
+        );
+    }
+}
+
+#[test]
+fn the_tryout_names_the_line_the_runner_refuses() {
+    let m = Machine::builtin("table-ac").unwrap();
+    // A written on the limit is taken; past it (line 6) the runner refuses.
+    let program = "G21 G90 G94\nT1 M6\nG43.4 H1\nG0 X0 Y0 Z50 A0 C0\nG1 X0 Y0 Z10 A119.9998 C0 F1000\nG1 X0 Y0 Z10 A120.5 C0\nG49\nM2\n";
+    let err = tryout::tryout(program, &m, 1, 0.0).unwrap_err();
+    assert_eq!(err.line, 6, "{err}");
+    assert!(err.message.contains("outside its limits"), "{err}");
+    let fine = program.replace("A120.5", "A119.9998");
+    let ok = tryout::tryout(&fine, &m, 1, 0.0).unwrap();
+    assert!(ok.cycle_time_s > 40.0 / 1000.0 * 60.0, "{ok:?}");
+}
