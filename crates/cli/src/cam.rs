@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
-use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
+use tezgah_cam::post::{post_with, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::region::FaceRegion;
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
@@ -115,11 +115,20 @@ pub const MAX_TILT_DEG: f64 = 180.0;
 
 /// The default lead of a ball end mill, degrees (`--lead`): off the normal the contact leaves
 /// the ball's centre, where the cutting speed is zero.
-pub const BALL_LEAD_DEG: f64 = 15.0;
+pub const BALL_LEAD_DEG: f64 = 10.0;
 
 /// The default `--axis-cone`, degrees: two thirds of the ball's default lead, so the contact
 /// stays at least 5° off the ball's centre.
-pub const AXIS_CONE_DEG: f64 = 10.0;
+pub const AXIS_CONE_DEG: f64 = 0.0;
+
+/// The lead: the one given, else [`BALL_LEAD_DEG`] for a ball end mill (`--tool auto` picks
+/// one) and 0 for flat and bull-nose ends.
+fn lead(spec: &ToolSpec, given: Option<f64>) -> f64 {
+    given.unwrap_or(match spec {
+        ToolSpec::Given(CutterShape::Ball { .. }) | ToolSpec::Auto => BALL_LEAD_DEG,
+        ToolSpec::Given(_) => 0.0,
+    })
+}
 
 /// Whether feeds are written in inverse time: asked for, or by default without
 /// tool-centre-point control (`--joints`), where the controller would apply a G94 feed to the
@@ -442,10 +451,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             args.axis_cone_deg
         ));
     }
-    let lead_deg = args.lead_deg.unwrap_or(match spec {
-        ToolSpec::Given(CutterShape::Ball { .. }) | ToolSpec::Auto => BALL_LEAD_DEG,
-        ToolSpec::Given(_) => 0.0,
-    });
+    let lead_deg = lead(&spec, args.lead_deg);
     for (name, v) in [("--lead", lead_deg), ("--tilt", args.tilt_deg)] {
         if !(v.is_finite() && v.abs() < 90.0) {
             return Err(miette!("{name} must be an angle in (−90°, 90°), got {v}"));
@@ -570,20 +576,43 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     let region = MachinedRegion::Reachable {
         max_tilt_deg: reach_normal_tilt_deg,
     };
-    let done = finish(
+    let judged = Judged {
+        region,
+        face: face_region.as_ref(),
+        outward_is_su_x_sv,
+        neighbours: &neighbours,
+        check_tolerance_mm: request.neighbour_tolerance_mm,
+    };
+    let mut done = finish(
         &surface,
         &path,
         &machine,
         &options,
         args.verify_cell_mm,
-        Judged {
-            region,
-            face: face_region.as_ref(),
-            outward_is_su_x_sv,
-            neighbours: &neighbours,
-            check_tolerance_mm: request.neighbour_tolerance_mm,
-        },
+        judged,
     )?;
+    if !done.verified(scallop) && options.ball_axis_cone_deg.is_some() {
+        // The steered axes are held to the strategy's gouge checks at the locations, not over
+        // the motion between them: a steered program that is not verified is posted again
+        // with the planned axes (a known gap: issue 23's wavy patch at lead 15°, h 0.1).
+        eprintln!(
+            "note: with the ball's axis steered the program is not verified (gouge {:.4} mm, \
+             scallop {:.4} mm); posting it with the planned axes",
+            done.verification.gouge_depth_mm, done.verification.max_scallop_mm
+        );
+        let planned = PostOptions {
+            ball_axis_cone_deg: None,
+            ..options.clone()
+        };
+        done = finish(
+            &surface,
+            &path,
+            &machine,
+            &planned,
+            args.verify_cell_mm,
+            judged,
+        )?;
+    }
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
@@ -679,7 +708,29 @@ pub fn finish(
     cell_mm: Option<f64>,
     judged: Judged,
 ) -> Result<Finished> {
-    let posted = post(path, machine, options).into_diagnostic()?;
+    // A steered ball's flutes, shank and holder are held to the strategy's gouge checks
+    // over the face and the part's other faces.
+    let mut faces: Vec<(&NurbsSurface, Option<&FaceRegion>)> = vec![(surface, judged.face)];
+    faces.extend(
+        judged
+            .neighbours
+            .iter()
+            .map(|n| (&n.check.surface, n.check.region.as_ref())),
+    );
+    let gouge = tezgah_cam::gouge::GougeSettings {
+        depth_tolerance: 0.5 * GOUGE_LIMIT_MM,
+        neighbour_depth_tolerance: judged.check_tolerance_mm,
+        ..tezgah_cam::gouge::GougeSettings::default()
+    };
+    let checker = match options.ball_axis_cone_deg {
+        Some(_) => Some(
+            tezgah_cam::gouge::GougeChecker::of_faces(&faces, &path.cutter, gouge)
+                .into_diagnostic()?,
+        ),
+        None => None,
+    };
+    let clear = |tip: &Vec3, axis: &Vec3| checker.as_ref().is_none_or(|c| c.clear(tip, axis));
+    let posted = post_with(path, machine, options, &clear).into_diagnostic()?;
     let step_over = verify::step_over(path).unwrap_or(2.0 * path.cutter.shape.radius());
     let rho = match path.cutter.shape.corner_radius() {
         r if r > 0.0 => r,
@@ -979,6 +1030,62 @@ mod tests {
             passes,
         };
         (s, path)
+    }
+
+    #[derive(clap::Parser)]
+    struct Line {
+        #[command(flatten)]
+        args: CamArgs,
+    }
+
+    fn args(extra: &[&str]) -> CamArgs {
+        use clap::Parser;
+        let base = [
+            "tezgah-cam",
+            "s.stp",
+            "--tool",
+            "ball:6",
+            "--strategy",
+            "zigzag",
+        ];
+        let rest = ["--scallop", "0.1", "--tolerance", "0.01", "-o", "o.ngc"];
+        let all: Vec<&str> = base.iter().chain(&rest).chain(extra).copied().collect();
+        Line::try_parse_from(all).unwrap().args
+    }
+
+    #[test]
+    fn joint_output_defaults_to_inverse_time() {
+        assert!(!inverse_time(&args(&[])));
+        assert!(inverse_time(&args(&["--inverse-time"])));
+        assert!(inverse_time(&args(&["--joints"])));
+        assert!(!inverse_time(&args(&["--joints", "--feed-per-minute"])));
+        // Both at once is a contradiction clap refuses.
+        use clap::Parser;
+        let both = [
+            "t",
+            "s.stp",
+            "--tool",
+            "ball:6",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.1",
+            "--tolerance",
+            "0.01",
+            "-o",
+            "o.ngc",
+            "--inverse-time",
+            "--feed-per-minute",
+        ];
+        assert!(Line::try_parse_from(both).is_err());
+        // A ball leans 15° unless told, a flat end not; the axis cone is 10°.
+        let a = args(&[]);
+        assert_eq!(a.axis_cone_deg, AXIS_CONE_DEG);
+        let ball = ToolSpec::parse("ball:6").unwrap();
+        assert_eq!(lead(&ball, a.lead_deg), 15.0);
+        assert_eq!(lead(&ball, args(&["--lead", "-3"]).lead_deg), -3.0);
+        assert_eq!(lead(&ToolSpec::parse("flat:6").unwrap(), None), 0.0);
+        assert_eq!(lead(&ToolSpec::Auto, None), 15.0);
     }
 
     #[test]

@@ -220,11 +220,24 @@ fn positive(what: &'static str, value: f64) -> Result<f64, PostError> {
     }
 }
 
-/// Posts `path` for `machine` (table-ac or table-bc).
+/// Posts `path` for `machine` (table-ac or table-bc). A steered ball's axes
+/// ([`PostOptions::ball_axis_cone_deg`]) are not checked against the part: see [`post_with`].
 pub fn post(
     path: &ToolPath,
     machine: &Machine,
     options: &PostOptions,
+) -> Result<Posted, PostError> {
+    post_with(path, machine, options, &|_, _| true)
+}
+
+/// [`post`], with `clear(tip, axis)` saying whether the cutter standing there is clear of the
+/// part (the strategy's gouge checks): a pass whose steered ball would not be keeps its
+/// planned axes ([`steer::steer`]).
+pub fn post_with(
+    path: &ToolPath,
+    machine: &Machine,
+    options: &PostOptions,
+    clear: &(dyn Fn(&Vec3, &Vec3) -> bool + Sync),
 ) -> Result<Posted, PostError> {
     let feed = positive("the feed", options.feed_mm_per_min)?;
     let tolerance = positive("the tolerance", options.tolerance_mm)?;
@@ -286,6 +299,7 @@ pub fn post(
             cone,
             radius,
             steer::max_step(radius, tolerance),
+            clear,
         );
         steered = Some(s);
     }
@@ -323,7 +337,8 @@ pub fn post(
     }
     let (points, worst, inserted) = motion.refine(points, tolerance, options.max_halvings)?;
     let (points, at_pole) = through_the_pole(points, &motion, tolerance)?;
-    let inserted = inserted + at_pole;
+    let (points, turns) = pole_turns(points, &motion)?;
+    let inserted = inserted + at_pole + turns;
     check_clear(&points, &motion, &sphere)?;
 
     let mut stats = PostStats {
@@ -425,6 +440,75 @@ fn through_the_pole(
                 }
             }
         }
+        out.push(b);
+    }
+    Ok((out, added))
+}
+
+/// Link stations on the clearance sphere whose axis leans less than this (rad, 1°) from the
+/// C axis are moved onto it: there the tool is clear of the part whatever its axis (the moves
+/// are checked again by [`check_clear`]), and an axis a hair from the pole is where C would
+/// swing.
+const LINK_POLE: f64 = std::f64::consts::PI / 180.0;
+
+/// The moves that touch the pole made as the runner takes them without a jump: a link
+/// station within [`LINK_POLE`] of the pole is put on it; a point on the pole takes the C of
+/// the point before (at the pole C does not move the axis, so the move arrives along one
+/// meridian plane); and before leaving the pole toward another C the table turns there with
+/// the tool standing. Arriving or leaving toward another C, the axis's great circle leaves the
+/// pole at an azimuth other than the programmed C, and the runner's walk along it jumps.
+fn pole_turns(
+    points: Vec<PostedPoint>,
+    motion: &MachineMotion<'_>,
+) -> Result<(Vec<PostedPoint>, usize), PostError> {
+    let at = |p: &PostedPoint, angles: TableAngles, previous: &Joints| {
+        motion
+            .joints(&p.tip, angles, previous)
+            .map_err(|e| PostError::Kinematics {
+                at: p.source,
+                error: e,
+            })
+    };
+    let n = points.len();
+    let mut out: Vec<PostedPoint> = Vec::with_capacity(n);
+    let mut added = 0;
+    for i in 0..n {
+        let mut b = points[i];
+        let Some(a) = out.last().copied() else {
+            out.push(b);
+            continue;
+        };
+        let station = i + 1 < n
+            && a.motion == Motion::Rapid
+            && b.motion == Motion::Rapid
+            && points[i + 1].motion == Motion::Rapid
+            && b.axis.angle(&points[i + 1].axis) > STILL_AXIS
+            && b.axis.angle(&a.axis) > STILL_AXIS;
+        if station && b.angles.tilt != 0.0 && b.angles.tilt.abs() <= LINK_POLE {
+            b.angles.tilt = 0.0;
+            b.axis = Vec3::z();
+        }
+        if b.angles.tilt == 0.0 && b.angles.c != a.angles.c {
+            b.angles.c = a.angles.c;
+        }
+        if a.angles.tilt == 0.0 && b.angles.tilt != 0.0 && b.angles.c != a.angles.c {
+            let angles = TableAngles {
+                tilt: 0.0,
+                c: b.angles.c,
+            };
+            let turn = PostedPoint {
+                angles,
+                joints: at(&a, angles, &a.joints)?,
+                motion: b.motion,
+                source: b.source,
+                inserted: true,
+                ..a
+            };
+            out.push(turn);
+            added += 1;
+        }
+        let previous = out.last().map_or(b.joints, |p| p.joints);
+        b.joints = at(&b, b.angles, &previous)?;
         out.push(b);
     }
     Ok((out, added))

@@ -19,6 +19,8 @@
 
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
+
 use tezgah_geom::Vec3;
 
 use super::orient::Orienter;
@@ -188,7 +190,7 @@ pub struct Steered {
     /// Largest angle between the steered axes of neighbouring locations, rad.
     pub max_step: f64,
     /// Passes that keep their planned axes: no rate of C fitted within the cone and the step
-    /// cap.
+    /// cap, or the steered tool would touch the part.
     pub kept_passes: usize,
 }
 
@@ -196,7 +198,14 @@ pub struct Steered {
 /// so that C moves little and slowly (module doc); tips move to keep the ball's centre.
 /// `path` must be of a ball cutter of radius `radius` (mm). C turns the axis by at most about
 /// `max_step` (rad) between neighbouring locations ([`max_step`]).
-pub fn steer(path: &mut ToolPath, o: &Orienter, cone: f64, radius: f64, max_step: f64) -> Steered {
+pub fn steer(
+    path: &mut ToolPath,
+    o: &Orienter,
+    cone: f64,
+    radius: f64,
+    max_step: f64,
+    clear: &(dyn Fn(&Vec3, &Vec3) -> bool + Sync),
+) -> Steered {
     let mut out = Steered::default();
     let mut c_end = 0.0;
     for pass in &mut path.passes {
@@ -231,16 +240,29 @@ pub fn steer(path: &mut ToolPath, o: &Orienter, cone: f64, radius: f64, max_step
             out.kept_passes += 1;
             continue;
         };
+        let steered: Vec<(Vec3, Vec3)> = pass
+            .points
+            .iter()
+            .zip(&cs)
+            .map(|(p, c)| {
+                let mut angles = o.keeping_c(&p.axis, *c);
+                // A machine that cannot tilt both ways stands at the pole instead (within
+                // the cone: the admitted C then are any only where the pole is within it).
+                angles.tilt = angles.tilt.clamp(o.tilt_limit.min, o.tilt_limit.max);
+                let axis = o.axis(angles);
+                (p.tip + p.axis * radius - axis * radius, axis)
+            })
+            .collect();
+        // The ball is the same, but its flutes and shank lean otherwise: a pass where the
+        // steered tool would touch the part keeps its planned axes.
+        if !steered.par_iter().all(|(tip, axis)| clear(tip, axis)) {
+            out.kept_passes += 1;
+            continue;
+        }
         let mut last: Option<Vec3> = None;
-        for (p, c) in pass.points.iter_mut().zip(&cs) {
-            let mut angles = o.keeping_c(&p.axis, *c);
-            // A machine that cannot tilt both ways stands at the pole instead (within the
-            // cone: the admitted C then are any only where the pole is within it).
-            angles.tilt = angles.tilt.clamp(o.tilt_limit.min, o.tilt_limit.max);
-            let axis = o.axis(angles);
+        for (p, (tip, axis)) in pass.points.iter_mut().zip(steered) {
             out.max_change = out.max_change.max(axis.angle(&p.axis));
-            let centre = p.tip + p.axis * radius;
-            p.tip = centre - axis * radius;
+            p.tip = tip;
             p.axis = axis;
             if let Some(l) = last {
                 out.max_step = out.max_step.max(l.angle(&axis));
@@ -323,7 +345,7 @@ mod tests {
         let planned = pass_by_pole(2.0, 12.0);
         let mut path = planned.clone();
         let cone = 10f64.to_radians();
-        let got = steer(&mut path, &o, cone, 3.0, 1.0);
+        let got = steer(&mut path, &o, cone, 3.0, 1.0, &|_, _| true);
         assert!(got.max_change <= cone + 1e-12, "{got:?}");
         // Planned: C swings about half a turn at the pole.
         assert!(travel(&c_of(&o, &planned)).to_degrees() > 150.0);
@@ -354,7 +376,7 @@ mod tests {
         let cone = 10f64.to_radians();
         let planned = pass_by_pole(15.0, 12.0);
         let mut path = planned.clone();
-        let got = steer(&mut path, &o, cone, 3.0, 1.0);
+        let got = steer(&mut path, &o, cone, 3.0, 1.0, &|_, _| true);
         assert!(got.max_change <= cone + 1e-9, "{got:?}");
         // The axis passes 15° from the pole: C must go from the first location's admitted
         // C (all below the middle's azimuth, 0°) to the last's (all above): at least the gap
