@@ -109,14 +109,24 @@ impl Orienter {
     }
 
     /// The tilt moved into its limits by whole turns, if any turn fits; a tilt within
-    /// [`LIMIT_MARGIN`] of a limit (either side) is kept that margin inside it.
+    /// [`LIMIT_MARGIN`] of a limit (either side) is kept that margin inside it (a limit at
+    /// zero excepted).
     fn tilt_in_limits(&self, tilt: f64) -> Option<f64> {
         let (lo, hi) = (self.tilt_limit.min, self.tilt_limit.max);
         let t = unwrap_within(tilt, tilt, lo - LIMIT_MARGIN, hi + LIMIT_MARGIN)?;
         if hi - lo <= 2.0 * LIMIT_MARGIN {
             return Some(0.5 * (lo + hi));
         }
-        Some(t.clamp(lo + LIMIT_MARGIN, hi - LIMIT_MARGIN))
+        // A limit at zero (a machine that tilts one way only) is written exactly as A0 and
+        // read back as exactly 0: the pole stays reachable.
+        let inside = |limit: f64, sign: f64| {
+            if limit == 0.0 {
+                0.0
+            } else {
+                limit + sign * LIMIT_MARGIN
+            }
+        };
+        Some(t.clamp(inside(lo, 1.0), inside(hi, -1.0)))
     }
 
     /// The candidates of one axis given the two states of the point before (for the pole).
