@@ -131,6 +131,23 @@ fn freeform_patch_matches_occt() {
 }
 
 #[test]
+fn issue_23_faces_match_occt() {
+    // The saddle with a bump, the wavy patch and the bowl of tests/machine.rs: one untrimmed
+    // bicubic face each, at OCCT's points and derivatives; the bowl's bottom is z = 0.
+    for name in ["saddle_bump", "wavy_patch", "bowl_patch"] {
+        let (m, _, _) = check(name);
+        assert_eq!(m.faces.len(), 1, "{name}");
+        assert_eq!(m.faces[0].surface.degrees(), (3, 3), "{name}");
+        assert!(m.faces[0].is_untrimmed(1e-7), "{name}");
+    }
+    let (bowl, _, _) = check("bowl_patch");
+    let s = &bowl.faces[0].surface;
+    let (u, v) = (s.domain_u(), s.domain_v());
+    let mid = s.point(0.5 * (u.0 + u.1), 0.5 * (v.0 + v.1));
+    assert!(mid.norm() < 1e-3, "{mid:?}");
+}
+
+#[test]
 fn inch_file_is_read_in_mm() {
     let (m, _, _) = check("freeform_patch_inch");
     assert_eq!(m.unit.name, "INCH");

@@ -6,13 +6,14 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use miette::{miette, IntoDiagnostic, Result, WrapErr};
-use tezgah_cam::post::{post, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
+use tezgah_cam::post::{post_with, FeedOutput, OutputForm, PartBox, PostOptions, Posted};
 use tezgah_cam::region::FaceRegion;
 use tezgah_cam::step::Face;
 use tezgah_cam::strategy::{FeedDirection, Refusal};
 use tezgah_cam::verify::{self, MachinedRegion, Verification, VerifyOptions, MAX_DEXELS};
 use tezgah_cam::{
-    Band, CheckFace, Cutter, Settings, StrategyKind, ToleranceShares, ToolAxis, ToolPath,
+    Band, CheckFace, Cutter, CutterShape, Settings, StrategyKind, ToleranceShares, ToolAxis,
+    ToolPath,
 };
 use tezgah_geom::{NurbsSurface, Vec3};
 use tezgah_kinematics::{Kinematics, Machine};
@@ -39,18 +40,32 @@ pub struct CamArgs {
     /// (shared by chords, linearisation and blending; taken from the scallop budget).
     #[arg(long)]
     pub tolerance: f64,
-    /// Lead angle: the tool tilted from the normal toward the feed, degrees.
-    #[arg(long = "lead", default_value_t = 0.0, allow_hyphen_values = true)]
-    pub lead_deg: f64,
+    /// Lead angle: the tool tilted from the normal toward the feed, degrees. Default: 10° for
+    /// a ball end mill (along the normal a ball cuts with its centre, where the cutting speed
+    /// is zero: it rubs rather than cuts, and the finish suffers; at 10° the contact turns at
+    /// R·sin 10° = 0.17 R from the axis), 0° for flat and bull-nose ends.
+    #[arg(long = "lead", allow_hyphen_values = true)]
+    pub lead_deg: Option<f64>,
+    /// How far a ball end mill's axis may turn from the planned one (lead and tilt about
+    /// the normal), degrees, so that the table turns little and slowly where the surface
+    /// faces up (the pole, where C would otherwise spin): the ball's centre, and so the cut,
+    /// stays. 0 keeps the planned axis.
+    #[arg(long = "axis-cone", default_value_t = AXIS_CONE_DEG)]
+    pub axis_cone_deg: f64,
     /// Tilt angle: the tool tilted from the normal across the feed, degrees.
     #[arg(long = "tilt", default_value_t = 0.0, allow_hyphen_values = true)]
     pub tilt_deg: f64,
     /// Cutting feed, mm/min (the tip's speed on the part).
     #[arg(long, default_value_t = 1000.0)]
     pub feed: f64,
-    /// Write feeds in inverse time (G93).
+    /// Write feeds in inverse time (G93): every block's F is 1/(its minutes at the feed on
+    /// the part). The default with --joints, where a G94 feed would apply to the machine's
+    /// X Y Z instead of the tip on the part.
     #[arg(long)]
     pub inverse_time: bool,
+    /// Write feeds per minute (G94) even with --joints.
+    #[arg(long, conflicts_with = "inverse_time")]
+    pub feed_per_minute: bool,
     /// Write machine joints (G43, no tool-centre-point control) instead of G43.4 output.
     #[arg(long)]
     pub joints: bool,
@@ -97,6 +112,31 @@ pub struct CamArgs {
 /// along the tool axis to a clearance sphere and turn the table only there, which is safe
 /// for any tilt.
 pub const MAX_TILT_DEG: f64 = 180.0;
+
+/// The default lead of a ball end mill, degrees (`--lead`): off the normal the contact leaves
+/// the ball's centre, where the cutting speed is zero.
+pub const BALL_LEAD_DEG: f64 = 10.0;
+
+/// The default `--axis-cone`, degrees: off. Steered at the default lead, the wavy patch's
+/// program measured 0.0053 mm of gouge at its edge (h 0.1) and was posted again unsteered;
+/// at lead 0 a 10° cone takes the table's spinning away (docs/cam.md).
+pub const AXIS_CONE_DEG: f64 = 0.0;
+
+/// The lead: the one given, else [`BALL_LEAD_DEG`] for a ball end mill (`--tool auto` picks
+/// one) and 0 for flat and bull-nose ends.
+fn lead(spec: &ToolSpec, given: Option<f64>) -> f64 {
+    given.unwrap_or(match spec {
+        ToolSpec::Given(CutterShape::Ball { .. }) | ToolSpec::Auto => BALL_LEAD_DEG,
+        ToolSpec::Given(_) => 0.0,
+    })
+}
+
+/// Whether feeds are written in inverse time: asked for, or by default without
+/// tool-centre-point control (`--joints`), where the controller would apply a G94 feed to the
+/// machine's X Y Z.
+fn inverse_time(args: &CamArgs) -> bool {
+    args.inverse_time || (args.joints && !args.feed_per_minute)
+}
 
 /// What the strategy is asked for.
 pub struct PlanRequest {
@@ -406,7 +446,14 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         ));
     }
     let feed = positive("--feed", args.feed)?;
-    for (name, v) in [("--lead", args.lead_deg), ("--tilt", args.tilt_deg)] {
+    if !(args.axis_cone_deg.is_finite() && (0.0..90.0).contains(&args.axis_cone_deg)) {
+        return Err(miette!(
+            "--axis-cone must be an angle in [0°, 90°), got {}",
+            args.axis_cone_deg
+        ));
+    }
+    let lead_deg = lead(&spec, args.lead_deg);
+    for (name, v) in [("--lead", lead_deg), ("--tilt", args.tilt_deg)] {
         if !(v.is_finite() && v.abs() < 90.0) {
             return Err(miette!("{name} must be an angle in (−90°, 90°), got {v}"));
         }
@@ -485,7 +532,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             None => tolerance,
         },
         band: Some(shares.band()),
-        lead_deg: args.lead_deg,
+        lead_deg,
         tilt_deg: args.tilt_deg,
         max_tilt_deg,
         direction,
@@ -506,7 +553,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
         } else {
             OutputForm::CentrePoint
         },
-        feed_output: if args.inverse_time {
+        feed_output: if inverse_time(&args) {
             FeedOutput::InverseTime
         } else {
             FeedOutput::PerMinute
@@ -522,6 +569,7 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
             scallop
         ),
         blend_mm: Some(shares.blend),
+        ball_axis_cone_deg: (args.axis_cone_deg > 0.0).then_some(args.axis_cone_deg),
         ..PostOptions::new(feed, shares.linearisation)
     };
     // The program is judged on everything it is meant to machine: the whole face, less what
@@ -529,20 +577,43 @@ pub fn cam(args: CamArgs) -> Result<ExitCode> {
     let region = MachinedRegion::Reachable {
         max_tilt_deg: reach_normal_tilt_deg,
     };
-    let done = finish(
+    let judged = Judged {
+        region,
+        face: face_region.as_ref(),
+        outward_is_su_x_sv,
+        neighbours: &neighbours,
+        check_tolerance_mm: request.neighbour_tolerance_mm,
+    };
+    let mut done = finish(
         &surface,
         &path,
         &machine,
         &options,
         args.verify_cell_mm,
-        Judged {
-            region,
-            face: face_region.as_ref(),
-            outward_is_su_x_sv,
-            neighbours: &neighbours,
-            check_tolerance_mm: request.neighbour_tolerance_mm,
-        },
+        judged,
     )?;
+    if !done.verified(scallop) && options.ball_axis_cone_deg.is_some() {
+        // The steered axes are held to the strategy's gouge checks at the locations, not over
+        // the motion between them: a steered program that is not verified is posted again
+        // with the planned axes (a known gap: issue 23's wavy patch at lead 10°, h 0.1).
+        eprintln!(
+            "note: with the ball's axis steered the program is not verified (gouge {:.4} mm, \
+             scallop {:.4} mm); posting it with the planned axes",
+            done.verification.gouge_depth_mm, done.verification.max_scallop_mm
+        );
+        let planned = PostOptions {
+            ball_axis_cone_deg: None,
+            ..options.clone()
+        };
+        done = finish(
+            &surface,
+            &path,
+            &machine,
+            &planned,
+            args.verify_cell_mm,
+            judged,
+        )?;
+    }
     std::fs::write(&args.output, &done.posted.program)
         .into_diagnostic()
         .wrap_err_with(|| format!("cannot write {}", args.output.display()))?;
@@ -638,7 +709,29 @@ pub fn finish(
     cell_mm: Option<f64>,
     judged: Judged,
 ) -> Result<Finished> {
-    let posted = post(path, machine, options).into_diagnostic()?;
+    // A steered ball's flutes, shank and holder are held to the strategy's gouge checks
+    // over the face and the part's other faces.
+    let mut faces: Vec<(&NurbsSurface, Option<&FaceRegion>)> = vec![(surface, judged.face)];
+    faces.extend(
+        judged
+            .neighbours
+            .iter()
+            .map(|n| (&n.check.surface, n.check.region.as_ref())),
+    );
+    let gouge = tezgah_cam::gouge::GougeSettings {
+        depth_tolerance: 0.5 * GOUGE_LIMIT_MM,
+        neighbour_depth_tolerance: judged.check_tolerance_mm,
+        ..tezgah_cam::gouge::GougeSettings::default()
+    };
+    let checker = match options.ball_axis_cone_deg {
+        Some(_) => Some(
+            tezgah_cam::gouge::GougeChecker::of_faces(&faces, &path.cutter, gouge)
+                .into_diagnostic()?,
+        ),
+        None => None,
+    };
+    let clear = |tip: &Vec3, axis: &Vec3| checker.as_ref().is_none_or(|c| c.clear(tip, axis));
+    let posted = post_with(path, machine, options, &clear).into_diagnostic()?;
     let step_over = verify::step_over(path).unwrap_or(2.0 * path.cutter.shape.radius());
     let rho = match path.cutter.shape.corner_radius() {
         r if r > 0.0 => r,
@@ -770,7 +863,7 @@ fn report_json(
         "machine": machine.name,
         "output": if args.joints { "joints" } else { "tcp" },
         "feed_mm_per_min": args.feed,
-        "inverse_time": args.inverse_time,
+        "inverse_time": inverse_time(args),
         "tolerance_mm": args.tolerance,
         "scallop_target_mm": scallop,
         "passes": path.passes.len(),
@@ -780,6 +873,9 @@ fn report_json(
         "plunge_length_mm": s.plunge_length_mm,
         "rapid_length_mm": s.rapid_length_mm,
         "machining_time_s": s.feed_time_s,
+        "cycle_time_s": s.cycle_time_s,
+        "max_axis_change_deg": s.max_axis_change_deg,
+        "cycle_over_path_time": s.cycle_time_s.map(|c| c / s.feed_time_s),
         "output_points": s.points,
         "inserted_points": s.inserted,
         "max_linearisation_mm": s.max_linearisation_mm,
@@ -837,15 +933,23 @@ fn summary(args: &CamArgs, done: &Finished, scallop: f64) {
     let s = &done.posted.stats;
     let v = &done.verification;
     println!(
-        "{} → {}: {} points ({} inserted), path {:.1} mm, {:.1} s at F{}",
+        "{} → {}: {} points ({} inserted), path {:.1} mm, {:.1} s at F{}, links {:.1} mm",
         args.surface.display(),
         args.output.display(),
         s.points,
         s.inserted,
         s.cutting_length_mm,
         s.feed_time_s,
-        args.feed
+        args.feed,
+        s.rapid_length_mm
     );
+    if let Some(c) = s.cycle_time_s {
+        println!(
+            "cycle on {}: {c:.1} s through tezgah's planning of the program ({:.2} × path/feed)",
+            args.machine.as_deref().unwrap_or("table-ac"),
+            c / s.feed_time_s
+        );
+    }
     println!(
         "verified on {} dexels (cell {:.4} mm): max scallop {:.4} mm (target {scallop}), \
          gouge {:.4} mm (limit {GOUGE_LIMIT_MM}), bounds −{:.4}/+{:.4} mm, uncut {}",
@@ -927,6 +1031,62 @@ mod tests {
             passes,
         };
         (s, path)
+    }
+
+    #[derive(clap::Parser)]
+    struct Line {
+        #[command(flatten)]
+        args: CamArgs,
+    }
+
+    fn args(extra: &[&str]) -> CamArgs {
+        use clap::Parser;
+        let base = [
+            "tezgah-cam",
+            "s.stp",
+            "--tool",
+            "ball:6",
+            "--strategy",
+            "zigzag",
+        ];
+        let rest = ["--scallop", "0.1", "--tolerance", "0.01", "-o", "o.ngc"];
+        let all: Vec<&str> = base.iter().chain(&rest).chain(extra).copied().collect();
+        Line::try_parse_from(all).unwrap().args
+    }
+
+    #[test]
+    fn joint_output_defaults_to_inverse_time() {
+        assert!(!inverse_time(&args(&[])));
+        assert!(inverse_time(&args(&["--inverse-time"])));
+        assert!(inverse_time(&args(&["--joints"])));
+        assert!(!inverse_time(&args(&["--joints", "--feed-per-minute"])));
+        // Both at once is a contradiction clap refuses.
+        use clap::Parser;
+        let both = [
+            "t",
+            "s.stp",
+            "--tool",
+            "ball:6",
+            "--strategy",
+            "zigzag",
+            "--scallop",
+            "0.1",
+            "--tolerance",
+            "0.01",
+            "-o",
+            "o.ngc",
+            "--inverse-time",
+            "--feed-per-minute",
+        ];
+        assert!(Line::try_parse_from(both).is_err());
+        // A ball leans 10° unless told, a flat end not; the axis cone is off.
+        let a = args(&[]);
+        assert_eq!(a.axis_cone_deg, AXIS_CONE_DEG);
+        let ball = ToolSpec::parse("ball:6").unwrap();
+        assert_eq!(lead(&ball, a.lead_deg), 10.0);
+        assert_eq!(lead(&ball, args(&["--lead", "-3"]).lead_deg), -3.0);
+        assert_eq!(lead(&ToolSpec::parse("flat:6").unwrap(), None), 0.0);
+        assert_eq!(lead(&ToolSpec::Auto, None), 10.0);
     }
 
     #[test]

@@ -10,8 +10,9 @@ use tezgah_gcode::{Config, ToolTable};
 use tezgah_geom::{Pose, Vec3};
 use tezgah_kinematics::{builtin_names, Machine, TcpSwitch};
 use tezgah_motion::interpolate::Sample;
-use tezgah_motion::path::smooth::{self, SmoothOptions};
-use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::path::smooth;
+use tezgah_motion::plan::PlanMachine;
+use tezgah_motion::prepare::{plan_options, prepare, PrepareError};
 use tezgah_motion::tool_pose::SampleTool;
 use tezgah_motion::verify::program::ProgramPath;
 use tezgah_motion::verify::slack::{BINS, NEAR_LIMIT};
@@ -29,11 +30,9 @@ pub struct BuiltPath {
     pub axis: AxisFigures,
 }
 
-/// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
-/// the tolerance, G61 keeps corners, G61.1 stops at every block end), then the pre-flight:
-/// every segment within the machine's reach and joint limits, else a report naming the file,
-/// line and column. `moves` carry `keys` numbers ([`tezgah_gcode::sources`]); the path
-/// returned carries plain line numbers.
+/// The program's moves made ready for `machine` ([`tezgah_motion::prepare`]: smoothed, then
+/// the pre-flight), every error a report naming the file, line and column. `moves` carry
+/// `keys` numbers ([`tezgah_gcode::sources`]); the path returned carries plain line numbers.
 pub fn build_path(
     sources: &Sources,
     keys: &LineKeys,
@@ -42,35 +41,28 @@ pub fn build_path(
     tolerance: f64,
     start: Pose,
 ) -> Result<BuiltPath> {
-    let pm = PlanMachine::from_machine(machine).map_err(|e| miette!("{e}"))?;
-    let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
-    let mut smoother =
-        smooth::Smoother::new(moves.into_iter(), opts.clone()).map_err(|e| miette!("{e}"))?;
-    let mut items = smoother
-        .by_ref()
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| path_error(sources, keys, &e))?;
-    let axis = AxisFigures {
-        deviation_deg: smoother.stats().max_axis_deviation,
-        tolerance_deg: opts.angular_tolerance,
-    };
-    let start_joints = pm
-        .joints(
-            pm.initial,
-            &Vec3::from(start.xyz()),
-            &[start.0[3], start.0[4], start.0[5]],
-            &tezgah_kinematics::Joints::zeros(pm.joint_count()),
-        )
-        .map_err(|e| miette!("the start pose: {e}"))?;
-    tezgah_motion::preflight::check_path(&items, &pm, start_joints)
-        .map_err(|e| report_line(sources, keys.source(e.line), &e.source.to_string()))?;
+    let prepared = prepare(moves, machine, tolerance, start).map_err(|e| match e {
+        PrepareError::Path(e) => path_error(sources, keys, &e),
+        PrepareError::Preflight(e) => {
+            report_line(sources, keys.source(e.line), &e.source.to_string())
+        }
+        other => miette!("{other}"),
+    })?;
+    let mut items = prepared.items;
     if !keys.is_plain() {
         for item in &mut items {
             let line = item.line_mut();
             *line = keys.plain(*line);
         }
     }
-    Ok(BuiltPath { items, pm, axis })
+    Ok(BuiltPath {
+        items,
+        pm: prepared.pm,
+        axis: AxisFigures {
+            deviation_deg: prepared.max_axis_deviation_deg,
+            tolerance_deg: prepared.angular_tolerance_deg,
+        },
+    })
 }
 
 /// A path builder's error at the file, line and column of its move (the message without its
@@ -205,12 +197,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if !(tolerance > 0.0 && tolerance.is_finite()) {
         return Err(miette!("--tolerance must be > 0, got {tolerance}"));
     }
-    let options = PlanOptions {
-        period,
-        // The chord error gets what compression and blending leave of the tolerance.
-        chord_share: smooth::CHORD_SHARE,
-        ..PlanOptions::default()
-    };
+    let options = plan_options(period);
     let probe = match &args.probe {
         Some(p) => Some(
             tezgah_kinematics::probe::ProbeModel::from_toml_str(&crate::library::read_text(p)?)

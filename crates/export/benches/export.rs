@@ -1,4 +1,4 @@
-//! Export throughput on `examples/delta.ngc` (reference 002's diagonal, a circle, a helix and
+//! Export throughput on `examples/delta.ngc` (the diagonal of Ayyıldız, 2017, §5.4, a circle, a helix and
 //! an arc on the linear delta, 936 blocks out at the default tolerance): interpretation
 //! excluded, path building, segmentation and the deviation figure included.
 

@@ -3,6 +3,7 @@
 //! Consumes `tezgah_geom::Move`s (from G-code, CAM or MDI) and produces timed samples. Stages:
 //! [`path`] (moves → segments), [`takeup`] (the joint move at a tool-centre-point switch),
 //! [`preflight`] (every segment's joints within reach and limits before anything moves),
+//! [`prepare`] (a program's moves smoothed and pre-flighted for a machine, and its planned cycle time),
 //! [`plan`] (speed limits, look-ahead, one [`profile`] per group of segments), [`interpolate`]
 //! (samples at the period, joints by the kinematics under each segment's tool control;
 //! [`cursor`] places the tool at any path coordinate of a piece, for the executor's re-timed
@@ -15,6 +16,7 @@ pub mod interpolate;
 pub mod path;
 pub mod plan;
 pub mod preflight;
+pub mod prepare;
 pub mod profile;
 pub mod takeup;
 pub mod tool_pose;

@@ -189,6 +189,11 @@ impl GougeChecker {
         }
     }
 
+    /// Whether the cutter standing at `tip` along `axis` (any length) passes [`Self::check`].
+    pub fn clear(&self, tip: &Vec3, axis: &Vec3) -> bool {
+        self.check(tip, &Unit::new_normalize(*axis)).is_none()
+    }
+
     /// Rear and global checks of the cutter standing at `tip` along `axis` (the local check
     /// needs the contact's curvature and lives in [`local`]).
     pub fn check(&self, tip: &Vec3, axis: &Unit<Vec3>) -> Option<Gouge> {

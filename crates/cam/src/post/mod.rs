@@ -6,17 +6,22 @@
 //! passes plus retract / link / plunge through that sphere), [`orient`] (both inverse solutions, the branch choice along the whole
 //! path, the pole, C unwrapped), the joints through the kinematics crate (limits checked),
 //! [`linearise`] (points inserted where the machine's motion strays from the path), [`emit`]
-//! (the G-code text, feed per minute or inverse time).
+//! (the G-code text, feed per minute or inverse time), [`tryout`] (the text run through
+//! tezgah's own interpreter, path builder and planner: refused there, refused here; else the
+//! machine's cycle time).
 
 pub mod clearance;
 pub mod emit;
 pub mod linearise;
 pub mod links;
 pub mod orient;
+pub mod steer;
+pub mod tryout;
 
 use tezgah_geom::{Axis, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, KinematicsError, Machine, Model, Tool};
 
+use crate::cutter::CutterShape;
 use crate::toolpath::ToolPath;
 use crate::verify::CutterPose;
 use clearance::Clearance;
@@ -75,6 +80,14 @@ pub struct PostOptions {
     pub blend_mm: Option<f64>,
     /// A title for the header comment.
     pub title: String,
+    /// A ball end mill's axis may be re-chosen within this cone about the planned one
+    /// (degrees) so that the table's C moves little and slowly ([`steer`]); `None` keeps the
+    /// planned axes. Other cutters keep theirs.
+    pub ball_axis_cone_deg: Option<f64>,
+    /// Run the written program through tezgah's runner ([`tryout`]): a program it refuses is
+    /// an error, and the machine's cycle time comes with the stats. Off only where a caller
+    /// needs the bare post (it costs one planning and interpolation of the program).
+    pub tryout: bool,
 }
 
 impl PostOptions {
@@ -93,6 +106,8 @@ impl PostOptions {
             max_halvings: 24,
             blend_mm: None,
             title: String::new(),
+            ball_axis_cone_deg: None,
+            tryout: true,
         }
     }
 }
@@ -121,6 +136,8 @@ pub enum PostError {
     },
     #[error("the tool path has no cutter locations")]
     Empty,
+    #[error("tezgah's runner refuses the written program at {0}")]
+    Refused(#[from] tryout::Refused),
 }
 
 fn place(at: Option<(usize, usize)>) -> String {
@@ -167,6 +184,11 @@ pub struct PostStats {
     pub max_linearisation_mm: f64,
     /// The sphere the links run on (part frame).
     pub clearance: Option<Clearance>,
+    /// Largest angle between a steered ball's axis and the planned one, degrees.
+    pub max_axis_change_deg: f64,
+    /// The machine's time for the program through tezgah's own planning, s (`None` without
+    /// [`PostOptions::tryout`]).
+    pub cycle_time_s: Option<f64>,
 }
 
 /// A posted program: its points, text and figures.
@@ -198,11 +220,24 @@ fn positive(what: &'static str, value: f64) -> Result<f64, PostError> {
     }
 }
 
-/// Posts `path` for `machine` (table-ac or table-bc).
+/// Posts `path` for `machine` (table-ac or table-bc). A steered ball's axes
+/// ([`PostOptions::ball_axis_cone_deg`]) are not checked against the part: see [`post_with`].
 pub fn post(
     path: &ToolPath,
     machine: &Machine,
     options: &PostOptions,
+) -> Result<Posted, PostError> {
+    post_with(path, machine, options, &|_, _| true)
+}
+
+/// [`post`], with `clear(tip, axis)` saying whether the cutter standing there is clear of the
+/// part (the strategy's gouge checks): a pass whose steered ball would not be keeps its
+/// planned axes ([`steer::steer`]).
+pub fn post_with(
+    path: &ToolPath,
+    machine: &Machine,
+    options: &PostOptions,
+    clear: &(dyn Fn(&Vec3, &Vec3) -> bool + Sync),
 ) -> Result<Posted, PostError> {
     let feed = positive("the feed", options.feed_mm_per_min)?;
     let tolerance = positive("the tolerance", options.tolerance_mm)?;
@@ -253,6 +288,21 @@ pub fn post(
         // the cutter's reach.
         pole_sin: (0.5 * tolerance / reach).min(1.0),
     };
+    let mut steered = None;
+    if let (Some(cone), CutterShape::Ball { radius }) =
+        (options.ball_axis_cone_deg, path.cutter.shape)
+    {
+        let cone = positive("the axis cone", cone)?.min(90.0).to_radians();
+        let s = steer::steer(
+            &mut path,
+            &orienter,
+            cone,
+            radius,
+            steer::max_step(radius, tolerance),
+            clear,
+        );
+        steered = Some(s);
+    }
     let tool = Tool::with_length(options.tool_length_mm);
     let motion = MachineMotion {
         model,
@@ -286,9 +336,13 @@ pub fn post(
         points.push(point(s, *a, joints));
     }
     let (points, worst, inserted) = motion.refine(points, tolerance, options.max_halvings)?;
+    let (points, at_pole) = through_the_pole(points, &motion, tolerance)?;
+    let (points, turns) = pole_turns(points, &motion)?;
+    let inserted = inserted + at_pole + turns;
     check_clear(&points, &motion, &sphere)?;
 
     let mut stats = PostStats {
+        max_axis_change_deg: steered.map_or(0.0, |s| s.max_change.to_degrees()),
         points: points.len(),
         inserted,
         max_linearisation_mm: worst,
@@ -305,6 +359,15 @@ pub fn post(
     }
     stats.feed_time_s = 60.0 * (stats.cutting_length_mm + stats.plunge_length_mm) / feed;
     let program = emit::program(&points, &motion, options, letters, &sphere)?;
+    if options.tryout {
+        let run = tryout::tryout(
+            &program,
+            machine,
+            options.tool_number,
+            options.tool_length_mm,
+        )?;
+        stats.cycle_time_s = Some(run.cycle_time_s);
+    }
     Ok(Posted {
         points,
         program,
@@ -314,6 +377,141 @@ pub fn post(
         tool,
         reach,
     })
+}
+
+/// Where the tilt changes sign between two neighbouring points (the axis passes by or through
+/// the pole between them), a point exactly at the pole is put between them, with the C of the
+/// first. A hair of C difference (0.0002° seen, and 1.3° at a tilt of 0.08°) sends the
+/// machine's axis by the pole at a hair's distance, where its azimuth — and C following it —
+/// swings half a turn in no distance; with C exactly held the axis's great circle passes
+/// through the pole to rounding, and a sample landing 1e-10 rad from it takes its azimuth
+/// from the rounding. The runner refuses either move as passing through a singular pose
+/// (`joint 0 jumps by 84.89` in issue 23). At the pole point the runner holds C exactly. Through the pole point the axis passes the pole itself:
+/// up to it C is held (one meridian plane), there the table turns to the next C with the tool
+/// standing (the axis on the C axis does not move), and from it C is held again. The points
+/// are placed only where the axis there strays from the path's by at most `tolerance` at the
+/// cutter's reach.
+fn through_the_pole(
+    points: Vec<PostedPoint>,
+    motion: &MachineMotion<'_>,
+    tolerance: f64,
+) -> Result<(Vec<PostedPoint>, usize), PostError> {
+    let mut out: Vec<PostedPoint> = Vec::with_capacity(points.len());
+    let mut added = 0;
+    for b in points {
+        if let Some(a) = out.last().copied() {
+            let (ta, tb) = (a.angles.tilt, b.angles.tilt);
+            if ta * tb < 0.0 {
+                let f = ta.abs() / (ta.abs() + tb.abs());
+                let (ua, ub) = (
+                    nalgebra::Unit::new_normalize(a.axis),
+                    nalgebra::Unit::new_normalize(b.axis),
+                );
+                let near = tezgah_kinematics::segment::slerp_axis(&ua, &ub, f)
+                    .is_ok_and(|k| k.angle(&Vec3::z_axis()) * motion.reach <= tolerance);
+                if near {
+                    let tip = a.tip + (b.tip - a.tip) * f;
+                    let mut previous = a.joints;
+                    let turns: &[f64] = if a.angles.c == b.angles.c {
+                        &[a.angles.c]
+                    } else {
+                        &[a.angles.c, b.angles.c]
+                    };
+                    for &c in turns {
+                        let angles = TableAngles { tilt: 0.0, c };
+                        let joints = motion.joints(&tip, angles, &previous).map_err(|e| {
+                            PostError::Kinematics {
+                                at: b.source,
+                                error: e,
+                            }
+                        })?;
+                        previous = joints;
+                        out.push(PostedPoint {
+                            tip,
+                            axis: Vec3::z(),
+                            angles,
+                            joints,
+                            motion: b.motion,
+                            source: b.source,
+                            inserted: true,
+                        });
+                        added += 1;
+                    }
+                }
+            }
+        }
+        out.push(b);
+    }
+    Ok((out, added))
+}
+
+/// Link stations on the clearance sphere whose axis leans less than this (rad, 1°) from the
+/// C axis are moved onto it: there the tool is clear of the part whatever its axis (the moves
+/// are checked again by [`check_clear`]), and an axis a hair from the pole is where C would
+/// swing.
+const LINK_POLE: f64 = std::f64::consts::PI / 180.0;
+
+/// The moves that touch the pole made as the runner takes them without a jump: a link
+/// station within [`LINK_POLE`] of the pole is put on it; a point on the pole takes the C of
+/// the point before (at the pole C does not move the axis, so the move arrives along one
+/// meridian plane); and before leaving the pole toward another C the table turns there with
+/// the tool standing. Arriving or leaving toward another C, the axis's great circle leaves the
+/// pole at an azimuth other than the programmed C, and the runner's walk along it jumps.
+fn pole_turns(
+    points: Vec<PostedPoint>,
+    motion: &MachineMotion<'_>,
+) -> Result<(Vec<PostedPoint>, usize), PostError> {
+    let at = |p: &PostedPoint, angles: TableAngles, previous: &Joints| {
+        motion
+            .joints(&p.tip, angles, previous)
+            .map_err(|e| PostError::Kinematics {
+                at: p.source,
+                error: e,
+            })
+    };
+    let n = points.len();
+    let mut out: Vec<PostedPoint> = Vec::with_capacity(n);
+    let mut added = 0;
+    for i in 0..n {
+        let mut b = points[i];
+        let Some(a) = out.last().copied() else {
+            out.push(b);
+            continue;
+        };
+        let station = i + 1 < n
+            && a.motion == Motion::Rapid
+            && b.motion == Motion::Rapid
+            && points[i + 1].motion == Motion::Rapid
+            && b.axis.angle(&points[i + 1].axis) > STILL_AXIS
+            && b.axis.angle(&a.axis) > STILL_AXIS;
+        if station && b.angles.tilt != 0.0 && b.angles.tilt.abs() <= LINK_POLE {
+            b.angles.tilt = 0.0;
+            b.axis = Vec3::z();
+        }
+        if b.angles.tilt == 0.0 && b.angles.c != a.angles.c {
+            b.angles.c = a.angles.c;
+        }
+        if a.angles.tilt == 0.0 && b.angles.tilt != 0.0 && b.angles.c != a.angles.c {
+            let angles = TableAngles {
+                tilt: 0.0,
+                c: b.angles.c,
+            };
+            let turn = PostedPoint {
+                angles,
+                joints: at(&a, angles, &a.joints)?,
+                motion: b.motion,
+                source: b.source,
+                inserted: true,
+                ..a
+            };
+            out.push(turn);
+            added += 1;
+        }
+        let previous = out.last().map_or(b.joints, |p| p.joints);
+        b.joints = at(&b, b.angles, &previous)?;
+        out.push(b);
+    }
+    Ok((out, added))
 }
 
 /// Requested axes closer than this (rad) count as one: the limit normals at a pole differ

@@ -16,6 +16,14 @@ use tezgah_kinematics::angle::{unwrap_within, wrap_pi};
 use tezgah_kinematics::trunnion::TiltAxis;
 use tezgah_kinematics::{table_ac, table_bc, JointLimit, KinematicsError};
 
+/// How far inside its limits a tilt is written, rad (0.0002°). The program carries 4 decimals,
+/// which round a tilt by up to 0.00005°, and the runner recomputes the tilt from the tool axis
+/// by inverse kinematics, with rounding of ~1e-12°: either puts a pose planned on the limit
+/// just beyond it (A = 120.0000000000012° was refused against 120°). A pose needing up to this
+/// much beyond the limit is moved inside it too: the tool axis then differs from the one asked
+/// for by at most 0.0004°, 0.07 µm at a 10 mm reach — far below any tolerance the post keeps.
+pub const LIMIT_MARGIN: f64 = 0.0002 * std::f64::consts::PI / 180.0;
+
 /// Table angles of one output point, rad: the tilt (A on table-ac, B on table-bc) and C.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TableAngles {
@@ -100,9 +108,25 @@ impl Orienter {
         TableAngles { tilt, c }
     }
 
-    /// The tilt moved into its limits by whole turns, if any turn fits.
+    /// The tilt moved into its limits by whole turns, if any turn fits; a tilt within
+    /// [`LIMIT_MARGIN`] of a limit (either side) is kept that margin inside it (a limit at
+    /// zero excepted).
     fn tilt_in_limits(&self, tilt: f64) -> Option<f64> {
-        unwrap_within(tilt, tilt, self.tilt_limit.min, self.tilt_limit.max)
+        let (lo, hi) = (self.tilt_limit.min, self.tilt_limit.max);
+        let t = unwrap_within(tilt, tilt, lo - LIMIT_MARGIN, hi + LIMIT_MARGIN)?;
+        if hi - lo <= 2.0 * LIMIT_MARGIN {
+            return Some(0.5 * (lo + hi));
+        }
+        // A limit at zero (a machine that tilts one way only) is written exactly as A0 and
+        // read back as exactly 0: the pole stays reachable.
+        let inside = |limit: f64, sign: f64| {
+            if limit == 0.0 {
+                0.0
+            } else {
+                limit + sign * LIMIT_MARGIN
+            }
+        };
+        Some(t.clamp(inside(lo, 1.0), inside(hi, -1.0)))
     }
 
     /// The candidates of one axis given the two states of the point before (for the pole).
@@ -393,6 +417,24 @@ mod tests {
     }
 
     #[test]
+    fn a_tilt_on_the_limit_is_written_inside_it() {
+        let o = ac(-30.0, 120.0);
+        // An axis needing exactly 120°, a rounding hair past it, and half the margin past it.
+        for extra in [0.0, 1e-14, 0.5 * LIMIT_MARGIN] {
+            let k = table_ac::axis(120f64.to_radians() + extra, 0.4);
+            let got = o.choose(&[k], ZERO).unwrap();
+            let deg = got[0].tilt.to_degrees();
+            assert!((deg - 119.9998).abs() < 1e-9, "{deg}");
+            // As the program writes it (4 decimals) it is inside the limit too.
+            assert!(format!("{deg:.4}").parse::<f64>().unwrap() < 120.0);
+            assert!((o.axis(got[0]) - k).norm() <= 2.0 * LIMIT_MARGIN);
+        }
+        // Further beyond: refused as before.
+        let k = table_ac::axis(120f64.to_radians() + 2.0 * LIMIT_MARGIN, 0.4);
+        assert!(o.choose(&[k], ZERO).is_err());
+    }
+
+    #[test]
     fn unreachable_tilt_is_an_error_naming_the_point() {
         let o = ac(-30.0, 30.0);
         let k = table_ac::axis(60f64.to_radians(), 0.3);
@@ -446,7 +488,8 @@ mod tests {
                 };
                 let mut last = ZERO;
                 for (a, k) in got.iter().zip(&axes) {
-                    prop_assert!((o.axis(*a) - k).norm() < 1e-6);
+                    // Within the limit margin's axis error of the axis asked for.
+                    prop_assert!((o.axis(*a) - k).norm() < 2.0 * LIMIT_MARGIN + 1e-9);
                     prop_assert!(o.tilt_limit.contains(a.tilt));
                     prop_assert!((a.c - last.c).abs() <= PI + 1e-9);
                     last = *a;

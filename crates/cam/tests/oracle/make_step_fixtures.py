@@ -36,6 +36,8 @@ Fixtures:
   trimmed_freeform.stp the free-form patch's surface trimmed in its parameters by an ellipse
                        (the outer loop) with a round hole: B-spline edges built from 2-D
                        conics on the surface (SURFACE_CURVE with pcurves)
+  saddle_bump.stp, wavy_patch.stp, bowl_patch.stp  issue 23's free-form faces whose normals
+                       pass through the vertical (bicubic fits of z = f(x, y), one face each)
   plate_with_holes.stp an 80 x 60 mm plane face with a circular and an elliptic hole (PLANE,
                        LINE, CIRCLE, ELLIPSE edges; three face bounds)
 Each X.stp has X.json: {"faces": [{"u": [u0, u1], "v": [v0, v1], "reversed": bool, "area": mm²
@@ -218,6 +220,42 @@ def plate_with_holes():
     return make.Face()
 
 
+def grid_patch(f, x0, x1, y0, y1, n):
+    """A bicubic B-spline approximating z = f(x, y) through an (n + 1)² grid over the box
+    (OCCT's GeomAPI_PointsToBSplineSurface, within 1e-4 mm of the grid)."""
+    from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
+    from OCP.GeomAbs import GeomAbs_C2
+    poles = Array2_gp_Pnt(1, n + 1, 1, n + 1)
+    for i in range(n + 1):
+        for j in range(n + 1):
+            x = x0 + (x1 - x0) * i / n
+            y = y0 + (y1 - y0) * j / n
+            poles.SetValue(i + 1, j + 1, gp_Pnt(x, y, f(x, y)))
+    surf = GeomAPI_PointsToBSplineSurface(poles, 3, 3, GeomAbs_C2, 1e-4).Surface()
+    return BRepBuilderAPI_MakeFace(surf, 1e-7).Face()
+
+
+def saddle_bump():
+    """Issue 23's saddle with a bump, 120 x 80 mm: z = (x^2 - y^2)/200 + a Gaussian hill 6 mm
+    high off centre; the normal passes through the vertical at the saddle point and the top."""
+    return grid_patch(lambda x, y: (x * x - y * y) / 200.0
+                      + 6.0 * math.exp(-((x - 15.0) ** 2 + (y + 5.0) ** 2) / 200.0),
+                      -60.0, 60.0, -40.0, 40.0, 24)
+
+
+def wavy_patch():
+    """Issue 23's wavy patch, 100 x 100 mm: z = 5 sin(2 pi x / 50) cos(2 pi y / 60); its
+    normals sweep through the vertical at every crest, trough and saddle."""
+    return grid_patch(lambda x, y: 5.0 * math.sin(2 * math.pi * x / 50.0)
+                      * math.cos(2 * math.pi * y / 60.0), 0.0, 100.0, 0.0, 100.0, 32)
+
+
+def bowl_patch():
+    """Issue 23's bowl, 80 x 80 mm: the paraboloid z = (x^2 + y^2)/80 (vertical normal at
+    its bottom, 45 degrees at the rim's middles)."""
+    return grid_patch(lambda x, y: (x * x + y * y) / 80.0, -40.0, 40.0, -40.0, 40.0, 16)
+
+
 def arr(values):
     a = Array1_double(1, len(values))
     for k, x in enumerate(values):
@@ -306,6 +344,9 @@ def main():
         ("filleted_block", filleted_block(), "MM"),
         ("swept_surfaces", swept_surfaces(), "MM"),
         ("trimmed_freeform", trimmed_freeform(), "MM"),
+        ("saddle_bump", saddle_bump(), "MM"),
+        ("wavy_patch", wavy_patch(), "MM"),
+        ("bowl_patch", bowl_patch(), "MM"),
     ]
     # Further arguments name the fixtures to (re)generate; none: all of them.
     only = set(sys.argv[2:])

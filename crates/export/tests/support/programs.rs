@@ -1,4 +1,4 @@
-//! The programs exported in the tests: reference 002's sag case, a delta program of arcs and
+//! The programs exported in the tests: the sag case of Ayyıldız (2017, §5.4), a delta program of arcs and
 //! helices, a five-axis program on table-ac, and random delta programs within reach.
 
 use std::f64::consts::PI;
@@ -6,7 +6,7 @@ use std::f64::consts::PI;
 use proptest::prelude::*;
 use tezgah_geom::Vec3;
 
-/// Reference 002 §5.4: the 100 mm XY diagonal, which sags 4.646 mm when only its end points
+/// Ayyıldız (2017, §5.4): the 100 mm XY diagonal, which sags 4.646 mm when only its end points
 /// are converted.
 pub const SAG: &str = "G21 G90 G94\nG0 X-31.654 Y-28.911 Z-0.2\nG1 X39.057 Y41.8 F1000\nM2\n";
 
