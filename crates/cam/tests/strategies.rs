@@ -367,7 +367,7 @@ fn random_surface_plans_without_failing(seed: u64) {
         ("flat:8", StrategyKind::IsoScallop, 8.0, 4.0),
     ] {
         let cutter = Cutter::standard(spec.parse().unwrap());
-        let mut settings = Settings::new(kind, 0.3, 0.02);
+        let mut settings = Settings::new(kind, 0.6, 0.02);
         settings.axis = ToolAxis::Surface {
             lead_deg: lead,
             tilt_deg: tilt,
