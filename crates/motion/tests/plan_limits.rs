@@ -8,6 +8,9 @@
 //! lower A, not by a lower V). End to end, the five-axis example with its corner blends holds
 //! every joint of `table-ac` (numeric joint derivatives on blends, which are not u ∝ s).
 
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use tezgah_geom::arclen::gauss_legendre;
 use tezgah_geom::{ArcLengthMap, Bezier, Curve, Pose, Vec3};
 use tezgah_kinematics::Machine;
@@ -277,18 +280,6 @@ fn five_axis_example_with_blends_holds_table_ac_limits() {
     )
     .unwrap();
     let report = verifier.finish();
-    for (i, j) in report.joints.iter().enumerate() {
-        assert!(
-            j.worst_ratio() <= 1.005,
-            "joint {i}: v {}/{}, a {}/{}, j {}/{} (jerk at line {})",
-            j.velocity,
-            j.max_velocity,
-            j.acceleration,
-            j.max_acceleration,
-            j.jerk,
-            j.max_jerk,
-            j.jerk_line
-        );
-    }
+    common::assert_joints_within(&report);
     assert!(report.max_deviation <= machine.motion.tolerance_mm);
 }

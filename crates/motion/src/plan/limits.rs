@@ -628,11 +628,7 @@ pub fn segment_limits_at_feed(
     feed_scale: f64,
 ) -> Result<SegmentLimits, PlanError> {
     limits_for_change(seg, geom, machine, options, reserve, feed_scale, |_| {
-        Changes {
-            start: REFERENCE_CHANGE,
-            end: REFERENCE_CHANGE,
-            ramp: 1.0,
-        }
+        Changes::both(REFERENCE_CHANGE)
     })
 }
 
@@ -672,12 +668,7 @@ pub fn cruise_limits(
     reserve: bool,
 ) -> Result<SegmentLimits, PlanError> {
     limits_for_change(seg, geom, machine, options, reserve, 1.0, |_| {
-        let c = 1.0 - LADDER[LADDER.len() - 1];
-        Changes {
-            start: c,
-            end: c,
-            ramp: 1.0,
-        }
+        Changes::both(1.0 - LADDER[LADDER.len() - 1])
     })
 }
 
@@ -828,6 +819,18 @@ struct Changes {
     start: f64,
     end: f64,
     ramp: f64,
+}
+
+impl Changes {
+    /// A change of `c` at both ends, acceleration and jerk kept for a ramp through the whole
+    /// speed (a stop may follow where the neighbours are not known).
+    fn both(c: f64) -> Changes {
+        Changes {
+            start: c,
+            end: c,
+            ramp: 1.0,
+        }
+    }
 }
 
 /// Fractions of the top speed [`best_split`] tries (a speed just under the curvature limit
