@@ -13,3 +13,5 @@ pub mod od;
 pub mod section;
 
 pub use section::{DriveSection, DriveSlave, SectionError};
+pub mod emulator;
+pub mod master;
