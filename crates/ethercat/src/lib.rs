@@ -13,5 +13,6 @@ pub mod od;
 pub mod section;
 
 pub use section::{DriveSection, DriveSlave, SectionError};
+pub mod drive;
 pub mod emulator;
 pub mod master;

@@ -146,7 +146,7 @@ impl PlannerSide {
             if r.state == RtState::Halted && !self.rearming && !self.halt_seen {
                 self.halt_seen = true;
                 let why = match r.fault {
-                    Some(f) => format!("drive fault {f:?}"),
+                    Some(f) => format!("drive fault: {f}"),
                     None => format!("set-point underrun ({} so far)", r.underruns),
                 };
                 self.exec.fault(r.commanded, &why);

@@ -70,10 +70,8 @@ impl Port {
                 sent = true;
             }
             let now = Instant::now();
-            if now >= deadline {
-                return Err(PortError::Timeout);
-            }
-            let wait = if sent {
+            let late = now >= deadline;
+            let wait = if sent || late {
                 Duration::ZERO
             } else {
                 self.slice.min(deadline - now)
@@ -87,6 +85,14 @@ impl Port {
                 // A frame that is not ours (another protocol, a stale answer) is no error.
                 let _ = self.rx.receive_frame(&self.buf[..n]);
                 wait = Duration::ZERO;
+            }
+            if late {
+                // One last look: an answer that came in by the deadline (the thread may have
+                // been preempted since) still counts.
+                return match fut.as_mut().poll(&mut cx) {
+                    Poll::Ready(v) => Ok(v),
+                    Poll::Pending => Err(PortError::Timeout),
+                };
             }
         }
     }
