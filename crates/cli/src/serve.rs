@@ -66,6 +66,44 @@ pub struct ServeArgs {
     /// connection closed (a running job goes on).
     #[arg(long, default_value_t = 16)]
     pub max_message_mib: usize,
+    /// Where the set-points go: `ideal` (a simulated drive that is always where it was told)
+    /// or `ethercat:<interface>`, the CiA-402 drives the machine file's `[drive]` table lists,
+    /// on that network interface (needs CAP_NET_RAW; see the README).
+    #[arg(long, default_value = "ideal")]
+    pub drive: String,
+}
+
+/// The drive `--drive` names, opened.
+enum Bus {
+    Ideal,
+    Ethercat(tezgah_ethercat::drive::EthercatDrive),
+}
+
+/// Opens the drive `spec` names for `machine` (its file text `text` holds `[drive]`).
+fn open_drive(spec: &str, machine: &tezgah_kinematics::Machine, text: &str, period: f64) -> Result<Bus> {
+    match spec.split_once(':') {
+        None if spec == "ideal" => Ok(Bus::Ideal),
+        Some(("ethercat", interface)) if !interface.is_empty() => {
+            let section = tezgah_ethercat::DriveSection::from_machine_text(text, machine)
+                .map_err(|e| miette!("{e}"))?
+                .ok_or_else(|| miette!("{}", tezgah_ethercat::SectionError::Missing))?;
+            let link = tezgah_ethercat::master::link::RawSocket::open(interface)
+                .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
+            let options =
+                tezgah_ethercat::master::MasterOptions::for_period(Duration::from_secs_f64(period));
+            let drive = tezgah_ethercat::drive::EthercatDrive::open(
+                Box::new(link),
+                &section,
+                machine.joints.len(),
+                options,
+            )
+            .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
+            Ok(Bus::Ethercat(drive))
+        }
+        _ => Err(miette!(
+            "--drive {spec}: expected `ideal` or `ethercat:<interface>`"
+        )),
+    }
 }
 
 /// What the server sends.
@@ -152,6 +190,7 @@ struct Shared {
 /// Runs the server until the process is stopped.
 pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     let machine = crate::run::load_machine(args.machine.as_deref())?;
+    let text = crate::run::machine_text(args.machine.as_deref())?;
     let options = ExecOptions::for_machine(&machine).map_err(|e| miette!("{e}"))?;
     let period = options.period;
     if !(args.lead_ms.is_finite() && args.lead_ms > 0.0) {
@@ -184,7 +223,32 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     } else {
         RealtimeSettings::BEST_EFFORT
     };
-    let host = spawn(executor, IdealDrive, ring, realtime);
+    let bus = open_drive(&args.drive, &machine, &text, period)?;
+    let host = match bus {
+        Bus::Ideal => spawn(executor, IdealDrive, ring, realtime),
+        Bus::Ethercat(drive) => {
+            // The machine starts where the executor stands; drives elsewhere would jump.
+            let (at, start) = (drive.position(), executor.drive_joints());
+            let off = at
+                .as_slice()
+                .iter()
+                .zip(start.as_slice())
+                .any(|(a, b)| (a - b).abs() > 1e-3);
+            if off {
+                return Err(miette!(
+                    "the drives stand at {:?}, the machine starts at {:?} (internal units): \
+                     move them to the start first",
+                    at.as_slice(),
+                    start.as_slice()
+                ));
+            }
+            log(&format!(
+                "EtherCAT: {} drives in operation enabled",
+                drive.master().slaves().len()
+            ));
+            spawn(executor, drive, ring, realtime)
+        }
+    };
     for w in host.realtime.warnings() {
         log(&format!("warning: {w}"));
     }

@@ -93,6 +93,7 @@ impl PlannerSide {
             s.underruns = r.underruns;
             s.late_worst_s = r.late_worst;
             s.late_over_half = r.late_over_half;
+            s.measured = r.measured.as_slice().to_vec();
         }
         s
     }
