@@ -200,14 +200,14 @@ impl Link for RawSocket {
     }
 }
 
-/// Runs emulated drives on a network interface until `stop` is set: every EtherCAT frame that
-/// arrives is passed through `bus` and sent back (the namespace tests' far end of the veth).
+/// Runs emulated drives on a network interface (`sock`, opened on it) until `stop` is set:
+/// every EtherCAT frame that arrives is passed through `bus` and sent back (the namespace
+/// tests' far end of the veth). Returns the frames answered.
 pub fn serve_interface(
-    interface: &str,
+    mut sock: RawSocket,
     bus: Arc<Mutex<Bus>>,
     stop: &std::sync::atomic::AtomicBool,
 ) -> io::Result<u64> {
-    let mut sock = RawSocket::open(interface)?;
     let mut buf = [0u8; MAX_FRAME];
     let mut answered = 0;
     while !stop.load(std::sync::atomic::Ordering::Relaxed) {

@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 
 use ethercrab::subdevice_group::Op;
 use ethercrab::{
-    DefaultLock, MainDevice, MainDeviceConfig, PduStorage, SubDeviceGroup, SubDeviceState, Timeouts,
+    DefaultLock, MainDevice, MainDeviceConfig, PduStorage, RetryBehaviour, SubDeviceGroup,
+    SubDeviceState, Timeouts,
 };
 
 use crate::cia402::{self, State};
@@ -181,7 +182,12 @@ impl Master {
         let md: &'static MainDevice<'static> = Box::leak(Box::new(MainDevice::new(
             pdu_loop,
             timeouts,
-            MainDeviceConfig::default(),
+            MainDeviceConfig {
+                // A frame lost during bring-up is sent again (the cycle has its own deadline
+                // and counts a loss as a fault).
+                retry_behaviour: RetryBehaviour::Count(3),
+                ..MainDeviceConfig::default()
+            },
         )));
         let mut port = Port::new(tx, rx, link);
         let deadline = Instant::now() + options.open_timeout;
