@@ -52,3 +52,4 @@ pub fn open(gain: f64, limit_mm: f64) -> (Arc<Mutex<Bus>>, EthercatDrive) {
     bus.lock().unwrap().clear_logs();
     (bus, d)
 }
+pub mod veth;
