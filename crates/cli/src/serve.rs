@@ -76,7 +76,7 @@ pub struct ServeArgs {
 /// The drive `--drive` names, opened.
 enum Bus {
     Ideal,
-    Ethercat(tezgah_ethercat::drive::EthercatDrive),
+    Ethercat(Box<tezgah_ethercat::drive::EthercatDrive>),
 }
 
 /// Opens the drive `spec` names for `machine` (its file text `text` holds `[drive]`).
@@ -98,7 +98,7 @@ fn open_drive(spec: &str, machine: &tezgah_kinematics::Machine, text: &str, peri
                 options,
             )
             .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
-            Ok(Bus::Ethercat(drive))
+            Ok(Bus::Ethercat(Box::new(drive)))
         }
         _ => Err(miette!(
             "--drive {spec}: expected `ideal` or `ethercat:<interface>`"
@@ -246,7 +246,7 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
                 "EtherCAT: {} drives in operation enabled",
                 drive.master().slaves().len()
             ));
-            spawn(executor, drive, ring, realtime)
+            spawn(executor, *drive, ring, realtime)
         }
     };
     for w in host.realtime.warnings() {

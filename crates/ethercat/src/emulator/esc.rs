@@ -120,7 +120,7 @@ impl Slave {
         }
         // Reading the read mailbox's last byte hands it back to the slave.
         let (start, len, on) = self.sm(1);
-        if on && len > 0 && addr <= start + len - 1 && start + len - 1 < addr + data.len() {
+        if on && len > 0 && addr < start + len && start + len - 1 < addr + data.len() {
             self.reply_waiting = false;
         }
     }

@@ -192,7 +192,7 @@ impl Link for RawSocket {
                 return Err(e);
             }
             // A packet socket also sees what this host sent: skip it.
-            if from.sll_pkttype == libc::PACKET_OUTGOING as u8 {
+            if from.sll_pkttype == libc::PACKET_OUTGOING {
                 continue;
             }
             return Ok(Some(n as usize));
