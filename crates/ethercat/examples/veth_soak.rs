@@ -26,7 +26,7 @@ fn main() {
     for w in applied.warnings() {
         eprintln!("warning: {w}");
     }
-    let v = Veth::new("s");
+    let v = Veth::new("s").expect("namespaces and veth");
     let cycles = seconds * 1000;
     let (f, _, _) = run(&v, cycles);
     println!("veth soak, 3 drives, {cycles} cycles at 1 ms: {f:?}");

@@ -20,14 +20,14 @@ fn drives_on_a_veth_pair_follow_a_path_and_the_wire_dissects_as_ethercat() {
     if !can_run("veth test") {
         return;
     }
-    let v = Veth::new("a");
+    let v = Veth::new("a").expect("namespaces and veth");
     let capture = tshark_available().then(|| Capture::start(&v));
     let cycles = 2000;
     let (f, mut d, _bus) = run(&v, cycles);
     eprintln!("veth, 3 drives, {cycles} cycles at 1 ms: {f:?}");
 
     // The link goes down: the next cycle cannot send, and the machine stops saying so.
-    ip(&["-n", &v.master_ns, "link", "set", &v.master_if, "down"]);
+    ip(&["-n", &v.master_ns, "link", "set", &v.master_if, "down"]).unwrap();
     let st = d.apply(&SetPoint::at_rest(cycles + 1, 0, Joints::new(path(cycles))));
     let fault = st.fault.expect("a fault");
     assert!(

@@ -8,6 +8,7 @@
 
 pub mod dictionary;
 pub mod esc;
+pub mod netns;
 pub mod servo;
 pub mod sii;
 

@@ -6,7 +6,6 @@
 #![allow(dead_code)]
 
 use std::fs::File;
-use std::os::fd::AsRawFd;
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -14,6 +13,8 @@ use std::time::{Duration, Instant};
 
 use super::{machine_and_section, COUNTS_PER_MM, PERIOD};
 use tezgah_ethercat::drive::EthercatDrive;
+use tezgah_ethercat::emulator::netns::enter;
+pub use tezgah_ethercat::emulator::netns::{ip, Veth};
 use tezgah_ethercat::emulator::Bus;
 use tezgah_ethercat::master::link::{serve_interface, RawSocket};
 use tezgah_ethercat::master::MasterOptions;
@@ -40,80 +41,6 @@ pub fn can_run(what: &str) -> bool {
     assert!(!ci(), "{what}: {why}, and under CI=true it must run");
     eprintln!("{what}: not run: {why}");
     false
-}
-
-pub fn ip(args: &[&str]) {
-    let out = Command::new("ip").args(args).output().expect("running ip");
-    assert!(
-        out.status.success(),
-        "ip {}: {}",
-        args.join(" "),
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
-/// Two namespaces and the veth between them; removed on drop.
-pub struct Veth {
-    pub master_ns: String,
-    pub slave_ns: String,
-    pub master_if: String,
-    pub slave_if: String,
-}
-
-impl Veth {
-    pub fn new(tag: &str) -> Veth {
-        let id = std::process::id() % 100_000;
-        let v = Veth {
-            master_ns: format!("tzm{tag}{id}"),
-            slave_ns: format!("tzs{tag}{id}"),
-            master_if: format!("tzm{tag}{id}"),
-            slave_if: format!("tzs{tag}{id}"),
-        };
-        let _ = Command::new("ip")
-            .args(["netns", "del", &v.master_ns])
-            .output();
-        let _ = Command::new("ip")
-            .args(["netns", "del", &v.slave_ns])
-            .output();
-        ip(&["netns", "add", &v.master_ns]);
-        ip(&["netns", "add", &v.slave_ns]);
-        ip(&[
-            "link",
-            "add",
-            &v.master_if,
-            "netns",
-            &v.master_ns,
-            "type",
-            "veth",
-            "peer",
-            "name",
-            &v.slave_if,
-            "netns",
-            &v.slave_ns,
-        ]);
-        ip(&["-n", &v.master_ns, "link", "set", &v.master_if, "up"]);
-        ip(&["-n", &v.slave_ns, "link", "set", &v.slave_if, "up"]);
-        v
-    }
-}
-
-impl Drop for Veth {
-    fn drop(&mut self) {
-        let _ = Command::new("ip")
-            .args(["netns", "del", &self.master_ns])
-            .output();
-        let _ = Command::new("ip")
-            .args(["netns", "del", &self.slave_ns])
-            .output();
-    }
-}
-
-/// Moves the calling thread into network namespace `ns`.
-pub fn enter(ns: &str) {
-    let f = File::open(format!("/var/run/netns/{ns}")).expect("namespace file");
-    // SAFETY: a valid descriptor of a network namespace; affects this thread only.
-    let r = unsafe { libc::setns(f.as_raw_fd(), libc::CLONE_NEWNET) };
-    assert_eq!(r, 0, "setns {ns}: {}", std::io::Error::last_os_error());
 }
 
 /// A tshark capture on the master's interface.
@@ -236,7 +163,7 @@ pub fn run(v: &Veth, cycles: u64) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
             v.slave_if.clone(),
         );
         std::thread::spawn(move || {
-            enter(&ns);
+            enter(&ns)?;
             let sock = RawSocket::open(&ifname);
             let _ = ready.send(());
             serve_interface(sock?, bus, &stop)
@@ -244,7 +171,7 @@ pub fn run(v: &Veth, cycles: u64) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
     };
     // The drives listen before the master sends its first frame.
     listening.recv().expect("the emulated drives' thread");
-    enter(&v.master_ns);
+    enter(&v.master_ns).expect("entering the master's namespace");
     let (m, s) = machine_and_section(["x", "y", "z"], 1.0);
     let link = RawSocket::open(&v.master_if).expect("raw socket");
     let options = MasterOptions {
