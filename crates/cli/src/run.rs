@@ -138,9 +138,11 @@ pub fn load_machine(spec: Option<&str>) -> Result<Machine> {
 /// for the tables another crate reads itself (`[drive]`).
 pub fn machine_text(spec: Option<&str>) -> Result<String> {
     match spec {
-        None => Ok(Machine::builtin_text(builtin_names().next().unwrap_or("mill3"))
-            .unwrap_or_default()
-            .to_owned()),
+        None => Ok(
+            Machine::builtin_text(builtin_names().next().unwrap_or("mill3"))
+                .unwrap_or_default()
+                .to_owned(),
+        ),
         Some(s) if builtin_names().any(|n| n == s) => {
             Ok(Machine::builtin_text(s).unwrap_or_default().to_owned())
         }

@@ -71,6 +71,10 @@ pub struct ServeArgs {
     /// on that network interface (needs CAP_NET_RAW; see the README).
     #[arg(long, default_value = "ideal")]
     pub drive: String,
+    /// With `--drive ethercat:…`: how long a cycle waits for its frame before the machine
+    /// stops on a lost frame, ms (default: 80 % of the machine's period).
+    #[arg(long)]
+    pub bus_timeout_ms: Option<f64>,
 }
 
 /// The drive `--drive` names, opened.
@@ -79,8 +83,15 @@ enum Bus {
     Ethercat(Box<tezgah_ethercat::drive::EthercatDrive>),
 }
 
-/// Opens the drive `spec` names for `machine` (its file text `text` holds `[drive]`).
-fn open_drive(spec: &str, machine: &tezgah_kinematics::Machine, text: &str, period: f64) -> Result<Bus> {
+/// Opens the drive `spec` names for `machine` (its file text `text` holds `[drive]`); a bus
+/// cycle waits `bus_timeout_ms` for its frame (default: 80 % of `period`).
+fn open_drive(
+    spec: &str,
+    machine: &tezgah_kinematics::Machine,
+    text: &str,
+    period: f64,
+    bus_timeout_ms: Option<f64>,
+) -> Result<Bus> {
     match spec.split_once(':') {
         None if spec == "ideal" => Ok(Bus::Ideal),
         Some(("ethercat", interface)) if !interface.is_empty() => {
@@ -89,8 +100,16 @@ fn open_drive(spec: &str, machine: &tezgah_kinematics::Machine, text: &str, peri
                 .ok_or_else(|| miette!("{}", tezgah_ethercat::SectionError::Missing))?;
             let link = tezgah_ethercat::master::link::RawSocket::open(interface)
                 .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
-            let options =
+            let mut options =
                 tezgah_ethercat::master::MasterOptions::for_period(Duration::from_secs_f64(period));
+            if let Some(ms) = bus_timeout_ms {
+                if !(ms.is_finite() && ms > 0.0 && ms <= 1000.0) {
+                    return Err(miette!(
+                        "--bus-timeout-ms must be > 0 and at most 1000, got {ms}"
+                    ));
+                }
+                options.cycle_timeout = Duration::from_secs_f64(ms / 1000.0);
+            }
             let drive = tezgah_ethercat::drive::EthercatDrive::open(
                 Box::new(link),
                 &section,
@@ -223,7 +242,7 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     } else {
         RealtimeSettings::BEST_EFFORT
     };
-    let bus = open_drive(&args.drive, &machine, &text, period)?;
+    let bus = open_drive(&args.drive, &machine, &text, period, args.bus_timeout_ms)?;
     let host = match bus {
         Bus::Ideal => spawn(executor, IdealDrive, ring, realtime),
         Bus::Ethercat(drive) => {
