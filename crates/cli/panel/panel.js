@@ -172,12 +172,6 @@ function onStatus(s) {
   $('underruns').textContent = s.underruns;
   $('time-scale').textContent = fmt(s.time_scale, 2);
   $('late').textContent = `${Math.round(s.late_worst_s * 1e6)} µs` + (s.late_over_half ? ` (${s.late_over_half} over ½ period)` : '');
-  // The drives' actual positions (a real drive bus), in file units.
-  const joints = (panel.machine && panel.machine.joints) || [];
-  $('measured').textContent = (s.measured || []).map((v, i) => {
-    const j = joints[i] || { name: `${i}`, unit: 'mm' };
-    return `${j.name} ${fmt(j.unit === 'deg' ? v * 180 / Math.PI : v, 3)}`;
-  }).join('  ') || '—';
   $('alarm').hidden = !s.error;
   $('alarm').textContent = s.error ? `ALARM: ${s.error}` : '';
   // DRO.
