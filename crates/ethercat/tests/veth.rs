@@ -12,6 +12,7 @@
 mod common;
 
 use common::veth::*;
+use tezgah_ethercat::emulator::netns::ip;
 use tezgah_executor::{Drive, DriveFault, SetPoint};
 use tezgah_kinematics::Joints;
 

@@ -278,7 +278,9 @@ impl Slave {
             let ps = self.u16_at(b + 8) as usize;
             let kind = self.mem[b + 11];
             let from = ls.max(la);
-            let to = (ls + len).min(la + data.len() as u32);
+            let to = ls
+                .saturating_add(len)
+                .min(la.saturating_add(data.len() as u32));
             if from >= to {
                 continue;
             }
@@ -310,9 +312,12 @@ impl Slave {
         let (os, _, _) = self.sm(2);
         let mut at = os;
         for m in &self.outputs {
-            let n = m.bytes();
+            let n = m.bytes().min(4);
+            let Some(bytes) = self.mem.get(at..at + n) else {
+                break;
+            };
             let mut v = [0u8; 4];
-            v[..n].copy_from_slice(&self.mem[at..at + n]);
+            v[..n].copy_from_slice(bytes);
             self.dictionary.set(m.index, m.sub, u32::from_le_bytes(v));
             at += n;
         }
@@ -339,7 +344,7 @@ impl Slave {
         let (is, _, _) = self.sm(3);
         let mut at = is;
         for m in &self.inputs {
-            let n = m.bytes();
+            let n = m.bytes().min(4);
             let v = self.dictionary.get(m.index, m.sub).to_le_bytes();
             if at + n <= MEMORY {
                 self.mem[at..at + n].copy_from_slice(&v[..n]);

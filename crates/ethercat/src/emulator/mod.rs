@@ -169,3 +169,59 @@ impl Bus {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Any bytes under the EtherCAT EtherType: answered or refused, never a panic, and the
+        /// frame keeps its length.
+        #[test]
+        fn any_frame_is_survived(body in proptest::collection::vec(any::<u8>(), 0..400),
+                                 header in any::<u16>()) {
+            let mut bus = Bus::drives(2, 0.5);
+            let mut frame = vec![0xFFu8; 12];
+            frame.extend_from_slice(&ETHERTYPE.to_be_bytes());
+            frame.extend_from_slice(&header.to_le_bytes());
+            frame.extend_from_slice(&body);
+            let n = frame.len();
+            bus.process(&mut frame);
+            prop_assert_eq!(frame.len(), n);
+        }
+
+        /// Datagrams well framed but aimed anywhere (any command, address, length).
+        #[test]
+        fn any_datagram_is_survived(cmd in 0u8..16, adp in any::<u16>(), ado in any::<u16>(),
+                                    data in proptest::collection::vec(any::<u8>(), 0..200)) {
+            let mut bus = Bus::drives(2, 0.5);
+            let mut frame = vec![0xFFu8; 12];
+            frame.extend_from_slice(&ETHERTYPE.to_be_bytes());
+            let len = 12 + data.len();
+            frame.extend_from_slice(&((len as u16) | 0x1000).to_le_bytes());
+            frame.extend_from_slice(&[cmd, 0]);
+            frame.extend_from_slice(&adp.to_le_bytes());
+            frame.extend_from_slice(&ado.to_le_bytes());
+            frame.extend_from_slice(&(data.len() as u16).to_le_bytes());
+            frame.extend_from_slice(&[0, 0]);
+            frame.extend_from_slice(&data);
+            frame.extend_from_slice(&[0, 0]);
+            prop_assert!(bus.process(&mut frame));
+        }
+    }
+
+    #[test]
+    fn a_broadcast_read_counts_every_slave() {
+        // BRD of the ESC type register: wkc = number of slaves (what the master's scan counts).
+        let mut bus = Bus::drives(3, 1.0);
+        let mut frame = vec![0xFFu8; 12];
+        frame.extend_from_slice(&ETHERTYPE.to_be_bytes());
+        frame.extend_from_slice(&(13u16 | 0x1000).to_le_bytes());
+        frame.extend_from_slice(&[7, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0]);
+        assert!(bus.process(&mut frame));
+        assert_eq!(frame[26], 0x11);
+        assert_eq!(u16::from_le_bytes([frame[27], frame[28]]), 3);
+        assert_eq!(frame[6] & 0x02, 0x02, "locally administered bit set");
+    }
+}

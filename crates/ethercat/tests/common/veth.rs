@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use super::{machine_and_section, COUNTS_PER_MM, PERIOD};
 use tezgah_ethercat::drive::EthercatDrive;
 use tezgah_ethercat::emulator::netns::enter;
-pub use tezgah_ethercat::emulator::netns::{ip, Veth};
+pub use tezgah_ethercat::emulator::netns::Veth;
 use tezgah_ethercat::emulator::Bus;
 use tezgah_ethercat::master::link::{serve_interface, RawSocket};
 use tezgah_ethercat::master::MasterOptions;
