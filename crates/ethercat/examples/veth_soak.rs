@@ -1,7 +1,7 @@
 //! The soak of issue 27: three emulated drives on a veth pair between two network namespaces,
 //! a path at 1 ms for a minute (or the seconds given as the first argument), every set-point
-//! checked once and in order, the cycle's timing figures printed, the master's thread at
-//! SCHED_FIFO as the executor's real-time thread. Needs root:
+//! checked once and in order, the cycle's timing figures printed; the master's thread and the
+//! drives' at SCHED_FIFO as the executor's real-time thread is. Needs root:
 //!
 //! ```sh
 //! cargo run --release -p tezgah-ethercat --example veth_soak -- 60
@@ -28,6 +28,6 @@ fn main() {
     }
     let v = Veth::new("s").expect("namespaces and veth");
     let cycles = seconds * 1000;
-    let (f, _, _) = run(&v, cycles);
+    let (f, _, _) = run(&v, cycles, true);
     println!("veth soak, 3 drives, {cycles} cycles at 1 ms: {f:?}");
 }

@@ -4,15 +4,16 @@
 //! [`od`] names the objects and the process-data layout, [`cia402`] the drive state machine
 //! from the master's side, [`error_code`] the texts of a drive's 0x603F, [`section`] the
 //! machine file's `[drive]` table. [`emulator`] is a CiA-402 drive that answers EtherCAT frames
-//! (for tests and demos); [`master`] scans, configures and runs the bus, and [`drive`] puts it
+//! (for tests and demos; `emulator::netns` makes the veth pair the namespace tests use);
+//! [`master`] scans, configures and runs the bus, and [`drive`] puts it
 //! behind the executor's `Drive` trait.
 
 pub mod cia402;
+pub mod drive;
+pub mod emulator;
 pub mod error_code;
+pub mod master;
 pub mod od;
 pub mod section;
 
 pub use section::{DriveSection, DriveSlave, SectionError};
-pub mod drive;
-pub mod emulator;
-pub mod master;

@@ -24,7 +24,7 @@ fn drives_on_a_veth_pair_follow_a_path_and_the_wire_dissects_as_ethercat() {
     let v = Veth::new("a").expect("namespaces and veth");
     let capture = tshark_available().then(|| Capture::start(&v));
     let cycles = 2000;
-    let (f, mut d, _bus) = run(&v, cycles);
+    let (f, mut d, _bus) = run(&v, cycles, false);
     eprintln!("veth, 3 drives, {cycles} cycles at 1 ms: {f:?}");
 
     // The link goes down: the next cycle cannot send, and the machine stops saying so.

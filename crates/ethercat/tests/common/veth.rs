@@ -150,8 +150,9 @@ pub fn path(k: u64) -> [f64; 3] {
 }
 
 /// Runs `cycles` set-points at 1 ms through drives on the veth; returns the figures, the
-/// drive and the emulated bus.
-pub fn run(v: &Veth, cycles: u64) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
+/// drive and the emulated bus. `realtime`: the drives' thread at SCHED_FIFO (as hardware, it
+/// answers at once; the soak asks for it, the test leaves the scheduler alone).
+pub fn run(v: &Veth, cycles: u64, realtime: bool) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
     let bus = Arc::new(Mutex::new(Bus::drives(3, 1.0)));
     let stop = Arc::new(AtomicBool::new(false));
     let (ready, listening) = std::sync::mpsc::channel();
@@ -164,6 +165,11 @@ pub fn run(v: &Veth, cycles: u64) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
         );
         std::thread::spawn(move || {
             enter(&ns)?;
+            if realtime {
+                let _ = tezgah_executor::realtime::apply(
+                    &tezgah_executor::realtime::RealtimeSettings::BEST_EFFORT,
+                );
+            }
             let sock = RawSocket::open(&ifname);
             let _ = ready.send(());
             serve_interface(sock?, bus, &stop)
