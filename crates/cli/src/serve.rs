@@ -162,6 +162,9 @@ struct StatusOut<'a> {
     /// Unit vector tip → spindle in the workpiece frame (the preview's frame).
     #[serde(skip_serializing_if = "Option::is_none")]
     tool_axis: Option<[f64; 3]>,
+    /// With a drive bus: each drive's state, actual position and error, in bus order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    drives: Option<Vec<tezgah_ethercat::monitor::DriveReading>>,
 }
 
 /// One client holds control at a time; the others watch. The first to connect while nobody
@@ -200,6 +203,8 @@ struct Shared {
     /// Its kinematics when it has rotary joints (for the tool axis in the status).
     kinematics: Option<tezgah_kinematics::Model>,
     host: Handle,
+    /// The drive bus' monitor, when there is a bus.
+    drives: Option<Arc<tezgah_ethercat::monitor::Monitor>>,
     control: Control,
     access: Access,
     interval: Duration,
@@ -243,6 +248,10 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
         RealtimeSettings::BEST_EFFORT
     };
     let bus = open_drive(&args.drive, &machine, &text, period, args.bus_timeout_ms)?;
+    let drives = match &bus {
+        Bus::Ideal => None,
+        Bus::Ethercat(d) => Some(d.monitor()),
+    };
     let host = match bus {
         Bus::Ideal => spawn(executor, IdealDrive, ring, realtime),
         Bus::Ethercat(drive) => {
@@ -300,6 +309,7 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
             .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary)
             .then(|| machine.kinematics.clone()),
         host,
+        drives,
         control: Control::default(),
         access: Access { addr, token },
         interval: Duration::from_millis(args.status_ms.max(1)),
@@ -468,6 +478,7 @@ fn session_loop(ws: &mut WebSocket<TcpStream>, shared: &Shared, me: u64) -> Resu
                 &Outgoing::Status(StatusOut {
                     status: &status,
                     tool_axis,
+                    drives: shared.drives.as_ref().map(|m| m.readings()),
                 }),
             )?;
         }

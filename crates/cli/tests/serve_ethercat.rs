@@ -238,6 +238,10 @@ fn serve_runs_a_program_on_emulated_drives_over_a_veth_pair() {
                 .all(|i| (s["measured"][i].as_f64().unwrap_or(f64::NAN) - end[i]).abs() < 1.5e-3)
     });
     assert!(s["error"].is_null(), "{s}");
+    // Each drive's state and actual position in the status.
+    assert_eq!(s["drives"][0]["joint"], "x");
+    assert_eq!(s["drives"][2]["state"], "operation enabled");
+    assert_eq!(s["drives"][1]["position"], -3.0);
     {
         let bus = drives.bus.lock().unwrap();
         let ends: Vec<i32> = bus

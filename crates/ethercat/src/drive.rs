@@ -10,12 +10,14 @@ use tezgah_kinematics::Joints;
 use crate::cia402::{command, State};
 use crate::master::link::Link;
 use crate::master::{CycleError, Master, MasterOptions, OpenError};
+use crate::monitor::Monitor;
 use crate::od::Outputs;
 use crate::section::DriveSection;
 
 /// CiA-402 drives on EtherCAT as the executor's drive.
 pub struct EthercatDrive {
     master: Master,
+    monitor: std::sync::Arc<Monitor>,
     outputs: Vec<Outputs>,
     position: Joints,
     fault: Option<DriveFault>,
@@ -37,7 +39,9 @@ impl EthercatDrive {
                 position[s.joint] = s.from_counts(i.position);
             }
         }
+        let monitor = std::sync::Arc::new(Monitor::new(master.slaves()));
         Ok(EthercatDrive {
+            monitor,
             outputs: vec![Outputs::default(); master.slaves().len()],
             master,
             position,
@@ -52,6 +56,18 @@ impl EthercatDrive {
 
     pub fn master(&self) -> &Master {
         &self.master
+    }
+
+    /// The drives' states and positions for the front end (updated every cycle).
+    pub fn monitor(&self) -> std::sync::Arc<Monitor> {
+        self.monitor.clone()
+    }
+
+    fn publish(&self) {
+        for (k, i) in self.master.inputs().iter().enumerate() {
+            self.monitor
+                .record(k, i.statusword, i.position, i.error_code);
+        }
     }
 
     /// One cycle toward `sp`; the first fault found, if any.
@@ -124,6 +140,7 @@ impl Drive for EthercatDrive {
         } else {
             self.stopped_cycle();
         }
+        self.publish();
         let mut following_error = Joints::zeros(self.position.len());
         for (k, e) in following_error.as_mut_slice().iter_mut().enumerate() {
             let c = setpoint.position.as_slice().get(k).copied().unwrap_or(0.0);

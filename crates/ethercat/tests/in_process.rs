@@ -280,3 +280,29 @@ fn a_missing_or_wrong_drive_is_refused_at_start() {
         "no EtherCAT slave answered (cable, interface?)"
     );
 }
+
+#[test]
+fn the_monitor_shows_states_positions_and_faults() {
+    let (bus, mut d) = open(1.0, 1.0);
+    let m = d.monitor();
+    d.apply(&sp(1, [1.5, -2.0, 0.25]));
+    d.apply(&sp(2, [1.5, -2.0, 0.25]));
+    let r = m.readings();
+    assert_eq!(r.len(), 3);
+    assert_eq!(r[1].joint, "y");
+    assert_eq!(r[1].state, "operation enabled");
+    assert_eq!(r[1].position, -2.0);
+    assert_eq!(r[1].error, None);
+    bus.lock().unwrap().slaves[2].servo.inject_fault(0x3220);
+    d.apply(&sp(3, [1.5, -2.0, 0.25]));
+    d.apply(&sp(4, [1.5, -2.0, 0.25]));
+    let r = m.readings();
+    assert_eq!(r[2].state, "fault reaction active");
+    assert_eq!(r[2].error_code, 0x3220);
+    assert_eq!(r[2].error, Some("DC link undervoltage"));
+    let json = serde_json::to_string(&r[2]).unwrap();
+    assert_eq!(
+        json,
+        r#"{"joint":"z","state":"fault reaction active","position":0.25,"error_code":12832,"error":"DC link undervoltage"}"#
+    );
+}
