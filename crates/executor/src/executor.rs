@@ -165,8 +165,9 @@ pub struct Executor {
     probe_last: Option<ProbeReport>,
     /// A program that probes, running part by part.
     live: Option<probing::LiveProbe>,
-    /// The loaded program's text (a program that probes is read again after each answer).
-    text: Option<String>,
+    /// The loaded program's text and the configuration it was read with (a program that
+    /// probes is read again after each answer).
+    text: Option<(String, tezgah_gcode::Config)>,
 }
 
 fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
@@ -200,6 +201,11 @@ impl Executor {
         let gcode = tezgah_gcode::Config {
             tool_centre_point_always: machine.tcp == TcpSwitch::Always,
             axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
+            // With a probe, the interpreter stops at each probe move for the machine's answer.
+            probe: match machine.probe {
+                Some(_) => tezgah_gcode::ProbeModel::Answered(Arc::from([])),
+                None => tezgah_gcode::ProbeModel::Unavailable,
+            },
             ..tezgah_gcode::Config::default()
         };
         let n = pm.joint_count();
@@ -476,7 +482,7 @@ impl Executor {
                 if self.state != RunState::Idle {
                     return Err(self.busy("load"));
                 }
-                let config = self.load_config();
+                let config = self.mdi.program_config(&self.gcode);
                 let text = program;
                 let program = Program::interpret(text.clone(), &config)?;
                 self.warning = (!program.warnings.is_empty()).then(|| program.warnings.join("\n"));
@@ -485,7 +491,7 @@ impl Executor {
                 let first = program.moves[..probing::first_cut(&program)].to_vec();
                 self.built = Some(self.preflight(first, here, &program.origins)?);
                 self.program = Some(program);
-                self.text = Some(text);
+                self.text = Some((text, config));
                 self.mode = Mode::Auto;
                 Ok(())
             }
@@ -493,8 +499,9 @@ impl Executor {
                 RunState::Idle => {
                     self.check_homed("cycle start")?;
                     let program = self.program.clone().ok_or(ExecError::NoProgram)?;
-                    let text = self.text.clone().unwrap_or_default();
-                    self.start_program(program, text)
+                    let (text, config) = self.text.clone().unwrap_or_default();
+                    let source = probing::Source::Program { text, config };
+                    self.start_program(program, Mode::Auto, source)
                 }
                 RunState::Held | RunState::Paused { .. } | RunState::Holding => {
                     self.state = RunState::Running;
@@ -548,7 +555,7 @@ impl Executor {
                     self.mdi.sync(&here)?;
                     self.mdi_at = here;
                 }
-                let moves = self.mdi.block(&block)?;
+                let (moves, awaits) = self.mdi.block(&block)?;
                 if let Some(end) = moves.iter().rev().find_map(|m| move_end(&m.kind)) {
                     self.mdi_at = end;
                 }
@@ -564,7 +571,13 @@ impl Executor {
                 }
                 // A block the pre-flight refuses leaves the modal moves as they were (the
                 // interpreter's position is re-synchronised before the next block anyway).
-                self.start_job(job, Mode::Mdi, &Origins::mdi(&block))?;
+                let program = Program {
+                    moves: job,
+                    origins: Arc::new(Origins::mdi(&block)),
+                    warnings: Vec::new(),
+                    awaits,
+                };
+                self.start_program(program, Mode::Mdi, probing::Source::Mdi)?;
                 self.mdi_modal = modal;
                 Ok(())
             }

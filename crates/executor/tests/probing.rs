@@ -189,3 +189,36 @@ fn a_hold_during_the_probe_move() {
     assert!(trip[2] <= -3.0 && trip[2] > -3.0 - 0.005 - 1e-12);
     assert!((out.last().unwrap().tip - Vec3::new(5.0, 0.0, trip[2] + 1.0)).norm() < 1e-9);
 }
+
+/// MDI: the probe block stops at the trip, the next block sees `#5063`; a probe that misses is
+/// LinuxCNC's error placed at the block; the status shows the input in contact at rest.
+#[test]
+fn mdi_probes_and_the_next_block_sees_the_result() {
+    let (mut exec, machine) = probing_executor(plane(-3.0, 0.0));
+    let period = machine.motion.period_s;
+    let mut trace = Trace::new(&exec);
+    assert!(exec.status().probe.fitted && !exec.status().probe.input);
+    run_mdi(&mut exec, &mut trace, "G21 G90 G0 X5 Z5");
+    run_mdi(&mut exec, &mut trace, "G38.2 Z-10 F300");
+    let status = exec.status();
+    let last = status.probe.last.unwrap();
+    let trip = last.trip_mm.unwrap();
+    assert!(last.tripped && trip[2] <= -3.0 && trip[2] > -3.0 - 5.0 * period - 1e-12);
+    assert!(status.probe.input && status.tip[2] < trip[2]);
+    run_mdi(&mut exec, &mut trace, "G0 Z[#5063 + 1]");
+    assert!((exec.status().tip[2] - (trip[2] + 1.0)).abs() < 1e-9);
+    assert!(!exec.status().probe.input);
+    exec.command(Command::Mdi {
+        block: "G38.2 X20 F600".into(),
+    })
+    .unwrap();
+    drive(&mut exec, &mut trace, 1_000_000, |_, _| {});
+    assert_eq!(
+        exec.status().error.as_deref(),
+        Some("MDI:1:1: G38.2 move finished without making contact.")
+    );
+    run_mdi(&mut exec, &mut trace, "G0 X0");
+    let (out, report) = trace.report();
+    assert_within_limits(&report);
+    assert_continuous(&out);
+}

@@ -386,8 +386,8 @@ pub enum ErrorKind {
     ProbeStartAtTarget,
     /// tezgah's own: no probe to answer (`Config::probe`).
     #[error(
-        "G{0} probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
-         --probe); check, serve and MDI do not probe yet"
+        "G{0} probing needs a probe: a machine file's [probe] (`tezgah run`, `serve`, MDI) or \
+         `tezgah run --probe`; `check` does not probe"
     )]
     ProbeUnavailable(String),
     /// tezgah's own: a pass driven by the executor reached a probe move it has no answer for

@@ -432,8 +432,8 @@ fn probing_errors_are_linuxcnc_s_and_runs_refuse_probing() {
         .unwrap_err();
     assert_eq!(
         err.kind.to_string(),
-        "G38.2 probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
-         --probe); check, serve and MDI do not probe yet"
+        "G38.2 probing needs a probe: a machine file's [probe] (`tezgah run`, `serve`, MDI) or \
+         `tezgah run --probe`; `check` does not probe"
     );
     assert_eq!((err.span.line, err.span.column), (2, 1));
 }

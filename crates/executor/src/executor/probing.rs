@@ -22,10 +22,18 @@ use crate::probe::Seek;
 use crate::probe_moves::{fraction_along, part, point_at, with_stops};
 use crate::program::Program;
 
-/// A program that probes, as far as it has run.
+/// Where the moves after a probe come from.
+pub(super) enum Source {
+    /// A loaded program, read again from its start with the answers so far.
+    Program { text: String, config: Config },
+    /// An MDI block: its interpreter takes the answer; the probe was the block's motion.
+    Mdi,
+}
+
+/// A program (or MDI block) that probes, as far as it has run.
 pub(super) struct LiveProbe {
-    text: String,
-    config: Config,
+    source: Source,
+    mode: Mode,
     answers: Vec<ProbeOutcome>,
     /// Each probe move run so far (its index in the moves) and where the machine came to rest.
     stops: Vec<(usize, Pose)>,
@@ -74,33 +82,24 @@ fn answered(config: &Config, answers: &[ProbeOutcome]) -> Config {
 }
 
 impl Executor {
-    /// The interpreter's configuration for a loaded program: the MDI offsets in force, and the
-    /// probe answered by the machine when it has one.
-    pub(super) fn load_config(&self) -> Config {
-        let mut config = self.mdi.program_config(&self.gcode);
-        if self.probe_model.is_some() {
-            config.probe = Answers::Answered(Arc::from([]));
-        }
-        config
-    }
-
-    /// Starts the loaded program: whole, or its first part if it probes.
+    /// Starts a loaded program (`Mode::Auto`) or an MDI block's moves: whole, or the part
+    /// before the probe move they end with.
     pub(super) fn start_program(
         &mut self,
         program: Program,
-        text: String,
+        mode: Mode,
+        source: Source,
     ) -> Result<(), ExecError> {
         let Some(_) = program.awaits else {
-            return self.start_job(program.moves, Mode::Auto, &program.origins);
+            return self.start_job(program.moves, mode, &program.origins);
         };
         let cut = first_cut(&program);
         let moves = program.moves[..cut].to_vec();
         let origins = Arc::clone(&program.origins);
-        let config = self.load_config();
-        self.start_job(moves, Mode::Auto, &origins)?;
+        self.start_job(moves, mode, &origins)?;
         self.live = Some(LiveProbe {
-            text,
-            config,
+            source,
+            mode,
             answers: Vec::new(),
             stops: Vec::new(),
             program,
@@ -247,11 +246,12 @@ impl Executor {
     ) -> Result<(), ExecError> {
         let holding = matches!(self.state, RunState::Holding | RunState::Held);
         let live = self.live.take();
+        let mode = live.as_ref().map_or(Mode::Auto, |l| l.mode);
         self.built = None;
         // The path run in the part left stays counted (a stopped probe move ends mid-piece).
         self.done_length += self.s;
         self.s = 0.0;
-        let started = self.start_job(moves, Mode::Auto, origins);
+        let started = self.start_job(moves, mode, origins);
         self.live = live;
         started?;
         if holding {
@@ -304,8 +304,19 @@ impl Executor {
         });
         live.answers.push(outcome);
         live.stops.push((index, stopped));
-        let pass = Program::interpret(live.text.clone(), &answered(&live.config, &live.answers));
-        let mut pass = match pass {
+        let (text, config) = match &live.source {
+            Source::Program { text, config } => (text.clone(), answered(config, &live.answers)),
+            Source::Mdi => {
+                // The block's motion was the probe: nothing after it moves.
+                let answered = self.mdi.answer(outcome);
+                self.drop_job();
+                if let Err(e) = answered {
+                    self.error = Some(e.to_string());
+                }
+                return Ok(());
+            }
+        };
+        let mut pass = match Program::interpret(text, &config) {
             Ok(p) => p,
             Err(e) => {
                 self.drop_job();

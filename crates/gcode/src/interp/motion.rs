@@ -181,8 +181,22 @@ impl Interpreter {
             return Ok(());
         };
         let Some(outcome) = outcome else {
+            self.pending_probe = Some(super::PendingProbe { g, start, end });
             return Err((ErrorKind::ProbeAwaitsAnswer(name()), at));
         };
+        self.apply_probe(g, start, end, outcome)
+            .map_err(|kind| (kind, at))
+    }
+
+    /// The machine's answer to the probe move G`g` from `start` to `end`: `#5061`… and the
+    /// position where the machine came to rest, or LinuxCNC's error for the outcome.
+    pub(super) fn apply_probe(
+        &mut self,
+        g: u32,
+        start: Pose,
+        end: Pose,
+        outcome: super::ProbeOutcome,
+    ) -> Result<(), ErrorKind> {
         self.probes += 1;
         let toward = matches!(g, 382 | 383);
         let point = |f: f64| {
@@ -195,17 +209,17 @@ impl Interpreter {
         let (probed, stopped, tripped) = match outcome {
             super::ProbeOutcome::Tripped { at: f, stopped } => (point(f), point(stopped), true),
             super::ProbeOutcome::Completed if matches!(g, 382) => {
-                return Err((ErrorKind::ProbeNoContact, at))
+                return Err(ErrorKind::ProbeNoContact)
             }
             super::ProbeOutcome::Completed if matches!(g, 384) => {
-                return Err((ErrorKind::ProbeStillInContact, at))
+                return Err(ErrorKind::ProbeStillInContact)
             }
             // G38.3 and G38.5 go on untripped from the end of the move.
             super::ProbeOutcome::Completed => (end, end, false),
             super::ProbeOutcome::AlreadyThere if toward => {
-                return Err((ErrorKind::ProbeAlreadyTripped, at))
+                return Err(ErrorKind::ProbeAlreadyTripped)
             }
-            super::ProbeOutcome::AlreadyThere => return Err((ErrorKind::ProbeAlreadyClear, at)),
+            super::ProbeOutcome::AlreadyThere => return Err(ErrorKind::ProbeAlreadyClear),
         };
         self.set_probe_parameters(probed, tripped);
         self.state.pos = stopped;
