@@ -403,6 +403,17 @@ pub enum ErrorKind {
     ProbeAlreadyTripped,
     #[error("Probe is already clear when starting G38.4 or G38.5 move")]
     ProbeAlreadyClear,
+    // --- spindle-synchronised motion (G33, G33.1) ---
+    #[error("K word missing with g33/g33.1")]
+    SyncMissingK,
+    #[error("F word used with a g33/g33.1")]
+    SyncWithF,
+    /// `Spindle not turning in G33` / `… G33.1`.
+    #[error("Spindle not turning in {0}")]
+    SyncSpindleStopped(&'static str),
+    /// tezgah's own: LinuxCNC sends the compensated moves without synchronisation.
+    #[error("G33/G33.1 with cutter radius compensation is not supported")]
+    SyncWithComp,
     // --- polar coordinates (`@` radius, `^` angle) ---
     #[error("Cannot use polar coordinate except in G17 plane")]
     PolarNotXyPlane,
