@@ -34,6 +34,8 @@ pub fn position_before(moves: &[Move], index: usize) -> Pose {
             MoveKind::Arc(a) => Some(a.end),
             MoveKind::Nurbs(n) => Some(n.end),
             MoveKind::ToolControl { at, .. } => Some(*at),
+            // A thread ends at its end; a rigid tap comes back to where it started.
+            MoveKind::Synced(s) if s.tap.is_none() => Some(s.end),
             _ => None,
         })
         .unwrap_or(Pose::ZERO)

@@ -74,6 +74,9 @@ pub struct SyncFigures {
     pub lock_after: f64,
     /// Rigid tap: how far past the programmed depth the tool went while the spindle reversed, mm.
     pub overshoot: Option<f64>,
+    /// Rigid tap: how far past the start (away from the hole) the tool went while the spindle
+    /// turned forward again, before the final placement, mm.
+    pub overshoot_back: Option<f64>,
     /// The whole move, s.
     pub duration: f64,
 }
@@ -132,12 +135,13 @@ enum Stage {
 /// The longest a synchronised move may take before it is called stuck, s.
 const MAX_DURATION: f64 = 3600.0;
 
-/// Runs `mv` from `start` (the machine at rest there with `joints`) along `seg`, its path
-/// (a straight feed to `mv.end`), with the spindle turning at `rpm` at angle `phase` (rev).
-/// Samples are numbered from 1 at `options.period`.
+/// Runs `mv` from `start` (the machine at rest there with `joints`) along `path.0`, its path
+/// (a straight feed to `mv.end`; a tap's way back along `path.1`, the feed back to `start`),
+/// with the spindle turning at `rpm` at angle `phase` (rev). Samples are numbered from 1 at
+/// `options.period`, each with the segment it lies on.
 #[allow(clippy::too_many_arguments)]
 pub fn run_synced(
-    seg: &Arc<Segment>,
+    path: (&Arc<Segment>, &Arc<Segment>),
     mv: &SyncedMove,
     start: Pose,
     rpm: f64,
@@ -161,6 +165,7 @@ pub fn run_synced(
         return Err(SyncError::NoLinearTravel);
     }
     let direction = (b - a) / length;
+    let (seg, back) = path;
     let path = path_limits(seg, machine, options)?;
     let (a_max, j_max) = (path.max_acceleration(), path.max_jerk());
     // The position loop's gain (1/s): slow enough that the jerk-limited velocity steps settle
@@ -178,7 +183,7 @@ pub fn run_synced(
     let mut figures = SyncFigures::default();
     let mut locked_from: Option<(f64, f64)> = None;
     let mut locked_to = (0.0, 0.0);
-    let mut deepest = 0.0f64;
+    let (mut deepest, mut shallowest) = (0.0f64, 0.0f64);
     let mut samples = Vec::new();
     let mut q = joints;
     let mut k: u64 = 0;
@@ -236,6 +241,7 @@ pub fn run_synced(
                     locked_to = (x.s, spindle.angle);
                 }
                 deepest = deepest.max(x.s);
+                shallowest = shallowest.min(x.s);
                 let next = match (mv.tap, stage) {
                     (None, _) => {
                         // A thread leaves the spindle where the stop still fits before its end.
@@ -286,6 +292,17 @@ pub fn run_synced(
         q = machine
             .joints(seg.control, &tip, &rotary, &q)
             .map_err(|e| SyncError::Kinematics(e.to_string()))?;
+        // A tap's way back lies on the feed back (the same line, run the other way).
+        let on = match phase {
+            Phase::Locked {
+                stage: Stage::Forward,
+                ..
+            }
+            | Phase::Index
+            | Phase::Match { .. } => seg,
+            _ if mv.tap.is_some() => back,
+            _ => seg,
+        };
         samples.push((
             Sample {
                 index: k,
@@ -296,7 +313,7 @@ pub fn run_synced(
                 joints: q,
                 feed: if done { 0.0 } else { x.v.abs() },
             },
-            vec![seg.clone()],
+            vec![on.clone()],
         ));
         if done {
             figures.duration = t;
@@ -311,6 +328,7 @@ pub fn run_synced(
     }
     if mv.tap.is_some() {
         figures.overshoot = Some(deepest - length);
+        figures.overshoot_back = Some(-shallowest);
     }
     Ok(SyncRun { samples, figures })
 }

@@ -35,17 +35,25 @@ fn run(
         },
         Move {
             line: 2,
+            kind: MoveKind::PathMode(tezgah_geom::PathMode::ExactStop),
+        },
+        Move {
+            line: 2,
             kind: MoveKind::Feed { end },
+        },
+        Move {
+            line: 2,
+            kind: MoveKind::Feed { end: start },
         },
     ];
     let items = smooth::build(moves, &opts).unwrap();
-    let seg = items
+    let segments: Vec<_> = items
         .into_iter()
-        .find_map(|i| match i {
+        .filter_map(|i| match i {
             PathItem::Segment(s) => Some(Arc::new(s)),
             _ => None,
         })
-        .unwrap();
+        .collect();
     let options = PlanOptions {
         period: PERIOD,
         ..PlanOptions::default()
@@ -60,7 +68,18 @@ fn run(
         )
         .unwrap();
     let mv = SyncedMove { end, pitch, tap };
-    let run = run_synced(&seg, &mv, start, rpm, 0.3, model, &pm, &options, joints).unwrap();
+    let run = run_synced(
+        (&segments[0], &segments[1]),
+        &mv,
+        start,
+        rpm,
+        0.3,
+        model,
+        &pm,
+        &options,
+        joints,
+    )
+    .unwrap();
     (run, machine)
 }
 
