@@ -212,3 +212,23 @@ fn the_spindle_reverses_at_its_acceleration_limit() {
     );
     assert!((s.angle - 100.0 / (2.0 * model.max_acceleration)).abs() < 0.01 + 1e-9);
 }
+
+/// The executor does not synchronise to a spindle: a program with G33 is refused at load,
+/// at its line, before anything moves.
+#[test]
+fn the_executor_refuses_g33_at_its_line() {
+    use tezgah_executor::command::Command;
+    use tezgah_executor::executor::{ExecOptions, Executor};
+    let m = Machine::default_machine();
+    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let e = exec
+        .command(Command::Load {
+            program: "G21 G90\nM3 S600\nG0 Z1\nG33.1 Z-5 K1\nM2\n".into(),
+        })
+        .unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("program:4:1: path: G33/G33.1 follow the spindle"),
+        "{e}"
+    );
+}
