@@ -234,7 +234,8 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // (Lines, arcs and helices turn evenly: the ends and the middle tell it.)
             const COARSE: usize = 16;
             let dc = (ub - ua) / COARSE as f64;
-            let coarse: f64 = if constant_speed(curve) {
+            let constant = constant_speed(curve);
+            let coarse: f64 = if constant {
                 0.0
             } else {
                 (0..COARSE)
@@ -246,6 +247,21 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                     .sum()
             };
             let turning = (k0.norm().max(k1.norm()).max(km.norm()) * seg.length).max(coarse);
+            // On lines, arcs and helices each axis's derivatives are sinusoids of the arc
+            // length: sampled every ≤ 0.1 rad of turning, a peak between samples is at most
+            // 1/cos(0.05) = 1.00125 of the sampled one, and the parabola through a peak and
+            // its neighbours misses it by far less. A spline's or blend's curvature can spike
+            // between samples: it keeps the wider margins.
+            let margin = if constant {
+                [1.002; 3]
+            } else {
+                [1.005, 1.05, 1.05]
+            };
+            let vertex_margin = if constant {
+                [1.002; 3]
+            } else {
+                [1.01, 1.06, 1.06]
+            };
             let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
             let du = (ub - ua) / samples as f64;
             // Per axis, the sample where |q''| and where |q'''| peak: the peak between samples
@@ -266,13 +282,17 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 // whole segment's maxima have the peak refinement below; a cell does not).
                 let h = 0.5 * su * du;
                 for i in 0..3 {
-                    let d = [t[i].abs() * 1.005, k[i].abs() * 1.05, dk[i].abs() * 1.05];
+                    let d = [
+                        t[i].abs() * margin[0],
+                        k[i].abs() * margin[1],
+                        dk[i].abs() * margin[2],
+                    ];
                     g1[i] = g1[i].max(d[0]);
                     g2[i] = g2[i].max(d[1]);
                     g3[i] = g3[i].max(d[2]);
                     let local = [
-                        (t[i].abs() + h * k[i].abs()) * 1.005,
-                        (k[i].abs() + h * dk[i].abs()) * 1.05,
+                        (t[i].abs() + h * k[i].abs()) * margin[0],
+                        (k[i].abs() + h * dk[i].abs()) * margin[1],
                         d[2],
                     ];
                     raise(cells, i, f, df, local);
@@ -310,7 +330,7 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                         let (a, b, c) = (before[i][o], here[i][o], after[i][o]);
                         let bend = 2.0 * b - a - c;
                         if b >= a && b >= c && bend > 0.0 {
-                            *x = (b + (c - a) * (c - a) / (8.0 * bend)) * [1.01, 1.06, 1.06][o];
+                            *x = (b + (c - a) * (c - a) / (8.0 * bend)) * vertex_margin[o];
                         }
                     }
                     raise(&mut tip_cells, i, s as f64 * df, df, d);
