@@ -846,11 +846,11 @@ impl<'a> Budgets<'a> {
         let mut m = 0;
         let below = |x: &[f64; 3], y: &[f64; 3]| x[0] <= y[0] && x[1] <= y[1] && x[2] <= y[2];
         for i in 0..machine.joint_count().min(MAX_JOINTS) {
-            for c in 0..CELLS {
-                let d = &cells[c][i];
+            for (c, cell) in cells.iter().enumerate() {
+                let d = &cell[i];
                 // Bounded by another cell (among equal ones, the first is kept).
-                let covered = (0..CELLS).any(|o| {
-                    let e = &cells[o][i];
+                let covered = cells.iter().enumerate().any(|(o, other)| {
+                    let e = &other[i];
                     o != c && below(d, e) && (o < c || !below(e, d))
                 });
                 if !covered {
