@@ -12,13 +12,13 @@ use tezgah_gcode::interp::SubroutineLibrary;
 use tezgah_geom::{Move, MoveKind, Pose, StopKind, Vec3};
 use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
-use tezgah_motion::path::smooth::SmoothOptions;
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
+use tezgah_motion::prepare::{plan_options, prepare_from, PrepareError};
 use tezgah_motion::{Junction, Limits, Segment};
 
 use crate::command::{Command, Mode, PauseReason, ProbeReport, ProbeStatus, RunState, Status};
 use crate::error::ExecError;
-use crate::job::{BuiltPath, Job, JobOptions, PlannedItem};
+use crate::job::{self, BuiltPath, Job, PlannedItem};
 use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
@@ -47,33 +47,29 @@ pub struct Produced {
     pub path: f64,
 }
 
-/// Settings of the executor.
+/// Settings of the executor: the machine file's period and tolerance. The path and the plan
+/// are made from them by motion's one entry point ([`tezgah_motion::prepare`]), as `tezgah
+/// run` makes them, so the executor follows the path `run` plans.
 #[derive(Debug, Clone)]
 pub struct ExecOptions {
     pub period: f64,
-    pub smooth: SmoothOptions,
-    pub plan: PlanOptions,
+    /// Path tolerance, mm (shared between smoothing and chord error by `prepare`).
+    pub tolerance: f64,
 }
 
 impl ExecOptions {
-    /// The machine file's period, tolerance and `[path]` settings, and `tezgah run`'s
-    /// tolerance split: the executor follows the path `tezgah run` plans.
+    /// The machine file's period and tolerance.
     pub fn for_machine(machine: &Machine) -> Result<ExecOptions, ExecError> {
-        let period = machine.motion.period_s;
-        let pm = PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
+        PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
         Ok(ExecOptions {
-            period,
-            smooth: SmoothOptions::for_machine(
-                &machine.path,
-                &pm,
-                machine.motion.tolerance_mm,
-                Pose::ZERO,
-            ),
-            plan: PlanOptions {
-                period,
-                ..PlanOptions::default()
-            },
+            period: machine.motion.period_s,
+            tolerance: machine.motion.tolerance_mm,
         })
+    }
+
+    /// The planner's options at this period ([`tezgah_motion::prepare::plan_options`]).
+    pub fn plan(&self) -> PlanOptions {
+        plan_options(self.period)
     }
 }
 
@@ -386,14 +382,6 @@ impl Executor {
         }
     }
 
-    fn job_options(&self) -> JobOptions {
-        JobOptions {
-            smooth: self.options.smooth.clone(),
-            plan: self.options.plan,
-            single_block: self.single_block,
-        }
-    }
-
     /// The tool's pose in the coordinates of the moves (mm, degrees).
     fn program_pose(&self) -> Pose {
         let p = &self.pose;
@@ -407,8 +395,8 @@ impl Executor {
         )
     }
 
-    /// Builds the whole path of `moves` from `start` with the executor's smoothing options
-    /// and checks every segment's joints against reach and limits (motion's pre-flight), so
+    /// Builds the whole path of `moves` from `start` and checks every segment's joints
+    /// against reach and limits from where the joints stand (motion's [`prepare_from`]), so
     /// a program that would leave the machine's work space is refused before anything moves;
     /// the job then plans that same path. Errors name the place `origins` gives the moves'
     /// lines; the path returned carries plain line numbers.
@@ -418,14 +406,21 @@ impl Executor {
         start: Pose,
         origins: &Origins,
     ) -> Result<BuiltPath, ExecError> {
-        let mut path = BuiltPath::build(moves, &self.machine, &self.job_options(), start).map_err(
-            |e| match e {
-                ExecError::Path(e) => origins.path_error(e),
-                other => other,
-            },
-        )?;
-        tezgah_motion::preflight::check_path(path.items(), &self.machine, self.pose.joints)
-            .map_err(|e| origins.preflight_error(&e))?;
+        let (moves, stops) = job::exact_stops(moves, self.single_block);
+        let prepared = prepare_from(
+            moves,
+            &self.machine_file,
+            self.options.tolerance,
+            start,
+            Some(self.pose.joints),
+        )
+        .map_err(|e| match e {
+            PrepareError::Path(e) => origins.path_error(e),
+            PrepareError::Preflight(e) => origins.preflight_error(&e),
+            PrepareError::Machine(e) => ExecError::Plan(e),
+            PrepareError::Start(e) => ExecError::Machine(format!("the start pose: {e}")),
+        })?;
+        let mut path = BuiltPath::new(prepared, stops, self.single_block);
         path.plain_lines(origins.keys());
         Ok(path)
     }
@@ -456,7 +451,7 @@ impl Executor {
             Some(b) => b,
             None => self.preflight(moves, start, origins)?,
         };
-        let job = Job::new(built, &self.machine, self.options.plan, self.pose.joints)?;
+        let job = Job::new(built, &self.machine, self.options.plan(), self.pose.joints)?;
         self.job = Some(job);
         self.current = None;
         self.peeked = None;
@@ -915,7 +910,7 @@ impl Executor {
     /// piece, when it is peeked or taken, so an override raised later reaches it too.
     fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
         overridable(piece)
-            .then(|| overspeed_limits(piece, &self.machine, &self.options.plan))
+            .then(|| overspeed_limits(piece, &self.machine, &self.options.plan()))
             .flatten()
     }
 

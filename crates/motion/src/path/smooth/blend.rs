@@ -296,7 +296,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     } else {
         8.0 * share / (3.0 * half) * (1.0 - 1e-12)
     };
-    let mut leg = ideal.min(room_a).min(room_b);
+    let room = room_a.min(room_b);
     let refuse = || {
         if tangent {
             NoBlend::Tangent {
@@ -306,12 +306,13 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             NoBlend::Corner
         }
     };
-    if !(leg > 0.0 && leg.is_finite()) {
-        return Err(refuse());
-    }
     let both_lines = !tangent && matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
     let corner = a.geo.point(a.geo.domain().1);
-    for _ in 0..=LEG_HALVINGS {
+    // The blend of legs `leg` and its deviation, if within the share.
+    let trial = |leg: f64| -> Result<Option<Placed>, NoBlend> {
+        if !(leg > 0.0 && leg.is_finite()) {
+            return Err(refuse());
+        }
         let ua = a.u_at(a.full_length - leg);
         let ub = b.u_at(leg);
         let (pa, pb) = (a.geo.point(ua), b.geo.point(ub));
@@ -349,27 +350,83 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             let away = bound.unwrap_or_else(|| away_sampled(&curve, a, &ca, b, &cb));
             to_corner.max(away)
         };
-        if deviation <= share {
-            let length = if both_lines {
-                line_line_length(leg, ta.dot(&tb))
-            } else {
-                curve.arc_length()
-            };
-            if !(length > 0.0 && length.is_finite()) {
-                return Err(refuse());
-            }
-            return Ok(Placed {
-                curve,
-                length,
-                ua,
-                ub,
-                deviation,
-                speed: lam,
-            });
+        if deviation > share {
+            return Ok(None);
+        }
+        let length = if both_lines {
+            line_line_length(leg, ta.dot(&tb))
+        } else {
+            curve.arc_length()
+        };
+        if !(length > 0.0 && length.is_finite()) {
+            return Err(refuse());
+        }
+        Ok(Some(Placed {
+            curve,
+            length,
+            ua,
+            ub,
+            deviation,
+            speed: lam,
+        }))
+    };
+    let mut leg = ideal.min(room);
+    if tangent {
+        // The clothoid estimate is far from what the quintic deviates: with λ = 2ℓ its
+        // curvature rises nearly linearly along the blend and it stays inside the two curves
+        // it joins, ~1/15 of the estimate off them (R10 line–arc at ε 0.008: 0.0005 mm).
+        // The jerk a speed v asks on a transition is ~v³·Δκ/L, so the longest blend the
+        // share allows is the fastest: measured, the legs grow until the share is met.
+        if let Some(p) = longest_within(leg, (leg * TANGENT_REACH).min(room), &trial)? {
+            return Ok(p);
+        }
+    }
+    for _ in 0..=LEG_HALVINGS {
+        if let Some(p) = trial(leg)? {
+            return Ok(p);
         }
         leg *= 0.5;
     }
     Err(refuse())
+}
+
+/// How far beyond the clothoid estimate a tangent blend's legs are tried ([`place`]).
+const TANGENT_REACH: f64 = 6.0;
+
+/// Bisections between a leg within the share and a longer one outside it.
+const LEG_BISECTIONS: usize = 6;
+
+/// The longest leg in `[lo, hi]` whose blend `trial` accepts, to within 2⁻⁶ of the span:
+/// `hi` itself if it is accepted, else by bisection from `lo` (`None` if `lo` is refused too;
+/// the caller then shortens the leg).
+fn longest_within(
+    lo: f64,
+    hi: f64,
+    trial: &impl Fn(f64) -> Result<Option<Placed>, NoBlend>,
+) -> Result<Option<Placed>, NoBlend> {
+    if hi > lo {
+        if let Some(p) = trial(hi)? {
+            return Ok(Some(p));
+        }
+    }
+    let Some(mut best) = trial(lo)? else {
+        return Ok(None);
+    };
+    let (mut lo, mut hi) = (lo, hi);
+    for _ in 0..LEG_BISECTIONS {
+        if hi <= lo {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        match trial(mid)? {
+            Some(p) => {
+                best = p;
+                lo = mid;
+            }
+            None => hi = mid,
+        }
+    }
+    Ok(Some(best))
 }
 
 /// The blend's largest distance from the pieces `a` over `ca` and `b` over `cb`, sampled and
