@@ -106,6 +106,8 @@ pub enum SyncError {
 }
 
 /// Where the move is in LinuxCNC's sequence.
+// One value for the whole move, on the stack: the profile's size costs nothing.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
     /// At rest, waiting for the spindle's index (the angle crossing a whole revolution).
