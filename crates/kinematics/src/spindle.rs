@@ -52,3 +52,28 @@ impl RawSpindle {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::Machine;
+
+    fn with_spindle(section: &str) -> Result<Machine, String> {
+        let text = Machine::builtin_text("mill3").unwrap().to_owned() + "\n[spindle]\n" + section;
+        Machine::from_toml_str(&text).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn the_spindle_section_is_read_with_defaults_and_checked_by_field() {
+        let m = with_spindle("max_acceleration_rev_s2 = 20.0\n").unwrap();
+        assert_eq!(m.spindle.max_acceleration, 20.0);
+        assert_eq!(m.spindle.time_constant, 0.02);
+        let e = with_spindle("time_constant_s = -1.0\n").unwrap_err();
+        assert!(e.contains("spindle.time_constant_s"), "{e}");
+        let e = with_spindle("inertia = 1.0\n").unwrap_err();
+        assert!(e.contains("inertia"), "{e}");
+        assert_eq!(
+            Machine::default_machine().spindle,
+            super::SpindleModel::default()
+        );
+    }
+}
