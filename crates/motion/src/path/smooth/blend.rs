@@ -309,7 +309,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     let both_lines = !tangent && matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
     let corner = a.geo.point(a.geo.domain().1);
     // The blend of legs `leg` and its deviation, if within the share.
-    let trial = |leg: f64| -> Result<Option<Placed>, NoBlend> {
+    let trial = |leg: f64| -> Result<(f64, Option<Placed>), NoBlend> {
         if !(leg > 0.0 && leg.is_finite()) {
             return Err(refuse());
         }
@@ -351,7 +351,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             to_corner.max(away)
         };
         if deviation > share {
-            return Ok(None);
+            return Ok((deviation, None));
         }
         let length = if both_lines {
             line_line_length(leg, ta.dot(&tb))
@@ -361,14 +361,17 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         if !(length > 0.0 && length.is_finite()) {
             return Err(refuse());
         }
-        Ok(Some(Placed {
-            curve,
-            length,
-            ua,
-            ub,
+        Ok((
             deviation,
-            speed: lam,
-        }))
+            Some(Placed {
+                curve,
+                length,
+                ua,
+                ub,
+                deviation,
+                speed: lam,
+            }),
+        ))
     };
     let mut leg = ideal.min(room);
     if tangent {
@@ -377,12 +380,13 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
         // it joins, ~1/15 of the estimate off them (R10 line–arc at ε 0.008: 0.0005 mm).
         // The jerk a speed v asks on a transition is ~v³·Δκ/L, so the longest blend the
         // share allows is the fastest: measured, the legs grow until the share is met.
-        if let Some(p) = longest_within(leg, (leg * TANGENT_REACH).min(room), &trial)? {
+        let reach = (leg * TANGENT_REACH).min(room);
+        if let Some(p) = longest_within(leg * TANGENT_START, reach, share, &trial)? {
             return Ok(p);
         }
     }
     for _ in 0..=LEG_HALVINGS {
-        if let Some(p) = trial(leg)? {
+        if let (_, Some(p)) = trial(leg)? {
             return Ok(p);
         }
         leg *= 0.5;
@@ -393,40 +397,69 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
 /// How far beyond the clothoid estimate a tangent blend's legs are tried ([`place`]).
 const TANGENT_REACH: f64 = 6.0;
 
-/// Bisections between a leg within the share and a longer one outside it.
-const LEG_BISECTIONS: usize = 6;
+/// The first leg tried, in clothoid estimates: at that estimate a line–arc quintic deviates
+/// ~1/15 of the share (whatever the radius: both scale alike), so √15 of it nearly meets it.
+const TANGENT_START: f64 = 3.7;
 
-/// The longest leg in `[lo, hi]` whose blend `trial` accepts, to within 2⁻⁶ of the span:
-/// `hi` itself if it is accepted, else by bisection from `lo` (`None` if `lo` is refused too;
-/// the caller then shortens the leg).
+/// Aim a little inside the share: the deviation is only nearly quadratic in the leg.
+const LEG_AIM: f64 = 0.97;
+
+/// Tries at the legs the deviation predicts, and then bisections.
+const LEG_TRIES: usize = 3;
+const LEG_BISECTIONS: usize = 3;
+
+/// The longest leg up to `hi` (nearly) whose blend `trial` accepts, starting from a guess
+/// `start`; `trial` gives the deviation of a leg and the blend if it is within `share`.
+/// `None` if no leg tried is accepted (the caller then shortens from its own estimate). A
+/// tangent blend deviates about in proportion to its leg squared (a transition's shift,
+/// ~L²·Δκ/24), so each try aims at the leg that scaling predicts from the last deviation
+/// measured, and bisection settles what the prediction misses. Each try measures the blend
+/// against both curves: one or two is what it usually costs.
 fn longest_within(
-    lo: f64,
+    start: f64,
     hi: f64,
-    trial: &impl Fn(f64) -> Result<Option<Placed>, NoBlend>,
+    share: f64,
+    trial: &impl Fn(f64) -> Result<(f64, Option<Placed>), NoBlend>,
 ) -> Result<Option<Placed>, NoBlend> {
-    if hi > lo {
-        if let Some(p) = trial(hi)? {
-            return Ok(Some(p));
+    let mut best: Option<Placed> = None;
+    let (mut ok, mut over) = (0.0, hi * (1.0 + 1e-12));
+    let mut aim = start.min(hi);
+    for _ in 0..LEG_TRIES {
+        let (d, placed) = trial(aim)?;
+        match placed {
+            Some(p) => {
+                // Close to the share, or at the top of the range: done (a transition's
+                // speed grows only with the cube root of its length).
+                if aim >= 0.97 * hi || d >= 0.9 * LEG_AIM * share {
+                    return Ok(Some(p));
+                }
+                ok = aim;
+                best = Some(p);
+            }
+            None => over = aim,
         }
-    }
-    let Some(mut best) = trial(lo)? else {
-        return Ok(None);
-    };
-    let (mut lo, mut hi) = (lo, hi);
-    for _ in 0..LEG_BISECTIONS {
-        if hi <= lo {
+        let next = (aim * (LEG_AIM * share / d.max(1e-300)).sqrt()).min(hi);
+        if next >= over || next <= ok {
             break;
         }
-        let mid = 0.5 * (lo + hi);
-        match trial(mid)? {
-            Some(p) => {
-                best = p;
-                lo = mid;
+        aim = next;
+    }
+    if ok > 0.0 {
+        for _ in 0..LEG_BISECTIONS {
+            let mid = 0.5 * (ok + over.min(hi));
+            if mid <= ok * 1.01 {
+                break;
             }
-            None => hi = mid,
+            match trial(mid)? {
+                (_, Some(p)) => {
+                    best = Some(p);
+                    ok = mid;
+                }
+                (_, None) => over = mid,
+            }
         }
     }
-    Ok(Some(best))
+    Ok(best)
 }
 
 /// The blend's largest distance from the pieces `a` over `ca` and `b` over `cb`, sampled and
