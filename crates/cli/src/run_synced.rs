@@ -132,25 +132,26 @@ pub fn run_synced_moves(
         if let (Some(past), Some(back)) = (run.figures.overshoot, run.figures.overshoot_back) {
             let turns = tap_points(start, &mv, past, back);
             let (segments, _) = lines(&turns[..2])?;
-            let deep = run
-                .samples
-                .iter()
-                .map(|s| s.0.index)
-                .zip(&run.samples)
-                .fold((0, f64::MIN), |best, (k, s)| {
-                    let d = (s.0.tip - Vec3::from(start.xyz())).norm();
-                    if d > best.1 {
-                        (k, d)
-                    } else {
-                        best
-                    }
-                });
-            let mut up = false;
-            for (s, segs) in &mut run.samples {
-                up |= s.index > deep.0;
-                let on = if !up {
+            // Along the line from the start toward the hole: the turning points are the
+            // sample furthest in and, after it, the one furthest out.
+            let along = |p: &Vec3| {
+                let a = Vec3::from(start.xyz());
+                (p - a).dot(&(Vec3::from(mv.end.xyz()) - a))
+            };
+            let turn = |from: usize, sign: f64| {
+                (from..run.samples.len())
+                    .max_by(|&i, &j| {
+                        let (x, y) = (&run.samples[i].0.tip, &run.samples[j].0.tip);
+                        (sign * along(x)).total_cmp(&(sign * along(y)))
+                    })
+                    .unwrap_or(from)
+            };
+            let deep = turn(0, 1.0);
+            let high = turn(deep, -1.0);
+            for (k, (_, segs)) in run.samples.iter_mut().enumerate() {
+                let on = if k <= deep {
                     0
-                } else if below(start, &mv, &s.tip) {
+                } else if k <= high {
                     1
                 } else {
                     2
@@ -213,12 +214,6 @@ fn tap_points(start: Pose, mv: &SyncedMove, past: f64, back: f64) -> [Pose; 2] {
         }
     }
     [deepest, highest]
-}
-
-/// Whether `p` lies on the hole's side of the tap's start.
-fn below(start: Pose, mv: &SyncedMove, p: &Vec3) -> bool {
-    let a = Vec3::from(start.xyz());
-    (p - a).dot(&(Vec3::from(mv.end.xyz()) - a)) > 0.0
 }
 
 /// The report's `synced`: per move its line, code, pitch and figures.
