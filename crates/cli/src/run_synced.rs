@@ -7,7 +7,7 @@
 
 use miette::Result;
 use tezgah_executor::probe_moves::{part, position_before};
-use tezgah_executor::synced::{run_synced, SyncRun};
+use tezgah_executor::synced::{run_synced, SyncError, SyncRun};
 use tezgah_geom::{FeedMode, Move, MoveKind, PathMode, Pose, SyncedMove, Vec3};
 use tezgah_kinematics::{Joints, Machine};
 use tezgah_motion::plan::PlanOptions;
@@ -51,6 +51,9 @@ pub fn run_synced_moves(
         let stopped = if mv.tap.is_some() { start } else { mv.end };
         let line = keys.plain(m.line);
         if Vec3::from(start.xyz()) == Vec3::from(mv.end.xyz()) {
+            if start != mv.end {
+                return Err(at(&SyncError::NoLinearTravel.to_string()));
+            }
             // Nothing to follow (LinuxCNC's motion finishes such a move at once).
             let run = SyncRun {
                 samples: Vec::new(),

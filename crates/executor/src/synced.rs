@@ -166,6 +166,10 @@ pub fn run_synced(
     if length <= 0.0 {
         return Err(SyncError::NoLinearTravel);
     }
+    // At the spindle's speed the move would outlast the bound: say so before simulating it.
+    if length / (pitch * speed) > MAX_DURATION {
+        return Err(SyncError::Unfinished(MAX_DURATION));
+    }
     let direction = (b - a) / length;
     let (seg, back) = path;
     let path = path_limits(seg, machine, options)?;
