@@ -13,6 +13,7 @@ mod plot;
 mod preview;
 mod run;
 mod run_probe;
+mod run_synced;
 mod serve;
 mod tracking;
 

@@ -244,11 +244,13 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         eprintln!("warning: {w}");
     }
     // The program as the interpreter emitted it (probe moves ending where the machine
-    // stopped), which `verify` measures the samples against.
+    // stopped, synchronised moves as they ran), which `verify` measures the samples against.
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
-    let program = ProgramPath::new(Pose::ZERO, pm.initial, &probed.moves);
+    let synced = crate::run_synced::run_synced_moves(&probed, &machine, tolerance, &options)?;
+    let reference = crate::run_synced::reference_moves(&probed.moves, &synced);
+    let program = ProgramPath::new(Pose::ZERO, pm.initial, &reference);
     let start = Pose::ZERO;
-    let first = crate::run_probe::first_part(&probed, &machine, tolerance)?;
+    let first = crate::run_probe::first_part(&probed, &synced, &machine, tolerance)?;
 
     // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
@@ -346,8 +348,9 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         }
     };
     let mut sink = sink;
-    let (duration, segments, axis) =
-        crate::run_probe::play(&probed, first, &machine, tolerance, &options, &mut sink)?;
+    let (duration, segments, axis) = crate::run_probe::play(
+        &probed, &synced, first, &machine, tolerance, &options, &mut sink,
+    )?;
     let axis = axis.unwrap_or(AxisFigures {
         deviation_deg: 0.0,
         tolerance_deg: 0.0,
@@ -379,6 +382,9 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         if !probed.steps.is_empty() {
             json["probes"] = crate::run_probe::probes_json(&probed);
         }
+        if !synced.is_empty() {
+            json["synced"] = crate::run_synced::synced_json(&synced);
+        }
         crate::library::write_json(p, &json)?;
     }
     if let (Some(dir), Some(t)) = (&args.plot, &trace) {
@@ -404,6 +410,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         tracking_summary(&machine, t);
     }
     crate::run_probe::probe_summary(&probed);
+    crate::run_synced::synced_summary(&synced);
     let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
         || report.deviation_ratio > 1.0
         || tracking.as_ref().is_some_and(|t| t.fault.is_some());

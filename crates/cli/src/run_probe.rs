@@ -22,6 +22,7 @@ use tezgah_motion::Segment;
 
 use crate::diagnostics::report_line;
 use crate::run::{build_path, AxisFigures, BuiltPath};
+use crate::run_synced::SyncStep;
 
 /// One probe move as it ran.
 pub struct ProbeStep {
@@ -127,22 +128,55 @@ pub fn interpret_probing(
     }
 }
 
-/// The path of the part before the first probe (the whole program when it does not probe),
-/// pre-flighted: built before anything is written or moves.
-pub fn first_part(probed: &Probed, machine: &Machine, tolerance: f64) -> Result<BuiltPath> {
-    let to = probed.steps.first().map_or(probed.moves.len(), |s| s.index);
+/// Where the program is cut: a probe move or a synchronised move, its samples as it ran and
+/// where the machine came to rest.
+struct Cut<'a> {
+    index: usize,
+    samples: &'a [Sampled],
+    stopped: Pose,
+}
+
+/// The cuts of the program, in order.
+fn cuts<'a>(probed: &'a Probed, synced: &'a [SyncStep]) -> Vec<Cut<'a>> {
+    let probes = probed.steps.iter().map(|s| Cut {
+        index: s.index,
+        samples: &s.run.samples,
+        stopped: s.stopped,
+    });
+    let synced = synced.iter().map(|s| Cut {
+        index: s.index,
+        samples: &s.run.samples,
+        stopped: s.stopped,
+    });
+    let mut cuts: Vec<Cut> = probes.chain(synced).collect();
+    cuts.sort_by_key(|c| c.index);
+    cuts
+}
+
+/// The path of the part before the first probe or synchronised move (the whole program when
+/// it has none), pre-flighted: built before anything is written or moves.
+pub fn first_part(
+    probed: &Probed,
+    synced: &[SyncStep],
+    machine: &Machine,
+    tolerance: f64,
+) -> Result<BuiltPath> {
+    let to = cuts(probed, synced)
+        .first()
+        .map_or(probed.moves.len(), |c| c.index);
     let (sources, keys) = (&probed.done.sources, &probed.done.keys);
     let moves = part(&probed.moves, 0, to, Pose::ZERO);
     build_path(sources, keys, moves, machine, tolerance, Pose::ZERO)
 }
 
-/// Plays the probed program into `sink`: the parts between probe moves planned and sampled
-/// from rest to rest (the first one is [`first_part`]; each later one is built and
-/// pre-flighted when it is reached), each probe move as it ran; sample times and indices run
-/// on across the parts. Returns the duration, the segments planned and the worst tool-axis
-/// figures.
+/// Plays the probed program into `sink`: the parts between probe and synchronised moves
+/// planned and sampled from rest to rest (the first one is [`first_part`]; each later one is
+/// built and pre-flighted when it is reached), each probe or synchronised move as it ran;
+/// sample times and indices run on across the parts. Returns the duration, the segments
+/// planned and the worst tool-axis figures.
 pub fn play(
     probed: &Probed,
+    synced: &[SyncStep],
     first: BuiltPath,
     machine: &Machine,
     tolerance: f64,
@@ -163,9 +197,9 @@ pub fn play(
     let (mut segments, mut axis) = (0, None::<AxisFigures>);
     let mut from = 0;
     let mut start = Pose::ZERO;
-    let cuts = probed.steps.iter().map(Some).chain([None]);
+    let cuts = cuts(probed, synced);
     let mut first = Some(first);
-    for step in cuts {
+    for step in cuts.iter().map(Some).chain([None]) {
         let to = step.map_or(moves.len(), |s| s.index);
         let built = match first.take() {
             Some(built) => built,
@@ -201,8 +235,13 @@ pub fn play(
         )
         .map_err(|e| miette!("{e}"))?;
         let Some(step) = step else { break };
-        let base = next;
-        for (s, seg) in &step.run.samples {
+        // A probe move's samples start with its row 0 (at rest where the part ended), a
+        // synchronised move's with its first period.
+        let base = match step.samples.first() {
+            Some((s, _)) if s.index > 0 => next - 1,
+            _ => next,
+        };
+        for (s, seg) in step.samples {
             emit(s, seg, &mut next, base);
         }
         segments += 1;

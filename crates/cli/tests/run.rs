@@ -785,3 +785,68 @@ fn the_probing_example_cuts_where_it_found_the_block() {
         );
     }
 }
+
+/// `examples/thread.ngc`: a G33 thread (K1.5 at 600 rev/min) and a G33.1 rigid tap (K1 at
+/// 300 rev/min, I2) on mill3's default spindle (50 rev/s²). The thread holds its lead within
+/// the synchronisation error it reports; the tap overshoots its depth by what the spindle turns
+/// while it reverses, ω²/2α = 0.25 rev × K, to within that error; the run stays within every
+/// joint limit and within the tolerance of the program (the tap's turning points included).
+#[test]
+fn threading_and_rigid_tapping_follow_the_simulated_spindle() {
+    let program = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/thread.ngc");
+    let json = tmp("thread.json");
+    let out = tezgah()
+        .args(["run", program, "--report"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("sync     G33 line 7: lead 1.50000 mm/rev"),
+        "{stdout}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let synced = &report["synced"];
+    let f = |k: usize, key: &str| synced[k][key].as_f64().unwrap();
+    // The thread: 21 mm at 1.5 mm/rev.
+    let turns = 21.0 / 1.5;
+    assert!((f(0, "lead_mm") - 1.5).abs() * turns <= 2.0 * f(0, "sync_error_mm") + 1e-9);
+    assert!(f(0, "sync_error_mm") < 1e-3);
+    assert_eq!(synced[1]["code"], "G33.1");
+    let closed = 1.0 * 5.0 * 5.0 / (2.0 * 50.0);
+    let overshoot = f(1, "overshoot_mm");
+    assert!(
+        (overshoot - closed).abs() <= f(1, "sync_error_mm") + 5e-3,
+        "{overshoot} vs {closed}"
+    );
+    assert!(
+        report["max_deviation_mm"].as_f64().unwrap() <= 0.01,
+        "{report}"
+    );
+}
+
+/// `check --machine` cannot play a synchronised move and says so at its line.
+#[test]
+fn check_with_a_machine_names_the_g33_line() {
+    let ngc = tmp("g33-check.ngc");
+    std::fs::write(&ngc, "G21 G90\nM3 S600\nG33 Z-5 K1\nM2\n").unwrap();
+    let out = tezgah()
+        .args(["check", "--machine", "mill3"])
+        .arg(&ngc)
+        .output()
+        .unwrap();
+    let text =
+        String::from_utf8_lossy(&out.stderr).to_string() + &String::from_utf8_lossy(&out.stdout);
+    assert!(
+        !out.status.success()
+            && text.contains("3:1")
+            && text.contains("G33/G33.1 follow the spindle"),
+        "{text}"
+    );
+}

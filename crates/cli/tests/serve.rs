@@ -475,3 +475,46 @@ fn serve_reports_the_tool_axis_on_a_machine_with_rotary_joints() {
     let s = wait_for(&mut ws, |_| true);
     assert!(s.get("tool_axis").is_none(), "{s}");
 }
+
+/// A program that probes, on mill3 with a plane in its machine file's `[probe]`: the status
+/// stream reports the probe (fitted, the input, the last probe move's trip), and the move after
+/// the probe lands at the probed height.
+#[test]
+fn serve_probes_on_the_machine_files_probe_and_reports_it() {
+    let dir = std::env::temp_dir().join(format!("tezgah-serve-probe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let machine = dir.join("mill3-probe.toml");
+    let mill3 = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../machines/mill3.toml"),
+    )
+    .unwrap();
+    let probe = "\n[probe]\ntool_radius_mm = 1.0\n[[probe.plane]]\npoint = [0, 0, -4]\n\
+                 normal = [0, 0, 1]\n";
+    std::fs::write(&machine, mill3 + probe).unwrap();
+    let (_server, mut ws) = start_with(&["--machine", machine.to_str().unwrap()]);
+    let first = wait_for(&mut ws, |_| true);
+    assert_eq!(first["probe"]["fitted"], true, "{first}");
+    let program = "G21 G90\nG0 X3 Z2\nG38.2 Z-10 F600\nG0 X6 Z[#5063 + 0.5]\nM2\n";
+    let r = request(
+        &mut ws,
+        json!({"id": 1, "command": "load", "program": program}),
+    );
+    assert_eq!(r["ok"], true, "{r}");
+    let r = request(&mut ws, json!({"id": 2, "command": "cycle_start"}));
+    assert_eq!(r["ok"], true, "{r}");
+    let touching = wait_for(&mut ws, |s| s["probe"]["input"] == true);
+    assert_eq!(touching["probe"]["probing"], true, "{touching}");
+    let end = wait_for(&mut ws, |s| state(s) == "idle" && tip(s)[0] == 6.0);
+    let last = &end["probe"]["last"];
+    assert_eq!(
+        (&last["code"], &last["tripped"]),
+        (&json!("G38.2"), &json!(true))
+    );
+    let z = last["trip_mm"][2].as_f64().unwrap();
+    // Contact at z = -4 + 1; at most one period's travel (10 mm/s × 1 ms) past it.
+    assert!(z <= -3.0 && z > -3.0 - 0.01 - 1e-12, "trip {z}");
+    assert!((tip(&end)[2] - (z + 0.5)).abs() < 1e-9, "{end}");
+    assert_eq!(end["probe"]["input"], false);
+    assert!(end["error"].is_null(), "{end}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -148,6 +148,37 @@ pub struct Status {
     /// or `%` (`program:line:col: …; run as if it ended with M2`).
     #[serde(default)]
     pub warning: Option<String>,
+    /// The simulated probe (machine file `[probe]`): its input now and the last probe move.
+    #[serde(default)]
+    pub probe: ProbeStatus,
+}
+
+/// The probe as a front end shows it (all false / none on a machine without a probe).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ProbeStatus {
+    /// The machine has a (simulated) probe.
+    pub fitted: bool,
+    /// The probe input at the tool where it stands: in contact.
+    pub input: bool,
+    /// A probe move (G38.2–G38.5) is in hand.
+    pub probing: bool,
+    /// The last probe move's answer.
+    pub last: Option<ProbeReport>,
+}
+
+/// How one probe move ended.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProbeReport {
+    /// `G38.2` … `G38.5`.
+    pub code: String,
+    /// Its source line.
+    pub line: u32,
+    /// Whether the input changed on the way.
+    pub tripped: bool,
+    /// Where it changed: the tool tip, workpiece frame, mm.
+    pub trip_mm: Option<[f64; 3]>,
+    /// Where the machine came to rest (the moves' coordinates: X Y Z mm, A B C degrees).
+    pub stopped: [f64; 6],
 }
 
 /// The modal state and offsets the DRO shows (those of the MDI interpreter: zero-set by

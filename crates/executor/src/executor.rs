@@ -12,13 +12,13 @@ use tezgah_gcode::interp::SubroutineLibrary;
 use tezgah_geom::{Move, MoveKind, Pose, StopKind, Vec3};
 use tezgah_kinematics::{Joints, Machine, TcpSwitch};
 use tezgah_motion::cursor::{CursorPose, PieceCursor};
-use tezgah_motion::path::smooth::SmoothOptions;
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned};
+use tezgah_motion::prepare::{plan_options, prepare_from, PrepareError};
 use tezgah_motion::{Junction, Limits, Segment};
 
-use crate::command::{Command, Mode, PauseReason, RunState, Status};
+use crate::command::{Command, Mode, PauseReason, ProbeReport, ProbeStatus, RunState, Status};
 use crate::error::ExecError;
-use crate::job::{BuiltPath, Job, JobOptions, PlannedItem};
+use crate::job::{self, BuiltPath, Job, PlannedItem};
 use crate::manual::active::ManualMotion;
 use crate::manual::{HomeSwitches, SimulatedSwitches};
 use crate::mdi::Mdi;
@@ -30,6 +30,7 @@ use crate::speed_override::Override;
 
 mod hold;
 mod manual;
+mod probing;
 
 /// One produced period: the set-point and, for checks and displays, where the tip is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,33 +47,29 @@ pub struct Produced {
     pub path: f64,
 }
 
-/// Settings of the executor.
+/// Settings of the executor: the machine file's period and tolerance. The path and the plan
+/// are made from them by motion's one entry point ([`tezgah_motion::prepare`]), as `tezgah
+/// run` makes them, so the executor follows the path `run` plans.
 #[derive(Debug, Clone)]
 pub struct ExecOptions {
     pub period: f64,
-    pub smooth: SmoothOptions,
-    pub plan: PlanOptions,
+    /// Path tolerance, mm (shared between smoothing and chord error by `prepare`).
+    pub tolerance: f64,
 }
 
 impl ExecOptions {
-    /// The machine file's period, tolerance and `[path]` settings, and `tezgah run`'s
-    /// tolerance split: the executor follows the path `tezgah run` plans.
+    /// The machine file's period and tolerance.
     pub fn for_machine(machine: &Machine) -> Result<ExecOptions, ExecError> {
-        let period = machine.motion.period_s;
-        let pm = PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
+        PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
         Ok(ExecOptions {
-            period,
-            smooth: SmoothOptions::for_machine(
-                &machine.path,
-                &pm,
-                machine.motion.tolerance_mm,
-                Pose::ZERO,
-            ),
-            plan: PlanOptions {
-                period,
-                ..PlanOptions::default()
-            },
+            period: machine.motion.period_s,
+            tolerance: machine.motion.tolerance_mm,
         })
+    }
+
+    /// The planner's options at this period ([`tezgah_motion::prepare::plan_options`]).
+    pub fn plan(&self) -> PlanOptions {
+        plan_options(self.period)
     }
 }
 
@@ -155,6 +152,18 @@ pub struct Executor {
     switches: Box<dyn HomeSwitches + Send>,
     /// The loaded program's path, built and pre-flighted at load, until a job takes it.
     built: Option<BuiltPath>,
+    /// The simulated probe G38 moves touch (machine file `[probe]`), if any.
+    probe_model: Option<tezgah_kinematics::probe::ProbeModel>,
+    /// The tool (its length in force) where the probe input is read.
+    probe_tool: tezgah_motion::tool_pose::SampleTool,
+    /// The probe input at the last set-point: in contact.
+    probe_input: bool,
+    probe_last: Option<ProbeReport>,
+    /// A program that probes, running part by part.
+    live: Option<probing::LiveProbe>,
+    /// The loaded program's text and the configuration it was read with (a program that
+    /// probes is read again after each answer).
+    text: Option<(String, tezgah_gcode::Config)>,
 }
 
 fn sub(a: &Joints, b: &Joints, scale: f64) -> Joints {
@@ -188,10 +197,16 @@ impl Executor {
         let gcode = tezgah_gcode::Config {
             tool_centre_point_always: machine.tcp == TcpSwitch::Always,
             axes: tezgah_gcode::AxisMask::of(machine.program_axes()),
+            // With a probe, the interpreter stops at each probe move for the machine's answer.
+            probe: match machine.probe {
+                Some(_) => tezgah_gcode::ProbeModel::Answered(Arc::from([])),
+                None => tezgah_gcode::ProbeModel::Unavailable,
+            },
             ..tezgah_gcode::Config::default()
         };
         let n = pm.joint_count();
         let switches = SimulatedSwitches::new(machine, &Joints::zeros(n))?;
+        let probe_tool = tezgah_motion::tool_pose::SampleTool::new(&pm);
         Ok(Executor {
             machine: pm,
             machine_file: machine.clone(),
@@ -202,6 +217,12 @@ impl Executor {
             homed: false,
             switches: Box::new(switches),
             built: None,
+            probe_model: machine.probe.clone(),
+            probe_tool,
+            probe_input: false,
+            probe_last: None,
+            live: None,
+            text: None,
             options,
             mdi: Mdi::new(gcode.clone()),
             mdi_modal: Vec::new(),
@@ -329,6 +350,12 @@ impl Executor {
                 .mdi
                 .work([self.pose.tip.x, self.pose.tip.y, self.pose.tip.z]),
             warning: self.warning.clone(),
+            probe: ProbeStatus {
+                fitted: self.probe_model.is_some(),
+                input: self.probe_input,
+                probing: self.live.as_ref().is_some_and(|l| l.probing()),
+                last: self.probe_last.clone(),
+            },
         }
     }
 
@@ -356,14 +383,6 @@ impl Executor {
         }
     }
 
-    fn job_options(&self) -> JobOptions {
-        JobOptions {
-            smooth: self.options.smooth.clone(),
-            plan: self.options.plan,
-            single_block: self.single_block,
-        }
-    }
-
     /// The tool's pose in the coordinates of the moves (mm, degrees).
     fn program_pose(&self) -> Pose {
         let p = &self.pose;
@@ -377,8 +396,8 @@ impl Executor {
         )
     }
 
-    /// Builds the whole path of `moves` from `start` with the executor's smoothing options
-    /// and checks every segment's joints against reach and limits (motion's pre-flight), so
+    /// Builds the whole path of `moves` from `start` and checks every segment's joints
+    /// against reach and limits from where the joints stand (motion's [`prepare_from`]), so
     /// a program that would leave the machine's work space is refused before anything moves;
     /// the job then plans that same path. Errors name the place `origins` gives the moves'
     /// lines; the path returned carries plain line numbers.
@@ -388,14 +407,21 @@ impl Executor {
         start: Pose,
         origins: &Origins,
     ) -> Result<BuiltPath, ExecError> {
-        let mut path = BuiltPath::build(moves, &self.machine, &self.job_options(), start).map_err(
-            |e| match e {
-                ExecError::Path(e) => origins.path_error(e),
-                other => other,
-            },
-        )?;
-        tezgah_motion::preflight::check_path(path.items(), &self.machine, self.pose.joints)
-            .map_err(|e| origins.preflight_error(&e))?;
+        let (moves, stops) = job::exact_stops(moves, self.single_block);
+        let prepared = prepare_from(
+            moves,
+            &self.machine_file,
+            self.options.tolerance,
+            start,
+            Some(self.pose.joints),
+        )
+        .map_err(|e| match e {
+            PrepareError::Path(e) => origins.path_error(e),
+            PrepareError::Preflight(e) => origins.preflight_error(&e),
+            PrepareError::Machine(e) => ExecError::Plan(e),
+            PrepareError::Start(e) => ExecError::Machine(format!("the start pose: {e}")),
+        })?;
+        let mut path = BuiltPath::new(prepared, stops, self.single_block);
         path.plain_lines(origins.keys());
         Ok(path)
     }
@@ -426,7 +452,7 @@ impl Executor {
             Some(b) => b,
             None => self.preflight(moves, start, origins)?,
         };
-        let job = Job::new(built, &self.machine, self.options.plan, self.pose.joints)?;
+        let job = Job::new(built, &self.machine, self.options.plan(), self.pose.joints)?;
         self.job = Some(job);
         self.current = None;
         self.peeked = None;
@@ -453,11 +479,15 @@ impl Executor {
                     return Err(self.busy("load"));
                 }
                 let config = self.mdi.program_config(&self.gcode);
-                let program = Program::interpret(program, &config)?;
+                let text = program;
+                let program = Program::interpret(text.clone(), &config)?;
                 self.warning = (!program.warnings.is_empty()).then(|| program.warnings.join("\n"));
                 let here = self.program_pose();
-                self.built = Some(self.preflight(program.moves.clone(), here, &program.origins)?);
+                // A program that probes: its part before the first probe move.
+                let first = program.moves[..probing::first_cut(&program)].to_vec();
+                self.built = Some(self.preflight(first, here, &program.origins)?);
                 self.program = Some(program);
+                self.text = Some((text, config));
                 self.mode = Mode::Auto;
                 Ok(())
             }
@@ -465,7 +495,9 @@ impl Executor {
                 RunState::Idle => {
                     self.check_homed("cycle start")?;
                     let program = self.program.clone().ok_or(ExecError::NoProgram)?;
-                    self.start_job(program.moves, Mode::Auto, &program.origins)
+                    let (text, config) = self.text.clone().unwrap_or_default();
+                    let source = probing::Source::Program { text, config };
+                    self.start_program(program, Mode::Auto, source)
                 }
                 RunState::Held | RunState::Paused { .. } | RunState::Holding => {
                     self.state = RunState::Running;
@@ -519,7 +551,7 @@ impl Executor {
                     self.mdi.sync(&here)?;
                     self.mdi_at = here;
                 }
-                let moves = self.mdi.block(&block)?;
+                let (moves, awaits) = self.mdi.block(&block)?;
                 if let Some(end) = moves.iter().rev().find_map(|m| move_end(&m.kind)) {
                     self.mdi_at = end;
                 }
@@ -535,7 +567,13 @@ impl Executor {
                 }
                 // A block the pre-flight refuses leaves the modal moves as they were (the
                 // interpreter's position is re-synchronised before the next block anyway).
-                self.start_job(job, Mode::Mdi, &Origins::mdi(&block))?;
+                let program = Program {
+                    moves: job,
+                    origins: Arc::new(Origins::mdi(&block)),
+                    warnings: Vec::new(),
+                    awaits,
+                };
+                self.start_program(program, Mode::Mdi, probing::Source::Mdi)?;
                 self.mdi_modal = modal;
                 Ok(())
             }
@@ -545,6 +583,13 @@ impl Executor {
                 }
                 self.check_homed("restart")?;
                 let program = self.program.as_ref().ok_or(ExecError::NoProgram)?;
+                if let Some(code) = &program.awaits {
+                    // Where each probe stopped is known only by running the program from its
+                    // start.
+                    return Err(ExecError::Gcode(format!(
+                        "a program that probes (G{code}) runs from its start only"
+                    )));
+                }
                 let moves = restart_moves(&program.moves, line)?;
                 let origins = Arc::clone(&program.origins);
                 // A restart starts elsewhere than the program: built and checked whole.
@@ -577,6 +622,7 @@ impl Executor {
         self.manual = None;
         self.last_manual = None;
         self.hold = None;
+        self.live = None;
         self.state = RunState::Idle;
         self.scale = TimeScale::held();
     }
@@ -609,6 +655,8 @@ impl Executor {
     /// override (M49, `M50 P0`, tapping).
     fn target(&self, factor: f64, overridable: bool) -> f64 {
         match self.state {
+            // The probe tripped: the time scale brakes where the path stop could not start.
+            RunState::Running if self.probe_stopping() => 0.0,
             // Above 1 only as far as the pieces' overspeed limits allow (the time scale caps it).
             RunState::Running if overridable => self.override_pct / 100.0 / factor,
             // Its feeds were planned as programmed (`Job` applies no factor to them).
@@ -649,15 +697,20 @@ impl Executor {
         if self.passed.len() > 1 {
             self.passed.drain(..self.passed.len() - 1);
         }
+        // A probe that tripped and came to rest answers; the program goes on from there.
+        if self.probe_at_rest() && self.state != RunState::Aborting {
+            return self.next_part();
+        }
         if self.current.is_none() {
             if let Some(ev) = self.fetch()? {
-                return Ok(self.finish_event(ev));
+                return self.finish(ev);
             }
         }
-        // A hold stops along the path where it can (a stop begun runs to its end).
-        if self.hold.is_some()
-            || (matches!(self.state, RunState::Holding | RunState::Aborting) && self.begin_hold())
-        {
+        // A hold (or a probe's trip) stops along the path where it can (a stop begun runs to
+        // its end).
+        let stopping =
+            matches!(self.state, RunState::Holding | RunState::Aborting) || self.probe_stopping();
+        if self.hold.is_some() || (stopping && self.begin_hold()) {
             return self.step_hold();
         }
         // The time scale moves with the plan's state where the tool is.
@@ -741,7 +794,7 @@ impl Executor {
             self.sample()?;
             return Ok(Some(self.emit(false, feed)));
         }
-        Ok(self.finish_event(event))
+        self.finish(event)
     }
 
     fn finish_event(&mut self, event: Event) -> Option<Produced> {
@@ -858,7 +911,7 @@ impl Executor {
     /// piece, when it is peeked or taken, so an override raised later reaches it too.
     fn fast_limits(&self, piece: &tezgah_motion::plan::Piece) -> Option<Limits> {
         overridable(piece)
-            .then(|| overspeed_limits(piece, &self.machine, &self.options.plan))
+            .then(|| overspeed_limits(piece, &self.machine, &self.options.plan()))
             .flatten()
     }
 
@@ -925,6 +978,7 @@ impl Executor {
     /// `setpoint` produced at path speed `feed`: the counter moves on; where the tool is goes
     /// with it.
     fn produced(&mut self, setpoint: SetPoint, feed: f64) -> Produced {
+        self.read_probe();
         self.k += 1;
         Produced {
             setpoint,

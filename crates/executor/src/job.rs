@@ -11,8 +11,8 @@ use std::collections::{HashMap, VecDeque};
 use tezgah_gcode::sources::LineKeys;
 use tezgah_geom::{Move, MoveKind, PathMode, Pose, StopKind, Vec3};
 use tezgah_kinematics::Joints;
-use tezgah_motion::path::smooth::SmoothOptions;
 use tezgah_motion::plan::{PlanMachine, PlanOptions, Planned, Planner};
+use tezgah_motion::prepare::Prepared;
 use tezgah_motion::takeup::TakeUp;
 use tezgah_motion::{PathItem, SegmentFeed};
 
@@ -24,9 +24,10 @@ pub struct PlannedItem {
     pub factor: f64,
 }
 
-/// Moves made into the whole smooth path from a start pose, and the kinds of their stops.
-/// The executor loads whole programs, so the path is held whole: built once, checked by the
-/// pre-flight, then handed to the [`Job`] that plans it (`tezgah run` streams instead).
+/// Moves made into the whole smooth path from a start pose ([`tezgah_motion::prepare`]), and
+/// the kinds of their stops. The executor loads whole programs, so the path is held whole:
+/// built once, checked by the pre-flight, then handed to the [`Job`] that plans it (`tezgah
+/// run` streams instead).
 pub struct BuiltPath {
     items: Vec<PathItem>,
     stops: HashMap<u32, StopKind>,
@@ -34,48 +35,44 @@ pub struct BuiltPath {
     single_block: bool,
 }
 
+/// The kinds of the program's stops by line, and under single block (`single_block`) the
+/// moves in exact-stop mode throughout, so that every block ends at rest.
+pub fn exact_stops(
+    mut moves: Vec<Move>,
+    single_block: bool,
+) -> (Vec<Move>, HashMap<u32, StopKind>) {
+    let mut stops = HashMap::new();
+    for m in &mut moves {
+        if let MoveKind::Stop(kind) = m.kind {
+            stops.insert(m.line, kind);
+        }
+        if single_block {
+            if let MoveKind::PathMode(mode) = &mut m.kind {
+                *mode = PathMode::ExactStop;
+            }
+        }
+    }
+    if single_block {
+        moves.insert(
+            0,
+            Move {
+                line: moves.first().map_or(0, |m| m.line),
+                kind: MoveKind::PathMode(PathMode::ExactStop),
+            },
+        );
+    }
+    (moves, stops)
+}
+
 impl BuiltPath {
-    /// The path of `moves` from `start` on `machine` with `options` (under single block every
-    /// block ends at rest: the path is built in exact-stop mode).
-    pub fn build(
-        moves: Vec<Move>,
-        machine: &PlanMachine,
-        options: &JobOptions,
-        start: Pose,
-    ) -> Result<BuiltPath, ExecError> {
-        let mut stops = HashMap::new();
-        let mut moves = moves;
-        for m in &mut moves {
-            if let MoveKind::Stop(kind) = m.kind {
-                stops.insert(m.line, kind);
-            }
-            if options.single_block {
-                if let MoveKind::PathMode(mode) = &mut m.kind {
-                    *mode = PathMode::ExactStop;
-                }
-            }
-        }
-        if options.single_block {
-            moves.insert(
-                0,
-                Move {
-                    line: moves.first().map_or(0, |m| m.line),
-                    kind: MoveKind::PathMode(PathMode::ExactStop),
-                },
-            );
-        }
-        let smooth = SmoothOptions {
-            start,
-            control: machine.initial,
-            ..options.smooth.clone()
-        };
-        let items = tezgah_motion::path::smooth::build(moves, &smooth).map_err(ExecError::Path)?;
-        Ok(BuiltPath {
-            items,
+    /// The prepared path, the kinds of its stops, and whether it was built for single block.
+    pub fn new(prepared: Prepared, stops: HashMap<u32, StopKind>, single_block: bool) -> BuiltPath {
+        BuiltPath {
+            items: prepared.items,
             stops,
-            start,
-            single_block: options.single_block,
-        })
+            start: prepared.start,
+            single_block,
+        }
     }
 
     pub fn items(&self) -> &[PathItem] {
@@ -121,15 +118,6 @@ pub struct Job {
     pushed: f64,
     popped: f64,
     stops: HashMap<u32, StopKind>,
-}
-
-/// How a job is built.
-#[derive(Debug, Clone)]
-pub struct JobOptions {
-    pub smooth: SmoothOptions,
-    pub plan: PlanOptions,
-    /// Stop at the end of every block (single block): the path is built in exact-stop mode.
-    pub single_block: bool,
 }
 
 impl Job {

@@ -24,6 +24,7 @@ pub mod scale;
 pub mod setpoint;
 pub mod speed_override;
 pub mod stop;
+pub mod synced;
 pub mod threads;
 
 pub use drive::{Drive, DriveFault, DriveStatus};

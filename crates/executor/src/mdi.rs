@@ -5,7 +5,7 @@ use std::sync::mpsc;
 
 use tezgah_gcode::interp::{line_at, LinePos};
 use tezgah_gcode::params::ParameterFile;
-use tezgah_gcode::{Config, Interpreter, MoveBuilder, Units};
+use tezgah_gcode::{Config, ErrorKind, Interpreter, MoveBuilder, ProbeOutcome, Units};
 use tezgah_geom::{Move, Plane, Pose};
 
 use crate::command::WorkState;
@@ -21,6 +21,8 @@ pub struct Mdi {
     moves: mpsc::Receiver<Move>,
     /// The machine's program axes: the words `sync` may write.
     axes: tezgah_gcode::AxisMask,
+    /// Where the last block's probe move waits for its answer (for the answer's errors).
+    probe_at: Option<tezgah_gcode::Span>,
 }
 
 impl Mdi {
@@ -42,6 +44,7 @@ impl Mdi {
             builder,
             moves: rx,
             axes,
+            probe_at: None,
         };
         while mdi.moves.try_recv().is_ok() {}
         mdi
@@ -73,8 +76,6 @@ impl Mdi {
         Ok(())
     }
 
-    /// The moves of one block (line number 1). An error leaves the modal state as the
-    /// interpreter leaves it after a failed block.
     /// `config` with the offsets MDI has set (G10, G92, G28.1/G30.1: the parameters LinuxCNC
     /// keeps between runs, #5161–#5390) in place of the ones it started with, so a program
     /// loaded after a zero-set runs in the zeroed frame.
@@ -139,22 +140,50 @@ impl Mdi {
         }
     }
 
-    pub fn block(&mut self, text: &str) -> Result<Vec<Move>, ExecError> {
+    /// The machine's answer to the probe move the last block ended with ([`Mdi::block`]'s
+    /// code): `#5061`… and the position set, or LinuxCNC's error at the block's G38 word.
+    pub fn answer(&mut self, outcome: ProbeOutcome) -> Result<(), ExecError> {
+        let span = self.probe_at.take().unwrap_or_default();
+        self.interp
+            .answer_probe(outcome)
+            .map(|_| ())
+            .map_err(|kind| ExecError::At {
+                at: tezgah_gcode::sources::Located {
+                    file: "MDI".into(),
+                    span,
+                },
+                message: kind.to_string(),
+            })
+    }
+
+    /// The moves of one block (line number 1), and the G-code (`38.2` …) of a probe move they
+    /// end with that waits for the machine's answer ([`Mdi::answer`]). An error leaves the
+    /// modal state as the interpreter leaves it after a failed block.
+    pub fn block(&mut self, text: &str) -> Result<(Vec<Move>, Option<String>), ExecError> {
         if text.contains('\n') {
             return Err(ExecError::Gcode("an MDI block is one line".into()));
         }
         let line = line_at(text, LinePos::FIRST)
             .ok_or_else(|| ExecError::Gcode("empty MDI block".into()))?;
         // Placed as every interpreter error is: `MDI:1:col`.
-        self.interp
-            .execute_line(line, &mut self.builder)
-            .map_err(|e| ExecError::At {
-                at: tezgah_gcode::sources::Located {
-                    file: "MDI".into(),
-                    span: e.span,
-                },
-                message: e.kind.to_string(),
-            })?;
-        Ok(self.moves.try_iter().collect())
+        let awaits = match self.interp.execute_line(line, &mut self.builder) {
+            Ok(_) => None,
+            Err(e) => match e.kind {
+                ErrorKind::ProbeAwaitsAnswer(code) => {
+                    self.probe_at = Some(e.span);
+                    Some(code)
+                }
+                kind => {
+                    return Err(ExecError::At {
+                        at: tezgah_gcode::sources::Located {
+                            file: "MDI".into(),
+                            span: e.span,
+                        },
+                        message: kind.to_string(),
+                    })
+                }
+            },
+        };
+        Ok((self.moves.try_iter().collect(), awaits))
     }
 }

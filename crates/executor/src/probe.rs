@@ -41,7 +41,7 @@ impl Seek {
     }
 
     /// Whether the input with the ball at `p` is what the move waits for.
-    fn found(self, model: &ProbeModel, p: &Vec3) -> bool {
+    pub fn found(self, model: &ProbeModel, p: &Vec3) -> bool {
         model.touches(p) == (self == Seek::Contact)
     }
 }

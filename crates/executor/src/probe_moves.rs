@@ -3,7 +3,7 @@
 //! a part of their own from rest, with the settings (feed, modes, tool control) the moves
 //! before them made. `tezgah run` cuts and joins its parts with these.
 
-use tezgah_geom::{Move, MoveKind, Pose};
+use tezgah_geom::{Move, MoveKind, Pose, Vec3};
 
 /// The moves `[from, to)` preceded by the settings the moves before them made (feed, modes,
 /// tool control), the tool-control switches among those placed at `start`.
@@ -34,6 +34,8 @@ pub fn position_before(moves: &[Move], index: usize) -> Pose {
             MoveKind::Arc(a) => Some(a.end),
             MoveKind::Nurbs(n) => Some(n.end),
             MoveKind::ToolControl { at, .. } => Some(*at),
+            // A thread ends at its end; a rigid tap comes back to where it started.
+            MoveKind::Synced(s) if s.tap.is_none() => Some(s.end),
             _ => None,
         })
         .unwrap_or(Pose::ZERO)
@@ -70,6 +72,15 @@ pub fn point_at(a: Pose, b: Pose, f: f64) -> Pose {
         p.0[i] += f * (b.0[i] - a.0[i]);
     }
     p
+}
+
+/// Where `p` lies along the straight move from `a` to `b` in X Y Z, as a fraction of it (the
+/// interpreter's measure of a probe answer); `None` for a move without X Y Z travel.
+pub fn fraction_along(a: Pose, b: Pose, p: Vec3) -> Option<f64> {
+    let (a, b) = (Vec3::from(a.xyz()), Vec3::from(b.xyz()));
+    let d = b - a;
+    let length2 = d.norm_squared();
+    (length2 > 0.0).then(|| (p - a).dot(&d) / length2)
 }
 
 #[cfg(test)]

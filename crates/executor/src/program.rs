@@ -5,6 +5,7 @@
 
 use std::sync::Arc;
 
+use tezgah_gcode::error::ErrorKind;
 use tezgah_gcode::sources::{self, LineKeys, Located, Pass, Sources};
 use tezgah_gcode::{canon::Discard, Config};
 use tezgah_geom::Move;
@@ -71,11 +72,15 @@ pub struct Program {
     pub origins: Arc<Origins>,
     /// The interpretation's warnings (a missing program end, run as M2).
     pub warnings: Vec<String>,
+    /// The G-code (`38.2` …) of the probe move the pass stopped at, waiting for the machine's
+    /// answer (`config.probe` is `Answered`): the moves end with that probe move.
+    pub awaits: Option<String>,
 }
 
 impl Program {
     /// Interprets `text` as a controller does (stopping at the first error, which names its
-    /// file, line and column); subroutine files come from `config`'s library.
+    /// file, line and column); subroutine files come from `config`'s library. A probe move
+    /// without an answer ends the moves there ([`Program::awaits`]).
     pub fn interpret(text: String, config: &Config) -> Result<Program, ExecError> {
         let library = config.subroutines.clone();
         let done = sources::interpret(
@@ -85,7 +90,11 @@ impl Program {
             |name| library.as_ref().and_then(|l| l.path(name)),
             &mut Discard,
         );
-        if let Some(e) = done.errors.first() {
+        let awaits = match done.errors.first().map(|e| &e.kind) {
+            Some(ErrorKind::ProbeAwaitsAnswer(code)) => Some(code.clone()),
+            _ => None,
+        };
+        if let Some(e) = done.errors.first().filter(|_| awaits.is_none()) {
             let error = done.sources.error_at(e);
             return Err(ExecError::At {
                 at: error.at,
@@ -93,6 +102,7 @@ impl Program {
             });
         }
         Ok(Program {
+            awaits,
             warnings: done.warnings,
             moves: done.moves,
             origins: Arc::new(Origins {

@@ -108,6 +108,21 @@ pub enum Canon {
     StraightProbe(Pose),
     TurnProbeOn,
     TurnProbeOff,
+    /// G33/G33.1: the moves up to `StopSpeedFeedSync` follow the spindle's angle, advancing
+    /// `feed_per_rev` (program units) per revolution (LinuxCNC's `START_SPEED_FEED_SYNCH` in
+    /// position mode).
+    StartSpeedFeedSync {
+        feed_per_rev: f64,
+    },
+    StopSpeedFeedSync,
+    /// G33.1: tap to X Y Z following the spindle, reverse it at depth and come back to the start
+    /// (LinuxCNC's `RIGID_TAP`); the current point does not change.
+    /// `end` is X Y Z of the bottom with the current A B C; `retract_scale` the spindle speed
+    /// factor for the way back (the I word, 1 without it; `rs274` does not print it).
+    RigidTap {
+        end: Pose,
+        retract_scale: f64,
+    },
     ArcFeed {
         first_end: f64,
         second_end: f64,
@@ -244,6 +259,14 @@ impl fmt::Display for Canon {
             StraightProbe(p) => write!(f, "STRAIGHT_PROBE({})", Six(p)),
             TurnProbeOn => f.write_str("TURN_PROBE_ON()"),
             TurnProbeOff => f.write_str("TURN_PROBE_OFF()"),
+            StartSpeedFeedSync { feed_per_rev } => {
+                write!(f, "START_SPEED_FEED_SYNC({feed_per_rev:.6},0)")
+            }
+            StopSpeedFeedSync => f.write_str("STOP_SPEED_FEED_SYNCH()"),
+            RigidTap { end, .. } => {
+                let [x, y, z] = [end.0[0], end.0[1], end.0[2]];
+                write!(f, "RIGID_TAP({x:.4}, {y:.4}, {z:.4})")
+            }
             ArcFeed {
                 first_end,
                 second_end,
@@ -343,6 +366,9 @@ impl Canon {
             Canon::StraightTraverse(_)
                 | Canon::StraightFeed(_)
                 | Canon::StraightProbe(_)
+                | Canon::StartSpeedFeedSync { .. }
+                | Canon::StopSpeedFeedSync
+                | Canon::RigidTap { .. }
                 | Canon::ArcFeed { .. }
                 | Canon::NurbsFeed(_)
                 | Canon::Dwell(_)

@@ -386,8 +386,8 @@ pub enum ErrorKind {
     ProbeStartAtTarget,
     /// tezgah's own: no probe to answer (`Config::probe`).
     #[error(
-        "G{0} probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
-         --probe); check, serve and MDI do not probe yet"
+        "G{0} probing needs a probe: a machine file's [probe] (`tezgah run`, `serve`, MDI) or \
+         `tezgah run --probe`; `check` does not probe"
     )]
     ProbeUnavailable(String),
     /// tezgah's own: a pass driven by the executor reached a probe move it has no answer for
@@ -403,6 +403,17 @@ pub enum ErrorKind {
     ProbeAlreadyTripped,
     #[error("Probe is already clear when starting G38.4 or G38.5 move")]
     ProbeAlreadyClear,
+    // --- spindle-synchronised motion (G33, G33.1) ---
+    #[error("K word missing with g33/g33.1")]
+    SyncMissingK,
+    #[error("F word used with a g33/g33.1")]
+    SyncWithF,
+    /// `Spindle not turning in G33` / `… G33.1`.
+    #[error("Spindle not turning in {0}")]
+    SyncSpindleStopped(&'static str),
+    /// tezgah's own: LinuxCNC sends the compensated moves without synchronisation.
+    #[error("G33/G33.1 with cutter radius compensation is not supported")]
+    SyncWithComp,
     // --- polar coordinates (`@` radius, `^` angle) ---
     #[error("Cannot use polar coordinate except in G17 plane")]
     PolarNotXyPlane,

@@ -12,8 +12,8 @@
 use std::sync::Arc;
 
 use tezgah_geom::{
-    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, Pose, StopKind, ToolControl,
-    Vec3,
+    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, Pose, StopKind, SyncedMove,
+    ToolControl, Vec3,
 };
 
 use crate::canon::{Canon, CanonSink, ControlMode, NurbsFeed, Origin, Units};
@@ -40,6 +40,8 @@ pub struct MoveBuilder<F: FnMut(Move)> {
     /// The current point without the tool offset (`g5x + R(p + g92)`, mm): where the next
     /// move starts, in the coordinates of TCP; the tool is added to it with TCP off.
     tipless: Pose,
+    /// G33/G33.1 in force: mm per spindle revolution.
+    synced: Option<f64>,
 }
 
 impl<F: FnMut(Move)> MoveBuilder<F> {
@@ -57,6 +59,7 @@ impl<F: FnMut(Move)> MoveBuilder<F> {
             announced: false,
             length_pending: None,
             tipless: Pose::ZERO,
+            synced: None,
         }
     }
 
@@ -169,6 +172,37 @@ impl<F: FnMut(Move)> CanonSink for MoveBuilder<F> {
             // A probe move is a feed toward its target; the machine stops short of it where
             // the probe trips, and whoever drives the run knows where (the program's next move
             // starts from there).
+            Canon::StartSpeedFeedSync { feed_per_rev } => {
+                self.synced = Some(feed_per_rev * self.units.mm());
+            }
+            Canon::StopSpeedFeedSync => self.synced = None,
+            Canon::StraightFeed(p) if self.synced.is_some() => {
+                let end = self.machine(p);
+                let pitch = self.synced.unwrap_or(0.0);
+                self.push(
+                    line,
+                    MoveKind::Synced(SyncedMove {
+                        end,
+                        pitch,
+                        tap: None,
+                    }),
+                );
+            }
+            Canon::RigidTap { end, retract_scale } => {
+                // The tap comes back to where it started: the current point stays.
+                let here = self.tipless;
+                let end = self.machine(end);
+                self.tipless = here;
+                let pitch = self.synced.unwrap_or(0.0);
+                // LinuxCNC's motion takes a factor that is not positive as no factor.
+                let scale = if retract_scale > 0.0 {
+                    retract_scale
+                } else {
+                    1.0
+                };
+                let tap = Some(scale);
+                self.push(line, MoveKind::Synced(SyncedMove { end, pitch, tap }));
+            }
             Canon::StraightFeed(p) | Canon::StraightProbe(p) => {
                 let end = self.machine(p);
                 self.push(line, MoveKind::Feed { end });

@@ -432,8 +432,8 @@ fn probing_errors_are_linuxcnc_s_and_runs_refuse_probing() {
         .unwrap_err();
     assert_eq!(
         err.kind.to_string(),
-        "G38.2 probing needs the simulated probe of `tezgah run` (a machine file's [probe] or \
-         --probe); check, serve and MDI do not probe yet"
+        "G38.2 probing needs a probe: a machine file's [probe] (`tezgah run`, `serve`, MDI) or \
+         `tezgah run --probe`; `check` does not probe"
     );
     assert_eq!((err.span.line, err.span.column), (2, 1));
 }
@@ -520,4 +520,52 @@ fn probe_answers_drive_the_interpreter() {
         "G38.5 probe move awaits the machine's answer"
     );
     assert_eq!((x, tripped), (8.0, 0.0));
+}
+
+/// G33 and G33.1 (absolute, G91, inches, G95 around them, polar, I and E words): every
+/// canonical call agrees with rs274's — `START_SPEED_FEED_SYNC`, the feed or `RIGID_TAP`,
+/// `STOP_SPEED_FEED_SYNCH`, the tap leaving the current point where it was.
+#[test]
+fn g33_and_g33_1_match_rs274_call_for_call() {
+    let expected = rs274_expected("spindle_sync");
+    assert_eq!(expected.len(), 63, "the expected file is whole");
+    let (ours, error) = our_rs274_calls("spindle_sync");
+    assert_eq!(error, None);
+    for (k, (a, b)) in expected.iter().zip(&ours).enumerate() {
+        assert_eq!(b, a, "call {}", k + 1);
+    }
+    assert_eq!(ours.len(), expected.len());
+}
+
+/// LinuxCNC's errors for G33/G33.1, in its order: the other words' rules first, then K
+/// missing (K is not modal), then F, then the spindle at execution.
+#[test]
+fn g33_errors_as_linuxcnc() {
+    use tezgah_gcode::{Canon, Interpreter, Origin};
+    let run = |program: &str| {
+        Interpreter::new(Config::linuxcnc(Default::default()))
+            .run(program, &mut Vec::<(Origin, Canon)>::new())
+            .unwrap_err()
+            .kind
+            .to_string()
+    };
+    let cases = [
+        ("G21\nG33 Z-1 K0.05\nM2\n", "Spindle not turning in G33"),
+        ("G21\nM5\nG33.1 Z-1 K1\nM2\n", "Spindle not turning in G33.1"),
+        ("G21\nM3 S100\nG33 Z-1\nM2\n", "K word missing with g33/g33.1"),
+        ("G21\nM3 S100\nG33 Z-1 K1\nZ-2\nM2\n", "K word missing with g33/g33.1"),
+        ("G21\nG33 Z-1 F10\nM2\n", "K word missing with g33/g33.1"),
+        ("G21\nG33 Z-1 E1\nM2\n", "K word missing with g33/g33.1"),
+        ("G21\nM3 S100\nG33.1 Z-1 K1 F1\nM2\n", "F word used with a g33/g33.1"),
+        (
+            "G21\nG33 Z-1 K1 I2\nM2\n",
+            "I word with no G2, G3, G5, G5.1, G10, G33.1, G76, or G87 to use it",
+        ),
+        ("G21\nG33 Z-1 P1\nM2\n", "P word with no G2 G3 G4 G10 G64 G5 G5.2 G76 G82 G86 G88 G89 or M50 M51 M52 M53 M62 M63 M64 M65 M66 M98 or user M code to use it"),
+        ("G21\nM3 S100\nG33 K1\nM2\n", "All axes missing with motion code"),
+        ("G21\nM3 S100\nG53 G33 Z-1 K1\nM2\n", "Must use g0 or g1 with g53"),
+    ];
+    for (program, message) in cases {
+        assert_eq!(run(program), message, "{program:?}");
+    }
 }

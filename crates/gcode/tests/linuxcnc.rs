@@ -62,6 +62,7 @@ const fn run(folder: &'static str, program: &'static str) -> Run {
 const RUNS: &[Run] = &[
     run("fractional-linenumbers", "test.ngc"),
     run("g6164", "test.ngc"),
+    run("g33.1", "g33.1.ngc"),
     run("unit-conversion", "test.ngc"),
     run("namedparam-bug424", "test.ngc"),
     run("g10/g10-l2-while-active", "test.ngc"),
@@ -204,7 +205,6 @@ const RUNS: &[Run] = &[
 /// Folders that need the full-dialect issue or are out of scope, with the reason.
 #[allow(dead_code)]
 const FOLDERS_NOT_YET: &[(&str, &str)] = &[
-    ("g33.1", "spindle-synchronised motion, out of scope"),
     ("g71-*, g72-*, g76", "lathe cycles, out of scope"),
     (
         "g84/g18/*, g84/g19/*",

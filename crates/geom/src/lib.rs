@@ -32,7 +32,8 @@ pub use curve::{Curve, Vec3};
 pub use error::CurveError;
 pub use line::Line;
 pub use moves::{
-    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, StopKind, ToolControl, Turn,
+    ArcMove, FeedMode, Move, MoveKind, NurbsMove, PathMode, Plane, StopKind, SyncedMove,
+    ToolControl, Turn,
 };
 pub use nurbs::{BoundingBox, Nurbs};
 pub use pose::{Axis, Pose};

@@ -34,6 +34,19 @@ impl Plane {
 /// `ARC_FEED` rotation argument (1 = less than one full turn, 2 = one extra full turn, …).
 pub type Turn = i32;
 
+/// G33 / G33.1: a straight move whose position along the line follows the spindle's angle,
+/// `pitch` mm per revolution (the thread's lead), instead of a feed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SyncedMove {
+    pub end: Pose,
+    /// mm along the line per spindle revolution.
+    pub pitch: f64,
+    /// G33.1: rigid tapping — the spindle reverses at `end` and the tool follows it back to the
+    /// start (where the move leaves the machine); the spindle speed on the way back is
+    /// multiplied by this (LinuxCNC's I word, 1 without it).
+    pub tap: Option<f64>,
+}
+
 /// A circular or helical feed move.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArcMove {
@@ -71,6 +84,9 @@ pub enum MoveKind {
     Arc(ArcMove),
     /// G5, G5.1, G5.2/G5.3, G06.2: a NURBS curve at the programmed feed.
     Nurbs(NurbsMove),
+    /// G33 / G33.1: a straight move following the spindle (`tezgah run` simulates the
+    /// spindle; the path builder takes it as a feed at pitch × programmed speed).
+    Synced(SyncedMove),
     /// G4: wait, motion stopped.
     Dwell { seconds: f64 },
     /// The feed in force from here on, mm/min (or 1/min in inverse time, mm/rev with G95).

@@ -29,6 +29,7 @@ pub mod machine;
 pub mod pose;
 pub mod probe;
 pub mod segment;
+pub mod spindle;
 pub mod table_ac;
 pub mod table_bc;
 pub mod tcp;

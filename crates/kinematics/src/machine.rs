@@ -11,7 +11,7 @@
 //!
 //! Every error names its field (`joint[2].max_jerk: must be > 0`); unknown fields are refused.
 
-mod check;
+pub(crate) mod check;
 mod joint;
 mod section;
 
@@ -73,6 +73,8 @@ struct RawMachine {
     joint: Vec<RawJoint>,
     #[serde(default)]
     probe: Option<crate::probe::RawProbe>,
+    #[serde(default)]
+    spindle: Option<crate::spindle::RawSpindle>,
     /// `[drive]`: the drive bus's own table (the `tezgah-ethercat` crate reads and checks it
     /// from the same text); the machine only lets it through.
     #[serde(default)]
@@ -166,6 +168,8 @@ pub struct Machine {
     pub tcp: TcpSwitch,
     /// `[probe]` (optional): the simulated probe G38 moves touch.
     pub probe: Option<crate::probe::ProbeModel>,
+    /// `[spindle]` (optional, defaults otherwise): how the spindle's speed responds, for G33.
+    pub spindle: crate::spindle::SpindleModel,
 }
 
 impl Machine {
@@ -334,6 +338,11 @@ fn build(raw: RawMachine, text: &str) -> Result<Machine, MachineError> {
         joints,
         tcp,
         probe: raw.probe.map(|p| p.build("probe.")).transpose()?,
+        spindle: raw
+            .spindle
+            .map(|s| s.build())
+            .transpose()?
+            .unwrap_or_default(),
     })
 }
 

@@ -40,21 +40,39 @@ pub enum PrepareError {
 
 /// The program's moves smoothed for `machine` (G64 compresses and blends within its shares of
 /// the tolerance, G61 keeps corners, G61.1 stops at every block end), then the pre-flight:
-/// every segment within the machine's reach and joint limits, from the program pose `start`.
+/// every segment within the machine's reach and joint limits, from the program pose `start`
+/// (the joints there found by the inverse kinematics).
 pub fn prepare(
     moves: Vec<Move>,
     machine: &Machine,
     tolerance: f64,
     start: Pose,
 ) -> Result<Prepared, PrepareError> {
+    prepare_from(moves, machine, tolerance, start, None)
+}
+
+/// [`prepare`] for a machine whose joints stand at `joints` (the executor knows them; where
+/// a pose has several inverses, the path is checked on the branch the machine is on), or at
+/// the inverse kinematics' answer for `start` when `None`.
+pub fn prepare_from(
+    moves: Vec<Move>,
+    machine: &Machine,
+    tolerance: f64,
+    start: Pose,
+    joints: Option<Joints>,
+) -> Result<Prepared, PrepareError> {
     let pm = PlanMachine::from_machine(machine)?;
     let opts = SmoothOptions::for_machine(&machine.path, &pm, tolerance, start);
     let mut smoother = smooth::Smoother::new(moves.into_iter(), opts.clone())?;
     let items = smoother.by_ref().collect::<Result<Vec<_>, _>>()?;
-    let (tip, rotary) = start_point(&start);
-    let start_joints = pm
-        .joints(pm.initial, &tip, &rotary, &Joints::zeros(pm.joint_count()))
-        .map_err(PrepareError::Start)?;
+    let start_joints = match joints {
+        Some(j) => j,
+        None => {
+            let (tip, rotary) = start_point(&start);
+            pm.joints(pm.initial, &tip, &rotary, &Joints::zeros(pm.joint_count()))
+                .map_err(PrepareError::Start)?
+        }
+    };
     check_path(&items, &pm, start_joints)?;
     Ok(Prepared {
         items,

@@ -169,8 +169,11 @@ fn tangent_collinear_and_reversal_junctions() {
     ];
     check_path(&items, &verts).unwrap();
     let d = deviation(Pose::ZERO, &m, &items);
-    let share = 0.4 * 0.01;
-    assert!(d <= share + 1e-9 && d > 1e-4, "deviation {d}");
+    // A line running into its own tangent arc spends no compression deviation, so its blend
+    // takes the blend and compression shares (0.4 + 0.4 of ε = 0.01), and grows until it
+    // uses most of them: the longest blend spreads the curvature jump thinnest.
+    let share = 0.8 * 0.01;
+    assert!(d <= share + 1e-9 && d > 0.5 * share, "deviation {d}");
     // Without a tolerance to spend (G61) the junctions stay tangent, curvature jumping.
     let mut exact = m.clone();
     exact.insert(1, mode(1, PathMode::ExactPath));

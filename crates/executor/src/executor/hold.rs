@@ -154,7 +154,7 @@ impl Executor {
                 analyse(last, &self.machine).ok()?,
                 analyse(head, &self.machine).ok()?,
             );
-            if !inside_group(&ga, &gb, x.a.abs(), &self.machine, &self.options.plan) {
+            if !inside_group(&ga, &gb, x.a.abs(), &self.machine, &self.options.plan()) {
                 return None;
             }
         }

@@ -202,7 +202,7 @@ fn check_other_words(
     }
     // Most blocks (`G1 X… Y… Z…`) carry none of the words below: no rule to check then.
     if !RULED_LETTERS.iter().any(|&c| block.has(c)) {
-        return Ok(());
+        return check_synced(block, motion);
     }
     let rule = |letter: u8, allowed: bool, kind: ErrorKind| -> Result<(), CheckError> {
         match block.word(letter) {
@@ -216,14 +216,20 @@ fn check_other_words(
         matches!(comp, Some(410 | 411 | 420 | 421)) || block.g(ggroup::SPINDLE_MODE) == Some(960),
         ErrorKind::DWordUnused,
     )?;
-    rule(b'e', false, ErrorKind::EWordUnused)?;
+    // LinuxCNC lets E ride along on G33/G33.1 (and ignores it).
+    rule(
+        b'e',
+        matches!(motion, Some(330 | 331)),
+        ErrorKind::EWordUnused,
+    )?;
     rule(
         b'h',
         matches!(block.g(ggroup::TOOL_LENGTH), Some(430 | 432 | 434)),
         ErrorKind::HWordUnused,
     )?;
     let ij_user = arc || g10 || matches!(motion, Some(50 | 51 | 870));
-    rule(b'i', ij_user, ErrorKind::IWordUnused)?;
+    // G33.1's I: the spindle speed factor of the way back.
+    rule(b'i', ij_user || motion == Some(331), ErrorKind::IWordUnused)?;
     rule(b'j', ij_user, ErrorKind::JWordUnused)?;
     rule(
         b'k',
@@ -278,5 +284,21 @@ fn check_other_words(
             || matches!(m(mgroup::SPINDLE), Some(19)),
         ErrorKind::RWordUnused,
     )?;
+    check_synced(block, motion)
+}
+
+/// G33 and G33.1 take their pitch from K on every block (K is not modal) and no F: checked
+/// after the other words, as LinuxCNC does.
+fn check_synced(block: &Block, motion: Option<u32>) -> Result<(), CheckError> {
+    if !matches!(motion, Some(330 | 331)) {
+        return Ok(());
+    }
+    let at = block.g[ggroup::MOTION].map_or(0, |c| c.at);
+    if !block.has(b'k') {
+        return Err((ErrorKind::SyncMissingK, at));
+    }
+    if let Some(w) = block.word(b'f') {
+        return Err((ErrorKind::SyncWithF, w.at));
+    }
     Ok(())
 }

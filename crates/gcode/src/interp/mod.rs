@@ -178,6 +178,17 @@ pub struct Interpreter {
     /// Probe moves run so far: the index of the next one's answer in
     /// [`ProbeModel::Answered`].
     probes: usize,
+    /// The probe move the last line stopped at for want of an answer
+    /// ([`Interpreter::answer_probe`] gives it one).
+    pending_probe: Option<PendingProbe>,
+}
+
+/// A probe move waiting for the machine's answer: its G number ×10 and its ends.
+#[derive(Debug, Clone, Copy)]
+struct PendingProbe {
+    g: u32,
+    start: Pose,
+    end: Pose,
 }
 
 /// Where in the source a line sits, for error spans.
@@ -245,6 +256,7 @@ impl Interpreter {
             missing_end: None,
             saved_modes: Default::default(),
             probes: 0,
+            pending_probe: None,
         };
         interp.restore_parameters();
         interp
@@ -288,6 +300,18 @@ impl Interpreter {
         for n in crate::params::G92_ENABLED..crate::params::G92_ENABLED + 10 {
             self.params.set(n, 0.0);
         }
+    }
+
+    /// Answers the probe move the last line stopped at ([`ErrorKind::ProbeAwaitsAnswer`], one
+    /// line at a time as MDI runs): `#5061`… and the position are set as if the line had had
+    /// the answer, or LinuxCNC's error for it is returned. What the line held after its motion
+    /// (a stop code) is not run. `false` when no probe waits.
+    pub fn answer_probe(&mut self, outcome: ProbeOutcome) -> Result<bool, ErrorKind> {
+        let Some(p) = self.pending_probe.take() else {
+            return Ok(false);
+        };
+        self.apply_probe(p.g, p.start, p.end, outcome)
+            .map(|()| true)
     }
 
     pub fn state(&self) -> &State {
@@ -470,6 +494,7 @@ impl Interpreter {
         if self.ended {
             return Ok(Flow::End);
         }
+        self.pending_probe = None;
         let mut block = self.block.take().unwrap_or_default();
         let result = self.read_and_execute(&mut block, line, sink);
         self.block = Some(block);

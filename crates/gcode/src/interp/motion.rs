@@ -42,6 +42,7 @@ impl Interpreter {
             }
             62 => self.g62_line(block, at, sink)?,
             382..=385 => self.probe(block, g, at, sink)?,
+            330 | 331 => self.spindle_synced(block, g == 331, at, sink)?,
             _ => return Err(unsupported(g, at)),
         }
         self.state.motion = Some(g);
@@ -181,8 +182,22 @@ impl Interpreter {
             return Ok(());
         };
         let Some(outcome) = outcome else {
+            self.pending_probe = Some(super::PendingProbe { g, start, end });
             return Err((ErrorKind::ProbeAwaitsAnswer(name()), at));
         };
+        self.apply_probe(g, start, end, outcome)
+            .map_err(|kind| (kind, at))
+    }
+
+    /// The machine's answer to the probe move G`g` from `start` to `end`: `#5061`… and the
+    /// position where the machine came to rest, or LinuxCNC's error for the outcome.
+    pub(super) fn apply_probe(
+        &mut self,
+        g: u32,
+        start: Pose,
+        end: Pose,
+        outcome: super::ProbeOutcome,
+    ) -> Result<(), ErrorKind> {
         self.probes += 1;
         let toward = matches!(g, 382 | 383);
         let point = |f: f64| {
@@ -195,20 +210,59 @@ impl Interpreter {
         let (probed, stopped, tripped) = match outcome {
             super::ProbeOutcome::Tripped { at: f, stopped } => (point(f), point(stopped), true),
             super::ProbeOutcome::Completed if matches!(g, 382) => {
-                return Err((ErrorKind::ProbeNoContact, at))
+                return Err(ErrorKind::ProbeNoContact)
             }
             super::ProbeOutcome::Completed if matches!(g, 384) => {
-                return Err((ErrorKind::ProbeStillInContact, at))
+                return Err(ErrorKind::ProbeStillInContact)
             }
             // G38.3 and G38.5 go on untripped from the end of the move.
             super::ProbeOutcome::Completed => (end, end, false),
             super::ProbeOutcome::AlreadyThere if toward => {
-                return Err((ErrorKind::ProbeAlreadyTripped, at))
+                return Err(ErrorKind::ProbeAlreadyTripped)
             }
-            super::ProbeOutcome::AlreadyThere => return Err((ErrorKind::ProbeAlreadyClear, at)),
+            super::ProbeOutcome::AlreadyThere => return Err(ErrorKind::ProbeAlreadyClear),
         };
         self.set_probe_parameters(probed, tripped);
         self.state.pos = stopped;
+        Ok(())
+    }
+
+    /// G33 (a straight move whose axes follow the spindle, K program units per revolution)
+    /// and G33.1 (rigid tapping: to the point and back following the spindle, which reverses
+    /// at depth; the current point stays), as LinuxCNC's `convert_straight` sends them.
+    fn spindle_synced(
+        &mut self,
+        block: &Block,
+        tap: bool,
+        at: u32,
+        sink: &mut impl CanonSink,
+    ) -> Exec {
+        if self.state.spindle.is_none() {
+            let name = if tap { "G33.1" } else { "G33" };
+            return Err((ErrorKind::SyncSpindleStopped(name), at));
+        }
+        if self.comp.side.is_some() {
+            return Err((ErrorKind::SyncWithComp, at));
+        }
+        let feed_per_rev = block.get(b'k').unwrap_or(0.0);
+        let end = self.find_ends(block).map_err(|k| (k, at))?;
+        self.emit(sink, Canon::StartSpeedFeedSync { feed_per_rev });
+        if tap {
+            let mut bottom = self.state.pos;
+            bottom.0[..3].copy_from_slice(&end.0[..3]);
+            let retract_scale = block.get(b'i').unwrap_or(1.0);
+            self.emit(
+                sink,
+                Canon::RigidTap {
+                    end: bottom,
+                    retract_scale,
+                },
+            );
+        } else {
+            self.emit(sink, Canon::StraightFeed(end));
+            self.state.pos = end;
+        }
+        self.emit(sink, Canon::StopSpeedFeedSync);
         Ok(())
     }
 

@@ -23,6 +23,8 @@ pub enum DirectError {
     BadDwell { line: u32, seconds: f64 },
     #[error("line {line}: position is not finite")]
     NotFinite { line: u32 },
+    #[error("line {line}: G33/G33.1 follow the spindle; only `tezgah run` simulates that")]
+    Synced { line: u32 },
 }
 
 /// Thresholds of the direct builder (explicit, never buried literals).
@@ -191,6 +193,7 @@ impl Direct {
                 out.push(PathItem::Dwell { seconds, line });
                 return Ok(());
             }
+            MoveKind::Synced(_) => return Err(DirectError::Synced { line }),
             &MoveKind::Stop(kind) => {
                 // M1 is honoured only with optional stop on, which `run` does not set.
                 if kind != StopKind::OptionalPause {

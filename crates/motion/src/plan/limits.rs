@@ -144,8 +144,18 @@ pub const CELLS: usize = 16;
 /// along the segment bounds: its own and those within `df` (one sample spacing), since between
 /// two samples a derivative is bounded by theirs with a margin, on either side.
 fn raise(cells: &mut Cells, i: usize, f: f64, df: f64, d: [f64; 3]) {
+    raise_in(cells, reach(f, df), i, d);
+}
+
+/// The cells a sample at `f` ∈ [0, 1] bounds, with `df` either side ([`raise`]).
+fn reach(f: f64, df: f64) -> std::ops::RangeInclusive<usize> {
     let cell = |x: f64| ((x * CELLS as f64).floor().max(0.0) as usize).min(CELLS - 1);
-    for cell in &mut cells[cell(f - df)..=cell(f + df)] {
+    cell(f - df)..=cell(f + df)
+}
+
+/// [`raise`] over the cells `range` (found once for a sample's three axes).
+fn raise_in(cells: &mut Cells, range: std::ops::RangeInclusive<usize>, i: usize, d: [f64; 3]) {
+    for cell in &mut cells[range] {
         for (m, x) in cell[i].iter_mut().zip(d) {
             *m = m.max(x);
         }
@@ -234,7 +244,8 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // (Lines, arcs and helices turn evenly: the ends and the middle tell it.)
             const COARSE: usize = 16;
             let dc = (ub - ua) / COARSE as f64;
-            let coarse: f64 = if constant_speed(curve) {
+            let constant = constant_speed(curve);
+            let coarse: f64 = if constant {
                 0.0
             } else {
                 (0..COARSE)
@@ -246,6 +257,21 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                     .sum()
             };
             let turning = (k0.norm().max(k1.norm()).max(km.norm()) * seg.length).max(coarse);
+            // On lines, arcs and helices each axis's derivatives are sinusoids of the arc
+            // length: sampled every ≤ 0.1 rad of turning, a peak between samples is at most
+            // 1/cos(0.05) = 1.00125 of the sampled one, and the parabola through a peak and
+            // its neighbours misses it by far less. A spline's or blend's curvature can spike
+            // between samples: it keeps the wider margins.
+            let margin = if constant {
+                [1.002; 3]
+            } else {
+                [1.005, 1.05, 1.05]
+            };
+            let vertex_margin = if constant {
+                [1.002; 3]
+            } else {
+                [1.01, 1.06, 1.06]
+            };
             let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
             let du = (ub - ua) / samples as f64;
             // Per axis, the sample where |q''| and where |q'''| peak: the peak between samples
@@ -265,17 +291,22 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
                 // from its sampled value by at most that times the next derivative (the
                 // whole segment's maxima have the peak refinement below; a cell does not).
                 let h = 0.5 * su * du;
+                let range = reach(f, df);
                 for i in 0..3 {
-                    let d = [t[i].abs() * 1.005, k[i].abs() * 1.05, dk[i].abs() * 1.05];
+                    let d = [
+                        t[i].abs() * margin[0],
+                        k[i].abs() * margin[1],
+                        dk[i].abs() * margin[2],
+                    ];
                     g1[i] = g1[i].max(d[0]);
                     g2[i] = g2[i].max(d[1]);
                     g3[i] = g3[i].max(d[2]);
                     let local = [
-                        (t[i].abs() + h * k[i].abs()) * 1.005,
-                        (k[i].abs() + h * dk[i].abs()) * 1.05,
+                        (t[i].abs() + h * k[i].abs()) * margin[0],
+                        (k[i].abs() + h * dk[i].abs()) * margin[1],
                         d[2],
                     ];
-                    raise(cells, i, f, df, local);
+                    raise_in(cells, range.clone(), i, local);
                 }
                 (t, k, dk)
             };
@@ -304,16 +335,17 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // maximum and its neighbours (the whole segment's peak is refined below too).
             for s in 1..samples {
                 let (before, here, after) = (&rows[s - 1], &rows[s], &rows[s + 1]);
+                let range = reach(s as f64 * df, df);
                 for i in 0..3 {
                     let mut d = [0.0; 3];
                     for (o, x) in d.iter_mut().enumerate() {
                         let (a, b, c) = (before[i][o], here[i][o], after[i][o]);
                         let bend = 2.0 * b - a - c;
                         if b >= a && b >= c && bend > 0.0 {
-                            *x = (b + (c - a) * (c - a) / (8.0 * bend)) * [1.01, 1.06, 1.06][o];
+                            *x = (b + (c - a) * (c - a) / (8.0 * bend)) * vertex_margin[o];
                         }
                     }
-                    raise(&mut tip_cells, i, s as f64 * df, df, d);
+                    raise_in(&mut tip_cells, range.clone(), i, d);
                 }
             }
             const FINE: usize = 8;
@@ -788,12 +820,20 @@ fn top_speed(
 }
 
 /// The joint budgets of a curved segment, point by point.
+///
+/// Of the (|q'|, |q''|, |q'''|) of one joint in its cells only those no other cell exceeds in
+/// all three are kept (the Pareto front, usually a few of the sixteen): every limit below
+/// tightens as each of the three grows (at any speed and acceleration: the acceleration left
+/// falls with |q''|, the jerk left with |q'''|, and both are divided among |q'| and |q''|), so
+/// a cell bounded by another in all three is never the binding one.
 struct Budgets<'a> {
     cells: &'a Cells,
+    /// (cell, joint) of the cells on each joint's front; `front[..m]` hold.
+    front: [(u8, u8); CELLS * MAX_JOINTS],
+    m: usize,
     /// b·Aᵢ and b·Jᵢ per joint.
     acceleration: [f64; MAX_JOINTS],
     jerk: [f64; MAX_JOINTS],
-    n: usize,
 }
 
 impl<'a> Budgets<'a> {
@@ -802,12 +842,37 @@ impl<'a> Budgets<'a> {
         let b = options.budget(kept);
         let scaled =
             |limits: &[f64]| std::array::from_fn(|i| b * limits.get(i).copied().unwrap_or(0.0));
+        let mut front = [(0, 0); CELLS * MAX_JOINTS];
+        let mut m = 0;
+        let below = |x: &[f64; 3], y: &[f64; 3]| x[0] <= y[0] && x[1] <= y[1] && x[2] <= y[2];
+        for i in 0..machine.joint_count().min(MAX_JOINTS) {
+            for (c, cell) in cells.iter().enumerate() {
+                let d = &cell[i];
+                // Bounded by another cell (among equal ones, the first is kept).
+                let covered = cells.iter().enumerate().any(|(o, other)| {
+                    let e = &other[i];
+                    o != c && below(d, e) && (o < c || !below(e, d))
+                });
+                if !covered {
+                    front[m] = (c as u8, i as u8);
+                    m += 1;
+                }
+            }
+        }
         Budgets {
             cells,
+            front,
+            m,
             acceleration: scaled(&machine.max_acceleration),
             jerk: scaled(&machine.max_jerk),
-            n: machine.joint_count().min(MAX_JOINTS),
         }
+    }
+
+    /// Each kept cell's joint and (|q'|, |q''|, |q'''|).
+    fn rows(&self) -> impl Iterator<Item = (usize, [f64; 3])> + '_ {
+        self.front[..self.m]
+            .iter()
+            .map(|&(c, i)| (i as usize, self.cells[c as usize][i as usize]))
     }
 }
 
@@ -890,44 +955,45 @@ fn best_split(
 /// fastest, with that ramp's duration: A takes a share of what the acceleration leaves, J the
 /// most the jerk then leaves (see [`jerk_left`]). `None` if nothing is left.
 fn at_speed(v: f64, dv: f64, budgets: &Budgets<'_>) -> Option<(f64, f64, f64)> {
-    // Per point and joint: |q'|, 3|q''| and the jerk left after the curvature's rate |q'''|v³.
-    let mut rows = [(0.0f64, 0.0f64, 0.0f64); CELLS * MAX_JOINTS];
-    let mut m = 0;
+    let v3 = v * v * v;
     // The most acceleration the acceleration budget leaves, and the most that leaves jerk
     // with the cross term paid at V (a profile's acceleration peaks below V, so this leaves
     // some jerk: shares of it are tried).
     let mut a_cap = f64::INFINITY;
     let mut a_low = f64::INFINITY;
-    for cell in budgets.cells {
-        for (i, &[g1, g2, g3]) in cell.iter().enumerate().take(budgets.n) {
-            let rest_a = budgets.acceleration[i] - g2 * v * v;
-            let rest_j = budgets.jerk[i] - g3 * v * v * v;
-            if rest_a < 0.0 || rest_j < 0.0 {
-                return None;
-            }
-            if g1 > 0.0 {
-                a_cap = a_cap.min(rest_a / g1);
-            }
-            if g2 > 0.0 {
-                a_low = a_low.min(rest_j / (3.0 * g2 * v));
-            }
-            if g1 > 0.0 || g2 > 0.0 {
-                rows[m] = (g1, 3.0 * g2, rest_j);
-                m += 1;
-            }
+    for (i, [g1, g2, g3]) in budgets.rows() {
+        let rest_a = budgets.acceleration[i] - g2 * v * v;
+        let rest_j = budgets.jerk[i] - g3 * v3;
+        if rest_a < 0.0 || rest_j < 0.0 {
+            return None;
+        }
+        if g1 > 0.0 {
+            a_cap = a_cap.min(rest_a / g1);
+        }
+        if g2 > 0.0 {
+            a_low = a_low.min(rest_j / (3.0 * g2 * v));
         }
     }
     if !(a_cap > 0.0 && a_cap.is_finite()) {
         return None;
     }
-    let rows = &rows[..m];
+    // The least over points and joints of what each allows (see [`jerk_left`]), from |q'|,
+    // 3|q''| and the jerk left after the curvature's rate |q'''|v³, recomputed per share of
+    // the acceleration: cheaper than storing them.
+    let jerk = |a: f64| {
+        let mut j = f64::INFINITY;
+        for (i, [g1, g2, g3]) in budgets.rows() {
+            if g1 > 0.0 || g2 > 0.0 {
+                let rest_j = budgets.jerk[i] - g3 * v3;
+                j = j.min(jerk_left(g1, 3.0 * g2, rest_j, v, a));
+            }
+        }
+        j
+    };
     let mut best: Option<(f64, f64, f64)> = None;
     let a_cap = a_low.min(a_cap);
     for a in ACCEL_FRACTIONS.map(|alpha| alpha * a_cap) {
-        let j = rows
-            .iter()
-            .map(|&(g1, g2x3, rest)| jerk_left(g1, g2x3, rest, v, a))
-            .fold(f64::INFINITY, f64::min);
+        let j = jerk(a);
         if !(j > 0.0 && j.is_finite()) {
             continue;
         }

@@ -296,7 +296,7 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
     } else {
         8.0 * share / (3.0 * half) * (1.0 - 1e-12)
     };
-    let mut leg = ideal.min(room_a).min(room_b);
+    let room = room_a.min(room_b);
     let refuse = || {
         if tangent {
             NoBlend::Tangent {
@@ -306,12 +306,13 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             NoBlend::Corner
         }
     };
-    if !(leg > 0.0 && leg.is_finite()) {
-        return Err(refuse());
-    }
     let both_lines = !tangent && matches!(a.geo, Geo::Line(_)) && matches!(b.geo, Geo::Line(_));
     let corner = a.geo.point(a.geo.domain().1);
-    for _ in 0..=LEG_HALVINGS {
+    // The blend of legs `leg` and its deviation, if within the share.
+    let trial = |leg: f64| -> Result<(f64, Option<Placed>), NoBlend> {
+        if !(leg > 0.0 && leg.is_finite()) {
+            return Err(refuse());
+        }
         let ua = a.u_at(a.full_length - leg);
         let ub = b.u_at(leg);
         let (pa, pb) = (a.geo.point(ua), b.geo.point(ub));
@@ -349,27 +350,116 @@ pub(crate) fn place(a: &Piece, b: &Piece, share: f64, max_angle: f64) -> Result<
             let away = bound.unwrap_or_else(|| away_sampled(&curve, a, &ca, b, &cb));
             to_corner.max(away)
         };
-        if deviation <= share {
-            let length = if both_lines {
-                line_line_length(leg, ta.dot(&tb))
-            } else {
-                curve.arc_length()
-            };
-            if !(length > 0.0 && length.is_finite()) {
-                return Err(refuse());
-            }
-            return Ok(Placed {
+        if deviation > share {
+            return Ok((deviation, None));
+        }
+        let length = if both_lines {
+            line_line_length(leg, ta.dot(&tb))
+        } else {
+            curve.arc_length()
+        };
+        if !(length > 0.0 && length.is_finite()) {
+            return Err(refuse());
+        }
+        Ok((
+            deviation,
+            Some(Placed {
                 curve,
                 length,
                 ua,
                 ub,
                 deviation,
                 speed: lam,
-            });
+            }),
+        ))
+    };
+    let mut leg = ideal.min(room);
+    if tangent {
+        // The clothoid estimate is far from what the quintic deviates: with λ = 2ℓ its
+        // curvature rises nearly linearly along the blend and it stays inside the two curves
+        // it joins, ~1/15 of the estimate off them (R10 line–arc at ε 0.008: 0.0005 mm).
+        // The jerk a speed v asks on a transition is ~v³·Δκ/L, so the longest blend the
+        // share allows is the fastest: measured, the legs grow until the share is met.
+        let reach = (leg * TANGENT_REACH).min(room);
+        if let Some(p) = longest_within(leg * TANGENT_START, reach, share, &trial)? {
+            return Ok(p);
+        }
+    }
+    for _ in 0..=LEG_HALVINGS {
+        if let (_, Some(p)) = trial(leg)? {
+            return Ok(p);
         }
         leg *= 0.5;
     }
     Err(refuse())
+}
+
+/// How far beyond the clothoid estimate a tangent blend's legs are tried ([`place`]).
+const TANGENT_REACH: f64 = 6.0;
+
+/// The first leg tried, in clothoid estimates: at that estimate a line–arc quintic deviates
+/// ~1/15 of the share (whatever the radius: both scale alike), so √15 of it nearly meets it.
+const TANGENT_START: f64 = 3.7;
+
+/// Aim a little inside the share: the deviation is only nearly quadratic in the leg.
+const LEG_AIM: f64 = 0.97;
+
+/// Tries at the legs the deviation predicts, and then bisections.
+const LEG_TRIES: usize = 3;
+const LEG_BISECTIONS: usize = 3;
+
+/// The longest leg up to `hi` (nearly) whose blend `trial` accepts, starting from a guess
+/// `start`; `trial` gives the deviation of a leg and the blend if it is within `share`.
+/// `None` if no leg tried is accepted (the caller then shortens from its own estimate). A
+/// tangent blend deviates about in proportion to its leg squared (a transition's shift,
+/// ~L²·Δκ/24), so each try aims at the leg that scaling predicts from the last deviation
+/// measured, and bisection settles what the prediction misses. Each try measures the blend
+/// against both curves: one or two is what it usually costs.
+fn longest_within(
+    start: f64,
+    hi: f64,
+    share: f64,
+    trial: &impl Fn(f64) -> Result<(f64, Option<Placed>), NoBlend>,
+) -> Result<Option<Placed>, NoBlend> {
+    let mut best: Option<Placed> = None;
+    let (mut ok, mut over) = (0.0, hi * (1.0 + 1e-12));
+    let mut aim = start.min(hi);
+    for _ in 0..LEG_TRIES {
+        let (d, placed) = trial(aim)?;
+        match placed {
+            Some(p) => {
+                // Close to the share, or at the top of the range: done (a transition's
+                // speed grows only with the cube root of its length).
+                if aim >= 0.97 * hi || d >= 0.9 * LEG_AIM * share {
+                    return Ok(Some(p));
+                }
+                ok = aim;
+                best = Some(p);
+            }
+            None => over = aim,
+        }
+        let next = (aim * (LEG_AIM * share / d.max(1e-300)).sqrt()).min(hi);
+        if next >= over || next <= ok {
+            break;
+        }
+        aim = next;
+    }
+    if ok > 0.0 {
+        for _ in 0..LEG_BISECTIONS {
+            let mid = 0.5 * (ok + over.min(hi));
+            if mid <= ok * 1.01 {
+                break;
+            }
+            match trial(mid)? {
+                (_, Some(p)) => {
+                    best = Some(p);
+                    ok = mid;
+                }
+                (_, None) => over = mid,
+            }
+        }
+    }
+    Ok(best)
 }
 
 /// The blend's largest distance from the pieces `a` over `ca` and `b` over `cb`, sampled and

@@ -24,6 +24,13 @@ pub enum PathError {
     /// A tolerance (options or `G64 P`) that is not finite and positive.
     #[error("line {line}: path tolerance {value} mm is not a positive finite number")]
     Tolerance { line: u32, value: f64 },
+    /// G33/G33.1 follow the spindle, not a feed: only a caller that simulates the spindle
+    /// (`tezgah run`) plays them, cutting the program at them.
+    #[error(
+        "line {line}: G33/G33.1 follow the spindle; only `tezgah run` simulates that (the \
+         executor, `check --machine` and `export` do not)"
+    )]
+    Synced { line: u32 },
     /// An option of [`super::SmoothOptions`] out of its range.
     #[error("smoothing option {name} = {value} is out of range")]
     Option { name: &'static str, value: f64 },
@@ -36,6 +43,7 @@ impl PathError {
             PathError::Curve { line, .. }
             | PathError::Feed { line, .. }
             | PathError::FeedPerRevolution { line }
+            | PathError::Synced { line }
             | PathError::Tolerance { line, .. } => Some(*line),
             PathError::Option { .. } => None,
         }

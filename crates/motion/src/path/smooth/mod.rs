@@ -352,6 +352,7 @@ impl<I: Iterator<Item = Move>> Smoother<I> {
                 return Ok(Some(Tok::FeedOverride(on)));
             }
             &MoveKind::Dwell { seconds } => return Ok(Some(Tok::Dwell { seconds, line })),
+            MoveKind::Synced(_) => return Err(PathError::Synced { line }),
             &MoveKind::Stop(StopKind::Pause)
             | &MoveKind::Stop(StopKind::OptionalPause)
             | &MoveKind::Stop(StopKind::PalletPause)
