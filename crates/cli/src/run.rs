@@ -134,6 +134,24 @@ pub fn load_machine(spec: Option<&str>) -> Result<Machine> {
     }
 }
 
+/// The text of the machine file `spec` names (the built-in's own text for a built-in name):
+/// for the tables another crate reads itself (`[drive]`).
+pub fn machine_text(spec: Option<&str>) -> Result<String> {
+    match spec {
+        None => Ok(
+            Machine::builtin_text(builtin_names().next().unwrap_or("mill3"))
+                .unwrap_or_default()
+                .to_owned(),
+        ),
+        Some(s) if builtin_names().any(|n| n == s) => {
+            Ok(Machine::builtin_text(s).unwrap_or_default().to_owned())
+        }
+        Some(s) => std::fs::read_to_string(s)
+            .into_diagnostic()
+            .wrap_err_with(|| format!("machine {s}")),
+    }
+}
+
 /// The interpreter's settings for a program run on `machine`: its units (mm) for the tool
 /// table and stored offsets, its program axes, its tool-centre-point switch.
 pub fn machine_config(

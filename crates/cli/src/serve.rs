@@ -66,6 +66,63 @@ pub struct ServeArgs {
     /// connection closed (a running job goes on).
     #[arg(long, default_value_t = 16)]
     pub max_message_mib: usize,
+    /// Where the set-points go: `ideal` (a simulated drive that is always where it was told)
+    /// or `ethercat:<interface>`, the CiA-402 drives the machine file's `[drive]` table lists,
+    /// on that network interface (needs CAP_NET_RAW; see the README).
+    #[arg(long, default_value = "ideal")]
+    pub drive: String,
+    /// With `--drive ethercat:…`: how long a cycle waits for its frame before the machine
+    /// stops on a lost frame, ms (default: 80 % of the machine's period).
+    #[arg(long)]
+    pub bus_timeout_ms: Option<f64>,
+}
+
+/// The drive `--drive` names, opened.
+enum Bus {
+    Ideal,
+    Ethercat(Box<tezgah_ethercat::drive::EthercatDrive>),
+}
+
+/// Opens the drive `spec` names for `machine` (its file text `text` holds `[drive]`); a bus
+/// cycle waits `bus_timeout_ms` for its frame (default: 80 % of `period`).
+fn open_drive(
+    spec: &str,
+    machine: &tezgah_kinematics::Machine,
+    text: &str,
+    period: f64,
+    bus_timeout_ms: Option<f64>,
+) -> Result<Bus> {
+    match spec.split_once(':') {
+        None if spec == "ideal" => Ok(Bus::Ideal),
+        Some(("ethercat", interface)) if !interface.is_empty() => {
+            let section = tezgah_ethercat::DriveSection::from_machine_text(text, machine)
+                .map_err(|e| miette!("{e}"))?
+                .ok_or_else(|| miette!("{}", tezgah_ethercat::SectionError::Missing))?;
+            let link = tezgah_ethercat::master::link::RawSocket::open(interface)
+                .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
+            let mut options =
+                tezgah_ethercat::master::MasterOptions::for_period(Duration::from_secs_f64(period));
+            if let Some(ms) = bus_timeout_ms {
+                if !(ms.is_finite() && ms > 0.0 && ms <= 1000.0) {
+                    return Err(miette!(
+                        "--bus-timeout-ms must be > 0 and at most 1000, got {ms}"
+                    ));
+                }
+                options.cycle_timeout = Duration::from_secs_f64(ms / 1000.0);
+            }
+            let drive = tezgah_ethercat::drive::EthercatDrive::open(
+                Box::new(link),
+                &section,
+                machine.joints.len(),
+                options,
+            )
+            .map_err(|e| miette!("EtherCAT on {interface}: {e}"))?;
+            Ok(Bus::Ethercat(Box::new(drive)))
+        }
+        _ => Err(miette!(
+            "--drive {spec}: expected `ideal` or `ethercat:<interface>`"
+        )),
+    }
 }
 
 /// What the server sends.
@@ -105,6 +162,9 @@ struct StatusOut<'a> {
     /// Unit vector tip → spindle in the workpiece frame (the preview's frame).
     #[serde(skip_serializing_if = "Option::is_none")]
     tool_axis: Option<[f64; 3]>,
+    /// With a drive bus: each drive's state, actual position and error, in bus order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    drives: Option<Vec<tezgah_ethercat::monitor::DriveReading>>,
 }
 
 /// One client holds control at a time; the others watch. The first to connect while nobody
@@ -143,6 +203,8 @@ struct Shared {
     /// Its kinematics when it has rotary joints (for the tool axis in the status).
     kinematics: Option<tezgah_kinematics::Model>,
     host: Handle,
+    /// The drive bus' monitor, when there is a bus.
+    drives: Option<Arc<tezgah_ethercat::monitor::Monitor>>,
     control: Control,
     access: Access,
     interval: Duration,
@@ -152,6 +214,7 @@ struct Shared {
 /// Runs the server until the process is stopped.
 pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     let machine = crate::run::load_machine(args.machine.as_deref())?;
+    let text = crate::run::machine_text(args.machine.as_deref())?;
     let options = ExecOptions::for_machine(&machine).map_err(|e| miette!("{e}"))?;
     let period = options.period;
     if !(args.lead_ms.is_finite() && args.lead_ms > 0.0) {
@@ -184,7 +247,36 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     } else {
         RealtimeSettings::BEST_EFFORT
     };
-    let host = spawn(executor, IdealDrive, ring, realtime);
+    let bus = open_drive(&args.drive, &machine, &text, period, args.bus_timeout_ms)?;
+    let drives = match &bus {
+        Bus::Ideal => None,
+        Bus::Ethercat(d) => Some(d.monitor()),
+    };
+    let host = match bus {
+        Bus::Ideal => spawn(executor, IdealDrive, ring, realtime),
+        Bus::Ethercat(drive) => {
+            // The machine starts where the executor stands; drives elsewhere would jump.
+            let (at, start) = (drive.position(), executor.drive_joints());
+            let off = at
+                .as_slice()
+                .iter()
+                .zip(start.as_slice())
+                .any(|(a, b)| (a - b).abs() > 1e-3);
+            if off {
+                return Err(miette!(
+                    "the drives stand at {:?}, the machine starts at {:?} (internal units): \
+                     move them to the start first",
+                    at.as_slice(),
+                    start.as_slice()
+                ));
+            }
+            log(&format!(
+                "EtherCAT: {} drives in operation enabled",
+                drive.master().slaves().len()
+            ));
+            spawn(executor, *drive, ring, realtime)
+        }
+    };
     for w in host.realtime.warnings() {
         log(&format!("warning: {w}"));
     }
@@ -217,6 +309,7 @@ pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
             .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary)
             .then(|| machine.kinematics.clone()),
         host,
+        drives,
         control: Control::default(),
         access: Access { addr, token },
         interval: Duration::from_millis(args.status_ms.max(1)),
@@ -385,6 +478,7 @@ fn session_loop(ws: &mut WebSocket<TcpStream>, shared: &Shared, me: u64) -> Resu
                 &Outgoing::Status(StatusOut {
                     status: &status,
                     tool_axis,
+                    drives: shared.drives.as_ref().map(|m| m.readings()),
                 }),
             )?;
         }

@@ -132,6 +132,10 @@ pub struct Status {
     pub jog_override_percent: f64,
     /// Commanded joints, machine-file order, internal units.
     pub joints: Vec<f64>,
+    /// Measured joints as the drive last reported them (the drives' actual positions),
+    /// internal units; empty when no real-time side reports.
+    #[serde(default)]
+    pub measured: Vec<f64>,
     /// Tool tip, workpiece frame, mm.
     pub tip: [f64; 3],
     /// Current time scale r (1 = as planned, 0 = stopped).

@@ -342,6 +342,7 @@ impl Executor {
             homed: self.homed,
             jog_override_percent: self.jog_override.percent(),
             joints: self.pose.joints.as_slice().to_vec(),
+            measured: Vec::new(),
             tip: [self.pose.tip.x, self.pose.tip.y, self.pose.tip.z],
             time_scale: self.scale.r,
             error: self.error.clone(),

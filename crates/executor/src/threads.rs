@@ -93,6 +93,7 @@ impl PlannerSide {
             s.underruns = r.underruns;
             s.late_worst_s = r.late_worst;
             s.late_over_half = r.late_over_half;
+            s.measured = r.measured.as_slice().to_vec();
         }
         s
     }
@@ -146,7 +147,7 @@ impl PlannerSide {
             if r.state == RtState::Halted && !self.rearming && !self.halt_seen {
                 self.halt_seen = true;
                 let why = match r.fault {
-                    Some(f) => format!("drive fault {f:?}"),
+                    Some(f) => format!("drive fault: {f}"),
                     None => format!("set-point underrun ({} so far)", r.underruns),
                 };
                 self.exec.fault(r.commanded, &why);

@@ -75,6 +75,11 @@ struct RawMachine {
     probe: Option<crate::probe::RawProbe>,
     #[serde(default)]
     spindle: Option<crate::spindle::RawSpindle>,
+    /// `[drive]`: the drive bus's own table (the `tezgah-ethercat` crate reads and checks it
+    /// from the same text); the machine only lets it through.
+    #[serde(default)]
+    #[allow(dead_code)]
+    drive: Option<serde::de::IgnoredAny>,
 }
 
 /// `[kinematics]` as the machine reads it: the model's `type` and the `tcp` switch.

@@ -24,6 +24,36 @@ pub enum DriveFault {
     FollowingError { joint: usize },
     /// The drive lost its link or power.
     Offline,
+    /// A drive on a bus reported a fault: its error code (CiA 402 object 0x603F) and the
+    /// code's text.
+    Drive {
+        joint: usize,
+        code: u16,
+        text: &'static str,
+    },
+    /// A bus cycle got no answer in time: a frame lost or the link down.
+    LostFrame,
+    /// A bus cycle's working counter was wrong: a drive did not take part.
+    WorkingCounter { expected: u16, got: u16 },
+}
+
+impl std::fmt::Display for DriveFault {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        match self {
+            DriveFault::FollowingError { joint } => {
+                write!(f, "joint {joint}: following error beyond its limit")
+            }
+            DriveFault::Offline => f.write_str("drive offline (link or power lost)"),
+            DriveFault::Drive { joint, code, text } => {
+                write!(f, "joint {joint}: drive error {code:#06x}: {text}")
+            }
+            DriveFault::LostFrame => f.write_str("bus frame lost (no answer within the cycle)"),
+            DriveFault::WorkingCounter { expected, got } => write!(
+                f,
+                "bus working counter {got}, expected {expected}: a drive did not answer"
+            ),
+        }
+    }
 }
 
 /// A set-point sink called from the real-time thread: implementations must not allocate,
