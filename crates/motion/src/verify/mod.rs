@@ -15,7 +15,7 @@ pub mod slack;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use tezgah_geom::deviation::point_segment_distance;
+use tezgah_geom::deviation::point_segment_distance_squared;
 use tezgah_geom::{ToolControl, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, Model, Tool};
 
@@ -172,10 +172,16 @@ impl Against {
             self.next_vertex += 1;
         }
         for v in self.pending.iter_mut() {
-            let d = match previous {
-                Some(p) => point_segment_distance(&v.point, p, tip),
-                None => (v.point - tip).norm(),
+            let d2 = match previous {
+                Some(p) => point_segment_distance_squared(&v.point, p, tip),
+                None => (v.point - tip).norm_squared(),
             };
+            // Most samples pass a vertex farther than they already came: the root only for
+            // a square that may be nearer (a margin over the rounding of both).
+            if d2 > v.distance * v.distance * (1.0 + 1e-9) {
+                continue;
+            }
+            let d = d2.sqrt();
             if d < v.distance {
                 v.distance = d;
                 v.tolerance = seg.tolerance;
@@ -299,11 +305,13 @@ impl Against {
 /// The streaming replay.
 pub struct Verifier {
     period: f64,
-    /// The last three samples' joints, oldest first.
+    /// The last three samples' joints, a ring with the newest at `newest`.
     history: Option<[Joints; 3]>,
+    newest: usize,
     peaks: Vec<JointPeaks>,
     samples: u64,
-    last: Option<Sample>,
+    /// The last sample's tip and line.
+    last: Option<(Vec3, u32)>,
     /// The tool control of the last segment a sample lay on: a dwell's samples lie on none,
     /// and a switch may follow a dwell.
     last_control: Option<ToolControl>,
@@ -331,6 +339,7 @@ impl Verifier {
         Verifier {
             period,
             history: None,
+            newest: 0,
             peaks,
             samples: 0,
             last: None,
@@ -354,9 +363,16 @@ impl Verifier {
 
     /// Takes the sample's finite differences; returns the worst peak/limit ratio over every
     /// joint and v, a, j, and the largest velocity ratio.
-    fn differences(&mut self, q: Joints, line: u32) -> (f64, f64) {
+    fn differences(&mut self, q: &Joints, line: u32) -> (f64, f64) {
         // At rest before the first sample.
-        let [q3, q2, q1] = *self.history.get_or_insert([q; 3]);
+        let history = self.history.get_or_insert([*q; 3]);
+        let n = self.newest;
+        let (q1, q2, q3) = (
+            history[n].as_slice(),
+            history[(n + 2) % 3].as_slice(),
+            history[(n + 1) % 3].as_slice(),
+        );
+        let q = q.as_slice();
         let ts = self.period;
         let mut worst: f64 = 0.0;
         let mut worst_v: f64 = 0.0;
@@ -391,14 +407,17 @@ impl Verifier {
                 *other = Some((line, worst));
             }
         }
-        self.history = Some([q2, q1, q]);
+        // The oldest slot takes the new sample.
+        let oldest = (n + 1) % 3;
+        history[oldest].as_mut_slice().copy_from_slice(q);
+        self.newest = oldest;
         (worst, worst_v)
     }
 
     /// Takes one sample and the path it lies on: the segments passed since the previous
     /// sample, ending with the sample's own (empty while standing still).
     pub fn push(&mut self, s: &Sample, path: &[Arc<Segment>]) {
-        let (worst, velocity) = self.differences(s.joints, s.line);
+        let (worst, velocity) = self.differences(&s.joints, s.line);
         let seg = path.last();
         self.slack
             .push(self.period, seg.map(|g| &**g), s.feed, worst, velocity);
@@ -414,7 +433,7 @@ impl Verifier {
             // The chord to the previous sample: its midpoint against the path between the two
             // samples — every segment passed, not only the two ends: at speed, short segments
             // and blends are entered and left within one period and the chord runs past them.
-            let previous = self.last.as_ref().map(|p| p.tip);
+            let previous = self.last.map(|(tip, _)| tip);
             if let Some(d) = self
                 .follow
                 .push(&s.tip, previous.as_ref(), path, same_reading)
@@ -430,14 +449,15 @@ impl Verifier {
         }
         self.samples += 1;
         self.cycle_time = s.t;
-        self.last = Some(*s);
+        self.last = Some((s.tip, s.line));
     }
 
     /// Ends the replay (at rest after the last sample) and returns the report.
     pub fn finish(mut self) -> Report {
-        if let Some(s) = self.last.take() {
+        if let (Some((_, line)), Some(h)) = (self.last.take(), self.history) {
+            let q = h[self.newest];
             for _ in 0..3 {
-                self.differences(s.joints, s.line);
+                self.differences(&q, line);
             }
         }
         if let Some((l, w)) = self.line_worst.take() {

@@ -201,12 +201,18 @@ impl ProgramPath {
             i += 1;
         }
         let mut best_i = i;
+        // A candidate farther than this from a query (squared) can neither beat its best
+        // nor tie with it, and is passed over without its square root: a sample's window
+        // holds a handful of moves, most of them clearly farther than the nearest.
+        let mut reach = [f64::INFINITY; N];
         while i < self.pieces.len() && self.pieces[i].start <= hi {
             let p = &self.pieces[i];
             let s0 = (lo - p.start).clamp(0.0, p.length);
             let s1 = (hi - p.start).clamp(0.0, p.length);
             for (k, (q, expected)) in queries.iter().enumerate() {
-                let (d, s) = p.nearest(q, s0, s1);
+                let Some((d, s)) = p.nearest_within(q, s0, s1, reach[k]) else {
+                    continue;
+                };
                 let sigma = p.start + s;
                 let b = &mut best[k];
                 let tie = (d - b.distance).abs() <= TIE_MM
@@ -216,6 +222,7 @@ impl ProgramPath {
                         distance: d.min(b.distance),
                         sigma,
                     };
+                    reach[k] = beyond_reach(b.distance);
                     if k == 0 {
                         best_i = i;
                     }
@@ -228,7 +235,29 @@ impl ProgramPath {
     }
 }
 
+/// The squared distance beyond which a candidate is farther than `best + TIE_MM` for certain
+/// (with a margin for the rounding of the square and its root): such a candidate can neither
+/// beat `best` nor tie with it.
+fn beyond_reach(best: f64) -> f64 {
+    let r = (best + 2.0 * TIE_MM) * (1.0 + 1e-9);
+    r * r
+}
+
 impl Piece {
+    /// [`Piece::nearest`], or `None` for a line whose nearest point is farther than
+    /// `reach` squared ([`beyond_reach`]): the exact distance is then not needed.
+    #[inline]
+    fn nearest_within(&self, q: &Vec3, s0: f64, s1: f64, reach: f64) -> Option<(f64, f64)> {
+        match &self.geo {
+            Geo::Line { start, dir } => {
+                let s = (q - start).dot(dir).clamp(s0, s1);
+                let d2 = (start + dir * s - q).norm_squared();
+                (d2 <= reach).then(|| (d2.sqrt(), s))
+            }
+            _ => Some(self.nearest(q, s0, s1)),
+        }
+    }
+
     /// Distance from `q` to the piece's part `s ∈ [s0, s1]` and the `s` where it is reached.
     fn nearest(&self, q: &Vec3, s0: f64, s1: f64) -> (f64, f64) {
         match &self.geo {
