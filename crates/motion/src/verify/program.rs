@@ -178,6 +178,19 @@ impl ProgramPath {
         n
     }
 
+    /// The distance from `q` to piece `i`'s part within `[lo, hi]` (`None` where there is
+    /// none): an upper bound, within [`TIE_DISTANCE_MM`], of what [`ProgramPath::nearest`]
+    /// finds over a window holding that part.
+    pub fn piece_distance(&self, i: usize, q: &Vec3, (lo, hi): (f64, f64)) -> Option<f64> {
+        let p = self.pieces.get(i)?;
+        if p.start > hi || p.start + p.length < lo {
+            return None;
+        }
+        let s0 = (lo - p.start).clamp(0.0, p.length);
+        let s1 = (hi - p.start).clamp(0.0, p.length);
+        Some(p.nearest(q, s0, s1).0)
+    }
+
     /// [`ProgramPath::nearest`] for several points over one window in one pass over its
     /// pieces (a sample's tip and its chord's midpoint); `hint` follows the first point.
     pub fn nearest_all<const N: usize>(
@@ -210,8 +223,18 @@ impl ProgramPath {
             let s0 = (lo - p.start).clamp(0.0, p.length);
             let s1 = (hi - p.start).clamp(0.0, p.length);
             for (k, (q, expected)) in queries.iter().enumerate() {
-                let Some((d, s)) = p.nearest_within(q, s0, s1, reach[k]) else {
-                    continue;
+                let (d, s) = match &p.geo {
+                    // Lines, nearly every move of a dense program, inline: the square root
+                    // only for a candidate within reach.
+                    Geo::Line { start, dir } => {
+                        let s = (*q - start).dot(dir).clamp(s0, s1);
+                        let d2 = (start + dir * s - *q).norm_squared();
+                        if d2 > reach[k] {
+                            continue;
+                        }
+                        (d2.sqrt(), s)
+                    }
+                    _ => p.nearest(q, s0, s1),
                 };
                 let sigma = p.start + s;
                 let b = &mut best[k];
@@ -235,6 +258,10 @@ impl ProgramPath {
     }
 }
 
+/// Distances this close (mm) are a tie for [`ProgramPath::nearest`]: what it returns is at
+/// most this much over the distance from any one candidate in its window.
+pub const TIE_DISTANCE_MM: f64 = TIE_MM;
+
 /// The squared distance beyond which a candidate is farther than `best + TIE_MM` for certain
 /// (with a margin for the rounding of the square and its root): such a candidate can neither
 /// beat `best` nor tie with it.
@@ -244,20 +271,6 @@ fn beyond_reach(best: f64) -> f64 {
 }
 
 impl Piece {
-    /// [`Piece::nearest`], or `None` for a line whose nearest point is farther than
-    /// `reach` squared ([`beyond_reach`]): the exact distance is then not needed.
-    #[inline]
-    fn nearest_within(&self, q: &Vec3, s0: f64, s1: f64, reach: f64) -> Option<(f64, f64)> {
-        match &self.geo {
-            Geo::Line { start, dir } => {
-                let s = (q - start).dot(dir).clamp(s0, s1);
-                let d2 = (start + dir * s - q).norm_squared();
-                (d2 <= reach).then(|| (d2.sqrt(), s))
-            }
-            _ => Some(self.nearest(q, s0, s1)),
-        }
-    }
-
     /// Distance from `q` to the piece's part `s ∈ [s0, s1]` and the `s` where it is reached.
     fn nearest(&self, q: &Vec3, s0: f64, s1: f64) -> (f64, f64) {
         match &self.geo {
