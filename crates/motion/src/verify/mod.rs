@@ -247,14 +247,17 @@ impl Against {
         hint: usize,
         seg: &Segment,
     ) -> Option<Nearest> {
-        let settled = self
-            .program
-            .piece_distance(self.hint, &mid, window)
-            .is_some_and(|c| {
-                // The search's answer is at most `c` plus its tie margin.
-                let c = c + 2.0 * TIE_DISTANCE_MM;
-                c <= tip || (c <= self.peak.distance && c / seg.tolerance <= self.peak.ratio)
-            });
+        let settles = |i: usize| {
+            self.program
+                .piece_distance(i, &mid, window)
+                .is_some_and(|c| {
+                    // The search's answer is at most `c` plus its tie margin.
+                    let c = c + 2.0 * TIE_DISTANCE_MM;
+                    c <= tip || (c <= self.peak.distance && c / seg.tolerance <= self.peak.ratio)
+                })
+        };
+        // The tip's move, or the one before it where the tip has just passed a vertex.
+        let settled = settles(self.hint) || self.hint.checked_sub(1).is_some_and(settles);
         if settled {
             return None;
         }
