@@ -20,6 +20,7 @@ use tezgah_motion::verify::{Report, Verifier};
 
 use crate::diagnostics::report_line;
 use crate::plot::Trace;
+use crate::replay::Replay;
 use crate::tracking::{DriveKind, Tracker, Tracking};
 
 /// The path a machine will follow, checked whole before anything moves.
@@ -228,16 +229,43 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     // The program as the interpreter emitted it (probe moves ending where the machine
     // stopped), which `verify` measures the samples against.
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
-    let program = ProgramPath::new(Pose::ZERO, pm.initial, &probed.moves);
+    let make_verifier = || {
+        let program = ProgramPath::new(Pose::ZERO, pm.initial, &probed.moves);
+        Verifier::new(&pm, period).against(&pm, program)
+    };
+    // The replay on a second thread, from here (its program path is built while this thread
+    // builds the path to plan) to the report.
+    std::thread::scope(|scope| {
+        let replay = Replay::start(scope, &make_verifier);
+        play_and_report(
+            &args, &machine, &probed, &pm, replay, period, tolerance, &name,
+        )
+    })
+}
+
+/// The rest of [`run`]: the path built and played, every sample to `replay` and the sinks the
+/// options ask for, then the report, plots and summary.
+#[allow(clippy::too_many_arguments)]
+fn play_and_report(
+    args: &RunArgs,
+    machine: &Machine,
+    probed: &crate::run_probe::Probed,
+    pm: &PlanMachine,
+    mut replay: Replay,
+    period: f64,
+    tolerance: f64,
+    name: &str,
+) -> Result<std::process::ExitCode> {
+    let options = plan_options(period);
     let start = Pose::ZERO;
-    let first = crate::run_probe::first_part(&probed, &machine, tolerance)?;
+    let first = crate::run_probe::first_part(probed, machine, tolerance)?;
 
     // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
         .joints
         .iter()
         .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary);
-    let mut tool = SampleTool::new(&pm);
+    let mut tool = SampleTool::new(pm);
     let mut csv = match &args.samples {
         Some(p) => {
             let f = std::fs::File::create(p)
@@ -258,7 +286,6 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let scales: Vec<f64> = (0..machine.joints.len())
         .map(|i| unit(&machine, i).1)
         .collect();
-    let mut verifier = Verifier::new(&pm, period).against(&pm, program);
     let mut tracker = match args.drive {
         DriveKind::Ideal => None,
         DriveKind::Servo => {
@@ -282,7 +309,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let mut count: u64 = 0;
     let mut line_buf = String::with_capacity(256);
     let sink = |s: &Sample, seg: &[std::sync::Arc<tezgah_motion::Segment>]| {
-        verifier.push(s, seg);
+        replay.push(s, seg);
         if let Some(t) = tracker.as_mut() {
             t.push(s);
         }
@@ -329,7 +356,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let mut sink = sink;
     let (duration, segments, axis) =
-        crate::run_probe::play(&probed, first, &machine, tolerance, &options, &mut sink)?;
+        crate::run_probe::play(probed, first, machine, tolerance, &options, &mut sink)?;
     let axis = axis.unwrap_or(AxisFigures {
         deviation_deg: 0.0,
         tolerance_deg: 0.0,
@@ -347,7 +374,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if let Some(mut w) = csv {
         w.flush().into_diagnostic()?;
     }
-    let report = verifier.finish();
+    let report = replay.finish()?;
     let tracking = tracker.map(Tracker::finish);
     if let Some(p) = &args.report {
         let mut json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
