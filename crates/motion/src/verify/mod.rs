@@ -234,11 +234,11 @@ impl Against {
     }
 
     /// The chord's midpoint `mid` (and its expected `σ`) against the program over `window`
-    /// (`hint` as the tip's
-    /// search had it), or `None` where its distance cannot change the report: where the
-    /// tip's nearest move already comes within `tip` (the sample's distance is the larger of
-    /// the two) or within the peak so far, by more than the search's tie margin. A midpoint
-    /// is nearly always that near: this saves most of a second search per sample.
+    /// (`hint` as the tip's search had it), or `None` where its distance cannot change the
+    /// report: where the tip's move, or the one before it, already comes within `tip` (the
+    /// sample's distance is the larger of the two) or within the peak so far, by more than
+    /// the search's tie margin. The peak only grows, so the report is the full search's. A
+    /// midpoint is nearly always that near: this saves most of a second search per sample.
     fn midpoint(
         &self,
         (mid, expected): (Vec3, f64),
