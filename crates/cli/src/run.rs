@@ -284,7 +284,7 @@ fn play_and_report(
         None => None,
     };
     let scales: Vec<f64> = (0..machine.joints.len())
-        .map(|i| unit(&machine, i).1)
+        .map(|i| unit(machine, i).1)
         .collect();
     let mut tracker = match args.drive {
         DriveKind::Ideal => None,
@@ -298,7 +298,7 @@ fn play_and_report(
                 )
                 .map_err(|e| miette!("{e}"))?;
             Some(
-                Tracker::new(&machine, pm.model.clone(), period, start_joints)
+                Tracker::new(machine, pm.model.clone(), period, start_joints)
                     .map_err(|e| miette!("--drive servo: {e}"))?,
             )
         }
@@ -377,16 +377,16 @@ fn play_and_report(
     let report = replay.finish()?;
     let tracking = tracker.map(Tracker::finish);
     if let Some(p) = &args.report {
-        let mut json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
+        let mut json = report_json(machine, &report, duration, name, period, tolerance, &axis);
         json["drive"] = serde_json::json!(match args.drive {
             DriveKind::Ideal => "ideal",
             DriveKind::Servo => "servo",
         });
         if let Some(t) = &tracking {
-            json["tracking"] = tracking_json(&machine, t);
+            json["tracking"] = tracking_json(machine, t);
         }
         if !probed.steps.is_empty() {
-            json["probes"] = crate::run_probe::probes_json(&probed);
+            json["probes"] = crate::run_probe::probes_json(probed);
         }
         crate::library::write_json(p, &json)?;
     }
@@ -398,21 +398,21 @@ fn play_and_report(
             .enumerate()
             .map(|(i, j)| crate::plot::JointInfo {
                 name: j.name.clone(),
-                unit: unit(&machine, i).0,
+                unit: unit(machine, i).0,
                 limits: [j.max_velocity, j.max_acceleration, j.max_jerk],
             })
             .collect();
         let files =
-            crate::plot::write_all(dir, t, &joints, period, &name).map_err(|e| miette!("{e}"))?;
+            crate::plot::write_all(dir, t, &joints, period, name).map_err(|e| miette!("{e}"))?;
         println!("plots: {} files in {}", files, dir.display());
     }
     summary(
-        &machine, &report, duration, &name, segments, period, tolerance, &axis,
+        machine, &report, duration, name, segments, period, tolerance, &axis,
     );
     if let Some(t) = &tracking {
-        tracking_summary(&machine, t);
+        tracking_summary(machine, t);
     }
-    crate::run_probe::probe_summary(&probed);
+    crate::run_probe::probe_summary(probed);
     let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
         || report.deviation_ratio > 1.0
         || tracking.as_ref().is_some_and(|t| t.fault.is_some());
