@@ -11,6 +11,7 @@ mod library;
 mod panel;
 mod plot;
 mod preview;
+mod replay;
 mod run;
 mod run_probe;
 mod run_synced;

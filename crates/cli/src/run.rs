@@ -20,6 +20,7 @@ use tezgah_motion::verify::{Report, Verifier};
 
 use crate::diagnostics::report_line;
 use crate::plot::Trace;
+use crate::replay::Replay;
 use crate::tracking::{DriveKind, Tracker, Tracking};
 
 /// The path a machine will follow, checked whole before anything moves.
@@ -248,16 +249,44 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let pm = PlanMachine::from_machine(&machine).map_err(|e| miette!("{e}"))?;
     let synced = crate::run_synced::run_synced_moves(&probed, &machine, tolerance, &options)?;
     let reference = crate::run_synced::reference_moves(&probed.moves, &synced);
-    let program = ProgramPath::new(Pose::ZERO, pm.initial, &reference);
+    let make_verifier = || {
+        let program = ProgramPath::new(Pose::ZERO, pm.initial, &reference);
+        Verifier::new(&pm, period).against(&pm, program)
+    };
+    // The replay on a second thread, from here (its program path is built while this thread
+    // builds the path to plan) to the report.
+    std::thread::scope(|scope| {
+        let replay = Replay::start(scope, &make_verifier);
+        play_and_report(
+            &args, &machine, &probed, &synced, &pm, replay, period, tolerance, &name,
+        )
+    })
+}
+
+/// The rest of [`run`]: the path built and played, every sample to `replay` and the sinks the
+/// options ask for, then the report, plots and summary.
+#[allow(clippy::too_many_arguments)]
+fn play_and_report(
+    args: &RunArgs,
+    machine: &Machine,
+    probed: &crate::run_probe::Probed,
+    synced: &[crate::run_synced::SyncStep],
+    pm: &PlanMachine,
+    mut replay: Replay,
+    period: f64,
+    tolerance: f64,
+    name: &str,
+) -> Result<std::process::ExitCode> {
+    let options = plan_options(period);
     let start = Pose::ZERO;
-    let first = crate::run_probe::first_part(&probed, &synced, &machine, tolerance)?;
+    let first = crate::run_probe::first_part(probed, synced, machine, tolerance)?;
 
     // The tool axis columns, for machines with rotary joints.
     let with_axis = machine
         .joints
         .iter()
         .any(|j| j.kind == tezgah_kinematics::JointKind::Rotary);
-    let mut tool = SampleTool::new(&pm);
+    let mut tool = SampleTool::new(pm);
     let mut csv = match &args.samples {
         Some(p) => {
             let f = std::fs::File::create(p)
@@ -276,9 +305,8 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
         None => None,
     };
     let scales: Vec<f64> = (0..machine.joints.len())
-        .map(|i| unit(&machine, i).1)
+        .map(|i| unit(machine, i).1)
         .collect();
-    let mut verifier = Verifier::new(&pm, period).against(&pm, program);
     let mut tracker = match args.drive {
         DriveKind::Ideal => None,
         DriveKind::Servo => {
@@ -291,7 +319,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
                 )
                 .map_err(|e| miette!("{e}"))?;
             Some(
-                Tracker::new(&machine, pm.model.clone(), period, start_joints)
+                Tracker::new(machine, pm.model.clone(), period, start_joints)
                     .map_err(|e| miette!("--drive servo: {e}"))?,
             )
         }
@@ -302,7 +330,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     let mut count: u64 = 0;
     let mut line_buf = String::with_capacity(256);
     let sink = |s: &Sample, seg: &[std::sync::Arc<tezgah_motion::Segment>]| {
-        verifier.push(s, seg);
+        replay.push(s, seg);
         if let Some(t) = tracker.as_mut() {
             t.push(s);
         }
@@ -349,7 +377,7 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     };
     let mut sink = sink;
     let (duration, segments, axis) = crate::run_probe::play(
-        &probed, &synced, first, &machine, tolerance, &options, &mut sink,
+        probed, synced, first, machine, tolerance, &options, &mut sink,
     )?;
     let axis = axis.unwrap_or(AxisFigures {
         deviation_deg: 0.0,
@@ -368,22 +396,22 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
     if let Some(mut w) = csv {
         w.flush().into_diagnostic()?;
     }
-    let report = verifier.finish();
+    let report = replay.finish()?;
     let tracking = tracker.map(Tracker::finish);
     if let Some(p) = &args.report {
-        let mut json = report_json(&machine, &report, duration, &name, period, tolerance, &axis);
+        let mut json = report_json(machine, &report, duration, name, period, tolerance, &axis);
         json["drive"] = serde_json::json!(match args.drive {
             DriveKind::Ideal => "ideal",
             DriveKind::Servo => "servo",
         });
         if let Some(t) = &tracking {
-            json["tracking"] = tracking_json(&machine, t);
+            json["tracking"] = tracking_json(machine, t);
         }
         if !probed.steps.is_empty() {
-            json["probes"] = crate::run_probe::probes_json(&probed);
+            json["probes"] = crate::run_probe::probes_json(probed);
         }
         if !synced.is_empty() {
-            json["synced"] = crate::run_synced::synced_json(&synced);
+            json["synced"] = crate::run_synced::synced_json(synced);
         }
         crate::library::write_json(p, &json)?;
     }
@@ -395,22 +423,22 @@ pub fn run(args: RunArgs) -> Result<std::process::ExitCode> {
             .enumerate()
             .map(|(i, j)| crate::plot::JointInfo {
                 name: j.name.clone(),
-                unit: unit(&machine, i).0,
+                unit: unit(machine, i).0,
                 limits: [j.max_velocity, j.max_acceleration, j.max_jerk],
             })
             .collect();
         let files =
-            crate::plot::write_all(dir, t, &joints, period, &name).map_err(|e| miette!("{e}"))?;
+            crate::plot::write_all(dir, t, &joints, period, name).map_err(|e| miette!("{e}"))?;
         println!("plots: {} files in {}", files, dir.display());
     }
     summary(
-        &machine, &report, duration, &name, segments, period, tolerance, &axis,
+        machine, &report, duration, name, segments, period, tolerance, &axis,
     );
     if let Some(t) = &tracking {
-        tracking_summary(&machine, t);
+        tracking_summary(machine, t);
     }
-    crate::run_probe::probe_summary(&probed);
-    crate::run_synced::synced_summary(&synced);
+    crate::run_probe::probe_summary(probed);
+    crate::run_synced::synced_summary(synced);
     let over = report.joints.iter().any(|j| j.worst_ratio() > 1.005)
         || report.deviation_ratio > 1.0
         || tracking.as_ref().is_some_and(|t| t.fault.is_some());

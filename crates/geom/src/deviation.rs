@@ -20,7 +20,15 @@ pub struct Deviation {
 }
 
 /// Distance from `p` to the segment `a`–`b` (a point when `a = b`).
+#[inline]
 pub fn point_segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
+    point_segment_distance_squared(p, a, b).sqrt()
+}
+
+/// The square of [`point_segment_distance`] (its root is that distance bit for bit): for
+/// comparisons that need the root only when a candidate is near enough.
+#[inline]
+pub fn point_segment_distance_squared(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
     let ab = b - a;
     let len2 = ab.norm_squared();
     let t = if len2 > 0.0 {
@@ -28,7 +36,7 @@ pub fn point_segment_distance(p: &Vec3, a: &Vec3, b: &Vec3) -> f64 {
     } else {
         0.0
     };
-    (p - (a + ab * t)).norm()
+    (p - (a + ab * t)).norm_squared()
 }
 
 /// Distance from `p` to the polyline (brute force over its segments).

@@ -62,8 +62,11 @@ impl Follow {
                     return (s.curve.point(sa) - mid).norm();
                 }
                 let (lo, start) = if Arc::ptr_eq(s, &last.seg) {
+                    // The last midpoint was half a chord behind the previous sample, this
+                    // one is half a chord past it: a whole chord on (at a steady speed the
+                    // first Newton step then confirms the guess).
                     let step = if last.speed > 0.0 {
-                        half / last.speed
+                        2.0 * half / last.speed
                     } else {
                         0.0
                     };
@@ -86,11 +89,17 @@ impl Follow {
             }
             d_chord = Some(best);
         }
-        self.last = Some(Last {
-            seg: seg.clone(),
-            u: next.0,
-            speed: next.1,
-        });
+        match &mut self.last {
+            // The same segment: no new reference to count.
+            Some(l) if Arc::ptr_eq(&l.seg, seg) => (l.u, l.speed) = next,
+            last => {
+                *last = Some(Last {
+                    seg: seg.clone(),
+                    u: next.0,
+                    speed: next.1,
+                })
+            }
+        }
         d_chord
     }
 }

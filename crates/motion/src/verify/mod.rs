@@ -15,7 +15,7 @@ pub mod slack;
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use tezgah_geom::deviation::point_segment_distance;
+use tezgah_geom::deviation::point_segment_distance_squared;
 use tezgah_geom::{ToolControl, Vec3};
 use tezgah_kinematics::{Joints, Kinematics, Model, Tool};
 
@@ -24,7 +24,7 @@ use crate::path::{Junction, Segment, SegmentFeed};
 use crate::plan::PlanMachine;
 
 use follow::Follow;
-use program::ProgramPath;
+use program::{Nearest, ProgramPath, TIE_DISTANCE_MM};
 use slack::Slack;
 
 /// Peaks of one joint (internal units: mm or rad).
@@ -172,10 +172,16 @@ impl Against {
             self.next_vertex += 1;
         }
         for v in self.pending.iter_mut() {
-            let d = match previous {
-                Some(p) => point_segment_distance(&v.point, p, tip),
-                None => (v.point - tip).norm(),
+            let d2 = match previous {
+                Some(p) => point_segment_distance_squared(&v.point, p, tip),
+                None => (v.point - tip).norm_squared(),
             };
+            // Most samples pass a vertex farther than they already came: the root only for
+            // a square that may be nearer (a margin over the rounding of both).
+            if d2 > v.distance * v.distance * (1.0 + 1e-9) {
+                continue;
+            }
+            let d = d2.sqrt();
             if d < v.distance {
                 v.distance = d;
                 v.tolerance = seg.tolerance;
@@ -227,6 +233,40 @@ impl Against {
         }
     }
 
+    /// The chord's midpoint `mid` (and its expected `σ`) against the program over `window`
+    /// (`hint` as the tip's search had it), or `None` where its distance cannot change the
+    /// report: where the tip's move, or the one before it, already comes within `tip` (the
+    /// sample's distance is the larger of the two) or within the peak so far, by more than
+    /// the search's tie margin. The peak only grows, so the report is the full search's. A
+    /// midpoint is nearly always that near: this saves most of a second search per sample.
+    fn midpoint(
+        &self,
+        (mid, expected): (Vec3, f64),
+        tip: f64,
+        window: (f64, f64),
+        hint: usize,
+        seg: &Segment,
+    ) -> Option<Nearest> {
+        let settles = |i: usize| {
+            self.program
+                .piece_distance(i, &mid, window)
+                .is_some_and(|c| {
+                    // The search's answer is at most `c` plus its tie margin.
+                    let c = c + 2.0 * TIE_DISTANCE_MM;
+                    c <= tip || (c <= self.peak.distance && c / seg.tolerance <= self.peak.ratio)
+                })
+        };
+        // The tip's move, or the one before it where the tip has just passed a vertex.
+        let settled = settles(self.hint) || self.hint.checked_sub(1).is_some_and(settles);
+        if settled {
+            return None;
+        }
+        Some(
+            self.program
+                .nearest(&mid, window, expected, &mut hint.clone()),
+        )
+    }
+
     /// Measures the sample against the program between `σ − w` and `σ + w` around the
     /// cursor: `w` covers the step from the last sample and both samples' distances from the
     /// program (the nearest points are at most that far apart) twice over, and the tolerance.
@@ -239,26 +279,17 @@ impl Against {
         // samples (a feature the path leaves out) the cursor catches up at once.
         let (before, after) = self.program.around(self.hint);
         let (lo, hi) = (lo.min(before), hi.max(after));
-        // The tip and the chord's midpoint, in one pass over the window.
-        let mid = match (chord, self.last_tip) {
-            (true, Some(p)) => Some(0.5 * (p + tip)),
+        // The tip, then the chord's midpoint over the same window.
+        let hint = self.hint;
+        let n = self
+            .program
+            .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
+        let m = match (chord, self.last_tip) {
+            (true, Some(p)) => {
+                let mid = (0.5 * (p + tip), self.sigma + 0.5 * step);
+                self.midpoint(mid, n.distance, (lo, hi), hint, seg)
+            }
             _ => None,
-        };
-        let (n, m) = match &mid {
-            Some(mid) => {
-                let [n, m] = self.program.nearest_all(
-                    [(&tip, self.sigma + step), (mid, self.sigma + 0.5 * step)],
-                    (lo, hi),
-                    &mut self.hint,
-                );
-                (n, Some(m))
-            }
-            None => {
-                let n = self
-                    .program
-                    .nearest(&tip, (lo, hi), self.sigma + step, &mut self.hint);
-                (n, None)
-            }
         };
         // A take-up at a tool-control switch (a rapid straight in joint space, TCP off, ending
         // at rest) runs between two readings of the program point and is not the program's:
@@ -280,7 +311,7 @@ impl Against {
             self.last_tip = None;
             return;
         }
-        let d = m.map_or(n.distance, |m| n.distance.max(m.distance));
+        let d = m.map_or(n.distance, |m: Nearest| n.distance.max(m.distance));
         if d.is_finite() {
             self.peak.push(d, seg.tolerance, s.line);
         }
@@ -299,11 +330,13 @@ impl Against {
 /// The streaming replay.
 pub struct Verifier {
     period: f64,
-    /// The last three samples' joints, oldest first.
+    /// The last three samples' joints, a ring with the newest at `newest`.
     history: Option<[Joints; 3]>,
+    newest: usize,
     peaks: Vec<JointPeaks>,
     samples: u64,
-    last: Option<Sample>,
+    /// The last sample's tip and line.
+    last: Option<(Vec3, u32)>,
     /// The tool control of the last segment a sample lay on: a dwell's samples lie on none,
     /// and a switch may follow a dwell.
     last_control: Option<ToolControl>,
@@ -331,6 +364,7 @@ impl Verifier {
         Verifier {
             period,
             history: None,
+            newest: 0,
             peaks,
             samples: 0,
             last: None,
@@ -354,16 +388,25 @@ impl Verifier {
 
     /// Takes the sample's finite differences; returns the worst peak/limit ratio over every
     /// joint and v, a, j, and the largest velocity ratio.
-    fn differences(&mut self, q: Joints, line: u32) -> (f64, f64) {
+    fn differences(&mut self, q: &Joints, line: u32) -> (f64, f64) {
         // At rest before the first sample.
-        let [q3, q2, q1] = *self.history.get_or_insert([q; 3]);
+        let history = self.history.get_or_insert([*q; 3]);
+        let n = self.newest;
+        let (q1, q2, q3) = (
+            history[n].as_slice(),
+            history[(n + 2) % 3].as_slice(),
+            history[(n + 1) % 3].as_slice(),
+        );
+        let q = q.as_slice();
         let ts = self.period;
         let mut worst: f64 = 0.0;
         let mut worst_v: f64 = 0.0;
-        for (i, p) in self.peaks.iter_mut().enumerate() {
-            let v = (q[i] - q1[i]).abs() / ts;
-            let a = (q[i] - 2.0 * q1[i] + q2[i]).abs() / (ts * ts);
-            let j = (q[i] - 3.0 * q1[i] + 3.0 * q2[i] - q3[i]).abs() / (ts * ts * ts);
+        let (ts2, ts3) = (ts * ts, ts * ts * ts);
+        let joints = q.iter().zip(q1).zip(q2).zip(q3);
+        for (p, (((q, q1), q2), q3)) in self.peaks.iter_mut().zip(joints) {
+            let v = (q - q1).abs() / ts;
+            let a = (q - 2.0 * q1 + q2).abs() / ts2;
+            let j = (q - 3.0 * q1 + 3.0 * q2 - q3).abs() / ts3;
             if v > p.velocity {
                 p.velocity = v;
                 p.velocity_line = line;
@@ -391,14 +434,17 @@ impl Verifier {
                 *other = Some((line, worst));
             }
         }
-        self.history = Some([q2, q1, q]);
+        // The oldest slot takes the new sample.
+        let oldest = (n + 1) % 3;
+        history[oldest].as_mut_slice().copy_from_slice(q);
+        self.newest = oldest;
         (worst, worst_v)
     }
 
     /// Takes one sample and the path it lies on: the segments passed since the previous
     /// sample, ending with the sample's own (empty while standing still).
     pub fn push(&mut self, s: &Sample, path: &[Arc<Segment>]) {
-        let (worst, velocity) = self.differences(s.joints, s.line);
+        let (worst, velocity) = self.differences(&s.joints, s.line);
         let seg = path.last();
         self.slack
             .push(self.period, seg.map(|g| &**g), s.feed, worst, velocity);
@@ -414,7 +460,7 @@ impl Verifier {
             // The chord to the previous sample: its midpoint against the path between the two
             // samples — every segment passed, not only the two ends: at speed, short segments
             // and blends are entered and left within one period and the chord runs past them.
-            let previous = self.last.as_ref().map(|p| p.tip);
+            let previous = self.last.map(|(tip, _)| tip);
             if let Some(d) = self
                 .follow
                 .push(&s.tip, previous.as_ref(), path, same_reading)
@@ -430,14 +476,15 @@ impl Verifier {
         }
         self.samples += 1;
         self.cycle_time = s.t;
-        self.last = Some(*s);
+        self.last = Some((s.tip, s.line));
     }
 
     /// Ends the replay (at rest after the last sample) and returns the report.
     pub fn finish(mut self) -> Report {
-        if let Some(s) = self.last.take() {
+        if let (Some((_, line)), Some(h)) = (self.last.take(), self.history) {
+            let q = h[self.newest];
             for _ in 0..3 {
-                self.differences(s.joints, s.line);
+                self.differences(&q, line);
             }
         }
         if let Some((l, w)) = self.line_worst.take() {

@@ -178,6 +178,19 @@ impl ProgramPath {
         n
     }
 
+    /// The distance from `q` to piece `i`'s part within `[lo, hi]` (`None` where there is
+    /// none): an upper bound, within [`TIE_DISTANCE_MM`], of what [`ProgramPath::nearest`]
+    /// finds over a window holding that part.
+    pub fn piece_distance(&self, i: usize, q: &Vec3, (lo, hi): (f64, f64)) -> Option<f64> {
+        let p = self.pieces.get(i)?;
+        if p.start > hi || p.start + p.length < lo {
+            return None;
+        }
+        let s0 = (lo - p.start).clamp(0.0, p.length);
+        let s1 = (hi - p.start).clamp(0.0, p.length);
+        Some(p.nearest(q, s0, s1).0)
+    }
+
     /// [`ProgramPath::nearest`] for several points over one window in one pass over its
     /// pieces (a sample's tip and its chord's midpoint); `hint` follows the first point.
     pub fn nearest_all<const N: usize>(
@@ -201,12 +214,28 @@ impl ProgramPath {
             i += 1;
         }
         let mut best_i = i;
+        // A candidate farther than this from a query (squared) can neither beat its best
+        // nor tie with it, and is passed over without its square root: a sample's window
+        // holds a handful of moves, most of them clearly farther than the nearest.
+        let mut reach = [f64::INFINITY; N];
         while i < self.pieces.len() && self.pieces[i].start <= hi {
             let p = &self.pieces[i];
             let s0 = (lo - p.start).clamp(0.0, p.length);
             let s1 = (hi - p.start).clamp(0.0, p.length);
             for (k, (q, expected)) in queries.iter().enumerate() {
-                let (d, s) = p.nearest(q, s0, s1);
+                let (d, s) = match &p.geo {
+                    // Lines, nearly every move of a dense program, inline: the square root
+                    // only for a candidate within reach.
+                    Geo::Line { start, dir } => {
+                        let s = (*q - start).dot(dir).clamp(s0, s1);
+                        let d2 = (start + dir * s - *q).norm_squared();
+                        if d2 > reach[k] {
+                            continue;
+                        }
+                        (d2.sqrt(), s)
+                    }
+                    _ => p.nearest(q, s0, s1),
+                };
                 let sigma = p.start + s;
                 let b = &mut best[k];
                 let tie = (d - b.distance).abs() <= TIE_MM
@@ -216,6 +245,7 @@ impl ProgramPath {
                         distance: d.min(b.distance),
                         sigma,
                     };
+                    reach[k] = beyond_reach(b.distance);
                     if k == 0 {
                         best_i = i;
                     }
@@ -226,6 +256,18 @@ impl ProgramPath {
         *hint = best_i;
         best
     }
+}
+
+/// Distances this close (mm) are a tie for [`ProgramPath::nearest`]: what it returns is at
+/// most this much over the distance from any one candidate in its window.
+pub const TIE_DISTANCE_MM: f64 = TIE_MM;
+
+/// The squared distance beyond which a candidate is farther than `best + TIE_MM` for certain
+/// (with a margin for the rounding of the square and its root): such a candidate can neither
+/// beat `best` nor tie with it.
+fn beyond_reach(best: f64) -> f64 {
+    let r = (best + 2.0 * TIE_MM) * (1.0 + 1e-9);
+    r * r
 }
 
 impl Piece {
