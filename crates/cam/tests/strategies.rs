@@ -900,3 +900,42 @@ fn a_trimmed_face_is_stepped_for_itself_not_for_its_surface() {
     assert!(v.max_scallop_mm > 0.6 * h, "{v:?}");
     assert!(v.gouge_depth_mm <= 0.001, "{v:?}");
 }
+
+#[test]
+fn a_ball_keeps_its_lean_on_the_way_back_and_a_flat_end_leads_both_ways() {
+    // Zig-zag over a plane with a 10° lead (issue 23): a ball's axis is the same on every
+    // pass (it trails on the way back, and cuts the same), so the table does not turn over
+    // at the links; a flat end leads on every pass, its axis mirrored on the way back.
+    let s = testing::plane(10.0);
+    let lead = |shape: CutterShape, deg: f64| {
+        let mut settings = Settings::new(StrategyKind::ZigZag, 0.5, 0.05);
+        settings.axis = ToolAxis::Surface {
+            lead_deg: deg,
+            tilt_deg: 0.0,
+            max_lead_deg: 30.0,
+            match_curvature: true,
+        };
+        let p = plan(&s, &Cutter::standard(shape), &settings).unwrap();
+        assert!(p.path.passes.len() >= 3 && p.refused.is_empty());
+        p
+    };
+    let p = lead(CutterShape::Ball { radius: 3.0 }, 10.0);
+    let first = p.path.passes[0].points[0].axis;
+    assert!(
+        (first.z - 10f64.to_radians().cos()).abs() < 1e-12,
+        "{first:?}"
+    );
+    for cl in p.path.passes.iter().flat_map(|q| &q.points) {
+        assert!(
+            (cl.axis - first).norm() < 1e-12,
+            "{:?} vs {first:?}",
+            cl.axis
+        );
+    }
+    let p = lead(CutterShape::Flat { radius: 3.0 }, 5.0);
+    let (out, back) = (p.path.passes[0].points[0], p.path.passes[1].points[0]);
+    // Leaning toward the feed: the axis' horizontal part along the pass's own direction.
+    let along = |q: &Pass| q.points[q.points.len() - 1].contact - q.points[0].contact;
+    assert!(out.axis.dot(&along(&p.path.passes[0])) > 0.0);
+    assert!(back.axis.dot(&along(&p.path.passes[1])) > 0.0);
+}
