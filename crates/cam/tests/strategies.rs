@@ -501,10 +501,11 @@ fn curvature_matched_flat_end_beats_the_ball_of_the_same_diameter() {
     // path than a ball of the same diameter. Free-form patch, D6, iso-scallop, h = 0.04, lead 5°
     // (raised where the cross-feed section is concave, and where the heel would gouge). A tight
     // chord tolerance (a tenth of h), so the material left below is the scallop, not the chords.
-    // (It ran at h = 0.01, with four times the locations: both steps grow as √h while h is
-    // small against the radii.)
+    // (It ran at h = 0.01, then 0.04 (−65.5 %), now 0.08 (−53.1 %, a fifth of the time): the
+    // ball's step grows as √h while h is small against the radii, the flat end's is near its
+    // cap (its radius) already, so the saving shrinks with h and stays above Can's.)
     let s = testing::freeform(0.0);
-    let (h, tolerance) = (0.04, 0.004);
+    let (h, tolerance) = (0.08, 0.008);
     let mut settings = Settings::new(StrategyKind::IsoScallop, h, tolerance);
     let ball_plan = plan(&s, &ball(6.0), &settings).unwrap();
     settings.axis = ToolAxis::Surface {
