@@ -395,6 +395,10 @@ fn a_band_wider_than_the_scallop_is_refused() {
 /// radii (≥ 26 mm) and the curvature varies across it, where the osculating-circle model is
 /// least sure; every side step is also checked on the true surface (`true_cusp`). Only the
 /// largest ball runs here (the 12 and 20 mm ones measured 0.196 mm: the session-5 note).
+/// The rear check is off: a ball standing on the normal cannot reach the surface behind its
+/// contact where every concave radius (≥ 26 mm) exceeds its own (16 mm), and the simulation
+/// still measures the gouge. With it on, its proof of that over a 32 mm ball was nine tenths
+/// of the tests' time (a minute each).
 fn step_free_form_large_ball(kind: StrategyKind, name: &str) {
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
@@ -404,15 +408,13 @@ fn step_free_form_large_ball(kind: StrategyKind, name: &str) {
     let face = &model.faces[0];
     let mut settings = banded(kind, 0.2, 0.0);
     settings.reverse_normal = !face.same_sense;
+    settings.gouge.rear = false;
     assert_within(name, &face.surface, &ball(32.0), &settings, 0.8);
 }
 
-#[test]
-fn step_free_form_large_ball_iso_scallop_holds_the_scallop_on_the_true_surface() {
-    step_free_form_large_ball(StrategyKind::IsoScallop, "STEP ball D32 iso-scallop h 0.2");
-}
-
-/// Zig-zag's constant step, at its worst place (a test of its own: the two took a minute).
+/// Zig-zag's constant step, at its worst place. Iso-scallop with the same ball, h and
+/// tolerance is `tezgah cam --tool auto`'s job on this fixture, verified end to end (at a
+/// finer cell) by the CLI's `cam_tool::auto_from_the_standard_set_on_the_free_form_is_verified`.
 #[test]
 fn step_free_form_large_ball_zigzag_holds_the_scallop_on_the_true_surface() {
     step_free_form_large_ball(StrategyKind::ZigZag, "STEP ball D32 zigzag h 0.2");

@@ -21,6 +21,10 @@ pub struct Sweep {
     turn: f64,
     /// Angular velocity per unit `s`: the turn about `a × b`, rad.
     spin: Vec3,
+    /// `spin`'s direction (zero without a turn) and `|step|`: [`Sweep::spread`] asks for
+    /// them for every cell and span of the rear check's search, so they are made once.
+    spin_axis: Vec3,
+    travel: f64,
 }
 
 impl Sweep {
@@ -42,13 +46,16 @@ impl Sweep {
         } else {
             Vec3::zeros()
         };
+        let step = tip_b - tip_a;
         Sweep {
             from: *tip_a,
-            step: tip_b - tip_a,
+            step,
             axis_from: *axis_a,
             axis_to: *axis_b,
             turn,
             spin,
+            spin_axis: spin.try_normalize(0.0).unwrap_or_else(Vec3::zeros),
+            travel: step.norm(),
         }
     }
 
@@ -96,8 +103,7 @@ impl Sweep {
             return 0.0;
         }
         let y = p - tip;
-        let k = self.spin.try_normalize(0.0).unwrap_or_else(Vec3::zeros);
-        let (theta, travel) = (self.turn, self.step.norm());
+        let (k, theta, travel) = (self.spin_axis, self.turn, self.travel);
         let slope = g.dot(&(-self.step - self.spin.cross(&y))).abs() + theta * near;
         let roll = k.cross(g).dot(&self.step);
         let coriolis = if roll < 0.0 {
@@ -115,7 +121,7 @@ impl Sweep {
             return 0.0;
         }
         let y = p - tip;
-        let (theta, travel) = (self.turn, self.step.norm());
+        let (theta, travel) = (self.turn, self.travel);
         let slope = (self.step + self.spin.cross(&y)).norm() + theta * near;
         let bend = theta * theta * (y.norm() + near + 3.0 * h * travel) + 2.0 * theta * travel;
         Self::parabola_max(slope, bend, h)

@@ -854,7 +854,14 @@ impl<'a> Context<'a> {
     fn run_pass(&self, path: &impl SurfacePath, reverse: bool) -> Result<PassResult, CamError> {
         let (t0, t1) = path.range();
         let h = (t1 - t0) * 1e-6;
-        let sign = if reverse { -1.0 } else { 1.0 };
+        // The lead and tilt are measured from the pass's direction on the part, not from the
+        // way it is cut, for a ball: it cuts the same leaning either way along the feed (its
+        // lead keeps the contact off the centre, where the cutting speed is zero, whether it
+        // leads or trails), so a zig-zag return keeps the outward pass's axis and the table
+        // does not turn over at every link (issue 23: +20–70 % cycle with the lead flipping).
+        // Other shapes lead on every pass: their heels and rims cut where they lean.
+        let trails = matches!(self.shape(), CutterShape::Ball { .. });
+        let sign = if reverse && !trails { -1.0 } else { 1.0 };
         let contact_at = |t: f64| {
             let (a, b) = (path.uv((t - h).max(t0)), path.uv((t + h).min(t1)));
             Contact {

@@ -100,6 +100,16 @@ impl PlanMachine {
         })
     }
 
+    /// The least change of joint `i` between neighbouring samples, in the joint's own unit
+    /// (mm or rad), that the joint-jump rule reads as motion: what the joint moves in
+    /// [`JUMP_FLOOR_S`] at its top speed. Smaller changes are the inverse kinematics' rounding
+    /// (C moves 1e-9 rad where a path arrives exactly at table-bc's pole), which halving the
+    /// step does not halve either; a true jump (C turning 180° across a pole) is millions of
+    /// times larger.
+    pub fn jump_floor(&self, i: usize) -> f64 {
+        self.max_velocity[i] * JUMP_FLOOR_S
+    }
+
     pub fn joint_count(&self) -> usize {
         self.max_velocity.len()
     }
@@ -441,11 +451,14 @@ impl ToolAxisMap for PlanMachine {
                 return false;
             };
             // A joint that jumps (leaving the pole, where C is free, toward another C) does
-            // not halve its change when the step is halved, as a smooth joint does.
-            let (i, big) = (0..q.len())
-                .map(|i| (i, (next[i] - q[i]).abs()))
+            // not halve its change when the step is halved, as a smooth joint does. The
+            // joint that moves most is the one furthest over its own floor (mm and rad are
+            // not compared).
+            let (i, over) = (0..q.len())
+                .map(|i| (i, (next[i] - q[i]).abs() / self.jump_floor(i)))
                 .fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
-            if big > 1e-9 {
+            let big = (next[i] - q[i]).abs();
+            if over > 1.0 {
                 let Some(mid) = at(0.5 * (f0 + f1), &q) else {
                     return false;
                 };
@@ -461,6 +474,9 @@ impl ToolAxisMap for PlanMachine {
     }
 }
 
+/// Time (s) in which a joint at its top speed moves [`PlanMachine::jump_floor`]: a thousandth
+/// of a 1 ms interpolation period, far below any move a period can show.
+const JUMP_FLOOR_S: f64 = 1e-6;
 /// Largest turn of the tool axis (rad) between two steps of [`PlanMachine::follows`]'s walk.
 const FOLLOW_STEP: f64 = 0.01;
 /// How close (mm, rad) the walk's joints must end to the programmed ones.

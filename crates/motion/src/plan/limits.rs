@@ -507,12 +507,13 @@ fn numeric_joints(
         let x = |k: usize| q[k][i];
         // A joint that jumps (a path through a singular pose, e.g. the C axis centre of a
         // Y-Z-C-A machine) has no speed that keeps it in its limits: halving the step around
-        // the largest change must halve it, as for any smooth joint.
+        // the largest change must halve it, as for any smooth joint. Changes below the
+        // joint's own floor (`PlanMachine::jump_floor`) are rounding, not motion.
         let k = (0..m)
             .max_by(|&a, &b| (x(a + 1) - x(a)).abs().total_cmp(&(x(b + 1) - x(b)).abs()))
             .unwrap_or(0);
         let big = (x(k + 1) - x(k)).abs();
-        if big > 1e-9 {
+        if big > machine.jump_floor(i) {
             let mut before = Joints::zeros(n);
             before.as_mut_slice().copy_from_slice(&q[k][..n]);
             let fm = (k as f64 + 0.5) / steps as f64;
