@@ -5,16 +5,13 @@
 //! never on timings.
 
 mod common;
-
-use std::net::TcpStream;
-use std::time::{Duration, Instant};
+#[path = "common/ws.rs"]
+mod ws;
 
 use common::{Banner, Server};
 use serde_json::{json, Value};
-use tungstenite::stream::MaybeTlsStream;
-use tungstenite::{Message, WebSocket};
-
-type Socket = WebSocket<MaybeTlsStream<TcpStream>>;
+use tungstenite::Message;
+use ws::{next, request, state, wait_for, Socket};
 
 fn start() -> (Server, Socket) {
     start_with(&[])
@@ -69,48 +66,6 @@ fn control(ws: &mut Socket) -> Value {
             return m;
         }
     }
-}
-
-fn next(ws: &mut Socket) -> Value {
-    loop {
-        if let Message::Text(t) = ws.read().unwrap() {
-            return serde_json::from_str(t.as_str()).unwrap();
-        }
-    }
-}
-
-/// Sends a request and returns its reply (status messages in between are skipped).
-fn request(ws: &mut Socket, message: Value) -> Value {
-    ws.send(Message::text(message.to_string())).unwrap();
-    loop {
-        let m = next(ws);
-        if m["type"] == "reply" {
-            return m;
-        }
-    }
-}
-
-/// Reads statuses until `done` holds for one (at most 20 s of wall time).
-fn wait_for(ws: &mut Socket, done: impl Fn(&Value) -> bool) -> Value {
-    let deadline = Instant::now() + Duration::from_secs(20);
-    let mut last = Value::Null;
-    loop {
-        assert!(
-            Instant::now() < deadline,
-            "timed out waiting for a status; the last: {last}"
-        );
-        let m = next(ws);
-        if m["type"] == "status" {
-            if done(&m) {
-                return m;
-            }
-            last = m;
-        }
-    }
-}
-
-fn state(status: &Value) -> &str {
-    status["state"]["state"].as_str().unwrap()
 }
 
 fn tip(status: &Value) -> [f64; 3] {

@@ -8,22 +8,20 @@
 //! Needs root; without it the test says so and returns, except under CI=true, where it fails.
 
 mod common;
+#[path = "common/ws.rs"]
+mod ws;
 
-use std::net::TcpStream;
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use serde_json::{json, Value};
+use serde_json::json;
 use tezgah_ethercat::emulator::netns::{enter, Veth};
 use tezgah_ethercat::emulator::{Bus, IDENTITY};
 use tezgah_ethercat::master::link::{serve_interface, RawSocket};
 use tezgah_kinematics::Machine;
-use tungstenite::stream::MaybeTlsStream;
-use tungstenite::{Message, WebSocket};
-
-type Socket = WebSocket<MaybeTlsStream<TcpStream>>;
+use ws::{request, state, wait_for};
 
 fn can_run() -> bool {
     // SAFETY: no arguments, no side effects.
@@ -161,46 +159,6 @@ fn serve(v: &Veth, machine: &std::path::Path) -> Result<(Server, String), String
         .unwrap()
         .to_owned();
     Ok((server, ws))
-}
-
-fn next(ws: &mut Socket) -> Value {
-    loop {
-        if let Message::Text(t) = ws.read().unwrap() {
-            return serde_json::from_str(t.as_str()).unwrap();
-        }
-    }
-}
-
-fn request(ws: &mut Socket, message: Value) -> Value {
-    ws.send(Message::text(message.to_string())).unwrap();
-    loop {
-        let m = next(ws);
-        if m["type"] == "reply" {
-            return m;
-        }
-    }
-}
-
-fn wait_for(ws: &mut Socket, done: impl Fn(&Value) -> bool) -> Value {
-    let deadline = Instant::now() + Duration::from_secs(30);
-    let mut last = Value::Null;
-    loop {
-        assert!(
-            Instant::now() < deadline,
-            "timed out; the last status: {last}"
-        );
-        let m = next(ws);
-        if m["type"] == "status" {
-            if done(&m) {
-                return m;
-            }
-            last = m;
-        }
-    }
-}
-
-fn state(s: &Value) -> &str {
-    s["state"]["state"].as_str().unwrap_or("")
 }
 
 #[test]
