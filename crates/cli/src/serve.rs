@@ -215,7 +215,7 @@ struct Shared {
 pub fn serve(args: ServeArgs) -> Result<std::process::ExitCode> {
     let machine = crate::run::load_machine(args.machine.as_deref())?;
     let text = crate::run::machine_text(args.machine.as_deref())?;
-    let options = ExecOptions::for_machine(&machine).map_err(|e| miette!("{e}"))?;
+    let options = ExecOptions::for_machine(&machine);
     let period = options.period;
     if !(args.lead_ms.is_finite() && args.lead_ms > 0.0) {
         return Err(miette!("--lead-ms must be > 0, got {}", args.lead_ms));

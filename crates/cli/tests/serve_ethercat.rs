@@ -12,14 +12,11 @@ mod common;
 mod ws;
 
 use std::process::{Child, Command, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use serde_json::json;
-use tezgah_ethercat::emulator::netns::{enter, Veth};
+use tezgah_ethercat::emulator::netns::{enter, DrivesOnVeth, Veth};
 use tezgah_ethercat::emulator::{Bus, IDENTITY};
-use tezgah_ethercat::master::link::{serve_interface, RawSocket};
 use tezgah_kinematics::Machine;
 use ws::{request, state, wait_for};
 
@@ -50,50 +47,6 @@ fn machine_file(products: [u32; 3]) -> std::path::PathBuf {
     let path = common::tmp_dir(&format!("serve-ethercat-{}", products[2])).join("mill3.toml");
     std::fs::write(&path, t).unwrap();
     path
-}
-
-/// The emulated drives answering on the slave end until dropped.
-struct Drives {
-    bus: Arc<Mutex<Bus>>,
-    stop: Arc<AtomicBool>,
-    thread: Option<std::thread::JoinHandle<std::io::Result<u64>>>,
-}
-
-impl Drives {
-    fn start(v: &Veth) -> Drives {
-        let bus = Arc::new(Mutex::new(Bus::drives(3, 1.0)));
-        let stop = Arc::new(AtomicBool::new(false));
-        let (ready, listening) = std::sync::mpsc::channel();
-        let thread = {
-            let (bus, stop, ns, ifname) = (
-                bus.clone(),
-                stop.clone(),
-                v.slave_ns.clone(),
-                v.slave_if.clone(),
-            );
-            std::thread::spawn(move || {
-                enter(&ns)?;
-                let sock = RawSocket::open(&ifname);
-                let _ = ready.send(());
-                serve_interface(sock?, bus, &stop)
-            })
-        };
-        listening.recv().unwrap();
-        Drives {
-            bus,
-            stop,
-            thread: Some(thread),
-        }
-    }
-}
-
-impl Drop for Drives {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
-    }
 }
 
 struct Server(Child);
@@ -167,7 +120,7 @@ fn serve_runs_a_program_on_emulated_drives_over_a_veth_pair() {
         return;
     }
     let v = Veth::new("cli").expect("namespaces and veth");
-    let drives = Drives::start(&v);
+    let drives = DrivesOnVeth::start(&v, Bus::drives(3, 1.0), false).unwrap();
     // This thread joins the server's namespace to reach its loopback.
     enter(&v.master_ns).unwrap();
 
@@ -248,7 +201,7 @@ fn a_drive_the_bus_lacks_is_refused_at_start() {
         return;
     }
     let v = Veth::new("cl2").expect("namespaces and veth");
-    let _drives = Drives::start(&v);
+    let _drives = DrivesOnVeth::start(&v, Bus::drives(3, 1.0), false).unwrap();
     let e = match serve(
         &v,
         &machine_file([IDENTITY.product_code, IDENTITY.product_code, 0x99]),

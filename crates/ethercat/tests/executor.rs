@@ -39,7 +39,7 @@ fn rig(
 ) {
     let (m, _) = machine_and_section(["x", "y", "z"], 1.0);
     let (bus, drive) = open(gain, 1.0);
-    let exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let exec = Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap();
     let limits = StopLimits::of(exec.machine());
     let start = drive.position();
     let (p, r) = rings(24, 4096);

@@ -58,13 +58,13 @@ pub struct ExecOptions {
 }
 
 impl ExecOptions {
-    /// The machine file's period and tolerance.
-    pub fn for_machine(machine: &Machine) -> Result<ExecOptions, ExecError> {
-        PlanMachine::from_machine(machine).map_err(ExecError::Plan)?;
-        Ok(ExecOptions {
+    /// The machine file's period and tolerance (the machine itself is checked by
+    /// [`Executor::new`]).
+    pub fn for_machine(machine: &Machine) -> ExecOptions {
+        ExecOptions {
             period: machine.motion.period_s,
             tolerance: machine.motion.tolerance_mm,
-        })
+        }
     }
 
     /// The planner's options at this period ([`tezgah_motion::prepare::plan_options`]).

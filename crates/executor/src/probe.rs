@@ -247,28 +247,16 @@ mod tests {
     }
 
     /// Every joint's speed, acceleration and jerk by finite differences of the samples at the
-    /// period (as the run's verifier takes them) within 0.5 % of its limits.
+    /// period (the run's verifier, `tezgah_motion::verify::Verifier`) within 0.5 % of its
+    /// limits.
     fn assert_within_limits(run: &ProbeRun, machine: &Machine) {
-        let t = 0.001;
-        for (i, joint) in machine.joints.iter().enumerate() {
-            let q: Vec<f64> = run.samples.iter().map(|s| s.0.joints[i]).collect();
-            let d = |x: &[f64]| -> Vec<f64> { x.windows(2).map(|w| (w[1] - w[0]) / t).collect() };
-            let (v, a) = (d(&q), d(&d(&q)));
-            let j = d(&a);
-            let peak = |x: &[f64]| x.iter().fold(0.0f64, |m, y| m.max(y.abs()));
-            assert!(peak(&v) <= joint.max_velocity * 1.005, "{} v", joint.name);
-            assert!(
-                peak(&a) <= joint.max_acceleration * 1.005,
-                "{} a {}",
-                joint.name,
-                peak(&a)
-            );
-            assert!(
-                peak(&j) <= joint.max_jerk * 1.005,
-                "{} j {}",
-                joint.name,
-                peak(&j)
-            );
+        let pm = PlanMachine::from_machine(machine).unwrap();
+        let mut verifier = tezgah_motion::verify::Verifier::new(&pm, 0.001);
+        for (s, _) in &run.samples {
+            verifier.push(s, &[]);
+        }
+        for (joint, peaks) in machine.joints.iter().zip(verifier.finish().joints) {
+            assert!(peaks.worst_ratio() <= 1.005, "{} {peaks:?}", joint.name);
         }
     }
 

@@ -20,7 +20,7 @@ fn plays_the_interpolator_samples(machine: &tezgah_kinematics::Machine, program:
     use tezgah_motion::plan::PlanMachine;
     let mut exec = Executor::new(
         machine,
-        ExecOptions::for_machine(machine).unwrap(),
+        ExecOptions::for_machine(machine),
         tezgah_geom::Pose::ZERO,
     )
     .unwrap();
@@ -722,7 +722,7 @@ fn five_axis_holds_and_override() {
     let new = || {
         Executor::new(
             &machine,
-            ExecOptions::for_machine(&machine).unwrap(),
+            ExecOptions::for_machine(&machine),
             tezgah_geom::Pose::ZERO,
         )
         .unwrap()

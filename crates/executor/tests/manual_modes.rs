@@ -145,7 +145,7 @@ fn jog_to_the_soft_limit_stops_on_it_and_further_jogs_that_way_are_refused() {
     let m = Machine::default_machine();
     let mut exec = Executor::new(
         &m,
-        ExecOptions::for_machine(&m).unwrap(),
+        ExecOptions::for_machine(&m),
         Pose::new(190.0, 0.0, 0.0, 0.0, 0.0, 0.0),
     )
     .unwrap();
@@ -358,7 +358,7 @@ fn a_missing_switch_stops_homing_with_the_joint_named() {
     // z's switch beyond its travel: the search gives up after 1.1 × the travel.
     let text = mill3_text();
     let m = Machine::from_toml_str(&text).unwrap();
-    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap();
     let offset = Joints::from_slice(&[0.0, 0.0, 1000.0]).unwrap();
     exec.set_switches(Box::new(SimulatedSwitches::new(&m, &offset).unwrap()));
     let start = exec.drive_joints();
@@ -429,7 +429,7 @@ fn auto_waits_for_homing_only_if_the_machine_file_asks() {
     let text = mill3_text().replace("home_required = false", "home_required = true");
     let m = Machine::from_toml_str(&text).unwrap();
     assert!(m.motion.home_required);
-    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap();
     exec.command(Command::Load {
         program: "G0 X1\nM2\n".into(),
     })
@@ -657,7 +657,7 @@ proptest! {
         let m = Machine::default_machine();
         let mut exec = Executor::new(
             &m,
-            ExecOptions::for_machine(&m).unwrap(),
+            ExecOptions::for_machine(&m),
             Pose::new(start.0, start.1, start.2, 0.0, 0.0, 0.0),
         )
         .unwrap();

@@ -15,7 +15,7 @@ use tezgah_kinematics::Machine;
 fn probing_executor(model: ProbeModel) -> (Executor, Machine) {
     let mut m = Machine::default_machine();
     m.probe = Some(model);
-    let exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let exec = Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap();
     (exec, m)
 }
 

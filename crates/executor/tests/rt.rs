@@ -314,7 +314,7 @@ fn rig_on(
     use tezgah_executor::executor::{ExecOptions, Executor};
     let exec = Executor::new(
         machine,
-        ExecOptions::for_machine(machine).unwrap(),
+        ExecOptions::for_machine(machine),
         tezgah_geom::Pose::ZERO,
     )
     .unwrap();

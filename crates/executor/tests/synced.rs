@@ -9,8 +9,10 @@ use tezgah_executor::synced::{run_synced, Spindle, SyncRun};
 use tezgah_geom::{Move, MoveKind, Pose, SyncedMove, Vec3};
 use tezgah_kinematics::spindle::SpindleModel;
 use tezgah_kinematics::{Joints, Machine};
+use tezgah_motion::interpolate::Sample;
 use tezgah_motion::path::smooth::{self, SmoothOptions};
 use tezgah_motion::plan::{PlanMachine, PlanOptions};
+use tezgah_motion::verify::Verifier;
 use tezgah_motion::PathItem;
 
 const PERIOD: f64 = 0.001;
@@ -83,35 +85,25 @@ fn run(
     (run, machine)
 }
 
-/// Every joint's speed, acceleration and jerk by finite differences within 0.5 % of its limits
-/// (the samples start from rest at `start`).
+/// Every joint's speed, acceleration and jerk by finite differences at the period (the run's
+/// verifier, `tezgah_motion::verify::Verifier`) within 0.5 % of its limits; the samples start
+/// from rest at `start`.
 fn assert_within_limits(run: &SyncRun, machine: &Machine, start: &[f64]) {
-    for (i, joint) in machine.joints.iter().enumerate() {
-        let q: Vec<f64> = std::iter::once(start[i])
-            .chain(run.samples.iter().map(|s| s.0.joints[i]))
-            .collect();
-        let d = |x: &[f64]| -> Vec<f64> { x.windows(2).map(|w| (w[1] - w[0]) / PERIOD).collect() };
-        let (v, a) = (d(&q), d(&d(&q)));
-        let j = d(&a);
-        let peak = |x: &[f64]| x.iter().fold(0.0f64, |m, y| m.max(y.abs()));
-        assert!(
-            peak(&v) <= joint.max_velocity * 1.005,
-            "{} v {}",
-            joint.name,
-            peak(&v)
-        );
-        assert!(
-            peak(&a) <= joint.max_acceleration * 1.005,
-            "{} a {}",
-            joint.name,
-            peak(&a)
-        );
-        assert!(
-            peak(&j) <= joint.max_jerk * 1.005,
-            "{} j {}",
-            joint.name,
-            peak(&j)
-        );
+    let pm = PlanMachine::from_machine(machine).unwrap();
+    let mut verifier = Verifier::new(&pm, PERIOD);
+    if let Some((first, _)) = run.samples.first() {
+        let rest = Sample {
+            joints: Joints::from_slice(start).unwrap(),
+            feed: 0.0,
+            ..*first
+        };
+        verifier.push(&rest, &[]);
+    }
+    for (s, _) in &run.samples {
+        verifier.push(s, &[]);
+    }
+    for (joint, peaks) in machine.joints.iter().zip(verifier.finish().joints) {
+        assert!(peaks.worst_ratio() <= 1.005, "{} {peaks:?}", joint.name);
     }
 }
 
@@ -220,7 +212,7 @@ fn the_executor_refuses_g33_at_its_line() {
     use tezgah_executor::command::Command;
     use tezgah_executor::executor::{ExecOptions, Executor};
     let m = Machine::default_machine();
-    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap();
+    let mut exec = Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap();
     let e = exec
         .command(Command::Load {
             program: "G21 G90\nM3 S600\nG0 Z1\nG33.1 Z-5 K1\nM2\n".into(),

@@ -7,6 +7,12 @@ use std::fs::File;
 use std::io;
 use std::os::fd::AsRawFd;
 use std::process::Command;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+
+use super::Bus;
+use crate::master::link::{serve_interface, RawSocket};
 
 /// Runs `ip` with `args`; its complaint as the error.
 pub fn ip(args: &[&str]) -> io::Result<()> {
@@ -85,5 +91,73 @@ pub fn enter(ns: &str) -> io::Result<()> {
         Ok(())
     } else {
         Err(io::Error::last_os_error())
+    }
+}
+
+/// Emulated drives answering on the drives' end of a [`Veth`], from a thread of their own in
+/// the drives' namespace, until stopped (or dropped): what the namespace tests, the soak and a
+/// `serve` test put on the far end of the cable.
+pub struct DrivesOnVeth {
+    /// The drives, to read what they received or to inject faults.
+    pub bus: Arc<Mutex<Bus>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<io::Result<u64>>>,
+}
+
+impl DrivesOnVeth {
+    /// Starts `bus` on `veth`'s drives' end and returns once it listens (so the master's first
+    /// frame finds it). `realtime`: the thread at the executor's best-effort real-time
+    /// settings, answering at once as hardware does.
+    pub fn start(veth: &Veth, bus: Bus, realtime: bool) -> io::Result<DrivesOnVeth> {
+        let bus = Arc::new(Mutex::new(bus));
+        let stop = Arc::new(AtomicBool::new(false));
+        let (ready, listening) = std::sync::mpsc::channel();
+        let thread = {
+            let (bus, stop) = (bus.clone(), stop.clone());
+            let (ns, ifname) = (veth.slave_ns.clone(), veth.slave_if.clone());
+            std::thread::spawn(move || {
+                enter(&ns)?;
+                if realtime {
+                    let _ = tezgah_executor::realtime::apply(
+                        &tezgah_executor::realtime::RealtimeSettings::BEST_EFFORT,
+                    );
+                }
+                let sock = RawSocket::open(&ifname);
+                let _ = ready.send(());
+                serve_interface(sock?, bus, &stop)
+            })
+        };
+        if listening.recv().is_err() {
+            // The thread ended before listening: its error says why.
+            let e = match thread.join() {
+                Ok(Err(e)) => e,
+                _ => io::Error::other("the emulated drives' thread stopped"),
+            };
+            return Err(e);
+        }
+        Ok(DrivesOnVeth {
+            bus,
+            stop,
+            thread: Some(thread),
+        })
+    }
+
+    /// Stops the drives; the frames they answered, or their socket's error.
+    pub fn stop(mut self) -> io::Result<u64> {
+        self.stop.store(true, Ordering::Relaxed);
+        match self.thread.take().map(JoinHandle::join) {
+            Some(Ok(r)) => r,
+            Some(Err(_)) => Err(io::Error::other("the emulated drives' thread panicked")),
+            None => Ok(0),
+        }
+    }
+}
+
+impl Drop for DrivesOnVeth {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
     }
 }

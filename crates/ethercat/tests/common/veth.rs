@@ -7,16 +7,16 @@
 
 use std::fs::File;
 use std::process::{Child, Command, Stdio};
-use std::sync::atomic::{AtomicBool, Ordering};
+
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use super::{machine_and_section, COUNTS_PER_MM, PERIOD};
 use tezgah_ethercat::drive::EthercatDrive;
-use tezgah_ethercat::emulator::netns::enter;
 pub use tezgah_ethercat::emulator::netns::Veth;
+use tezgah_ethercat::emulator::netns::{enter, DrivesOnVeth};
 use tezgah_ethercat::emulator::Bus;
-use tezgah_ethercat::master::link::{serve_interface, RawSocket};
+use tezgah_ethercat::master::link::RawSocket;
 use tezgah_ethercat::master::MasterOptions;
 use tezgah_executor::{Drive, SetPoint};
 use tezgah_kinematics::Joints;
@@ -153,30 +153,10 @@ pub fn path(k: u64) -> [f64; 3] {
 /// drive and the emulated bus. `realtime`: the drives' thread at SCHED_FIFO (as hardware, it
 /// answers at once; the soak asks for it, the test leaves the scheduler alone).
 pub fn run(v: &Veth, cycles: u64, realtime: bool) -> (Figures, EthercatDrive, Arc<Mutex<Bus>>) {
-    let bus = Arc::new(Mutex::new(Bus::drives(3, 1.0)));
-    let stop = Arc::new(AtomicBool::new(false));
-    let (ready, listening) = std::sync::mpsc::channel();
-    let slaves = {
-        let (bus, stop, ns, ifname) = (
-            bus.clone(),
-            stop.clone(),
-            v.slave_ns.clone(),
-            v.slave_if.clone(),
-        );
-        std::thread::spawn(move || {
-            enter(&ns)?;
-            if realtime {
-                let _ = tezgah_executor::realtime::apply(
-                    &tezgah_executor::realtime::RealtimeSettings::BEST_EFFORT,
-                );
-            }
-            let sock = RawSocket::open(&ifname);
-            let _ = ready.send(());
-            serve_interface(sock?, bus, &stop)
-        })
-    };
     // The drives listen before the master sends its first frame.
-    listening.recv().expect("the emulated drives' thread");
+    let drives = DrivesOnVeth::start(v, Bus::drives(3, 1.0), realtime)
+        .expect("the emulated drives on the veth");
+    let bus = drives.bus.clone();
     enter(&v.master_ns).expect("entering the master's namespace");
     let (m, s) = machine_and_section(["x", "y", "z"], 1.0);
     let link = RawSocket::open(&v.master_if).expect("raw socket");
@@ -227,7 +207,6 @@ pub fn run(v: &Veth, cycles: u64, realtime: bool) -> (Figures, EthercatDrive, Ar
             );
         }
     }
-    stop.store(true, Ordering::Relaxed);
-    slaves.join().unwrap().expect("the emulated drives' socket");
+    drives.stop().expect("the emulated drives' socket");
     (f, d, bus)
 }

@@ -14,7 +14,7 @@ pub const TOL: f64 = 0.01;
 
 pub fn executor() -> Executor {
     let m = Machine::default_machine();
-    Executor::new(&m, ExecOptions::for_machine(&m).unwrap(), Pose::ZERO).unwrap()
+    Executor::new(&m, ExecOptions::for_machine(&m), Pose::ZERO).unwrap()
 }
 
 /// Every set-point produced, replayed through the verifier.

@@ -262,15 +262,10 @@ pub fn analyse(seg: &Segment, machine: &PlanMachine) -> Result<Geometry, PlanErr
             // 1/cos(0.05) = 1.00125 of the sampled one, and the parabola through a peak and
             // its neighbours misses it by far less. A spline's or blend's curvature can spike
             // between samples: it keeps the wider margins.
-            let margin = if constant {
-                [1.002; 3]
+            let (margin, vertex_margin) = if constant {
+                ([1.002; 3], [1.002; 3])
             } else {
-                [1.005, 1.05, 1.05]
-            };
-            let vertex_margin = if constant {
-                [1.002; 3]
-            } else {
-                [1.01, 1.06, 1.06]
+                ([1.005, 1.05, 1.05], [1.01, 1.06, 1.06])
             };
             let samples = ((turning / 0.1).ceil() as usize).clamp(32, 4096);
             let du = (ub - ua) / samples as f64;
